@@ -1,0 +1,83 @@
+//! What one experiment is: the tutorial's flags as a plain, serializable struct. The CLI fills it;
+//! batch manifests and tests can build it directly.
+
+use serde::{Deserialize, Serialize};
+use std::path::PathBuf;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum IntegratorKind {
+    Discrete,
+    Continuous,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case", default)]
+pub struct RunConfig {
+    pub urdf: PathBuf,
+    /// Simulated time, s.
+    pub duration: f64,
+    /// Control period, s.
+    pub dt: f64,
+    /// Plant step, s: `None` is the control period, 0 the continuous plant.
+    pub time_step: Option<f64>,
+    pub integrator: Option<IntegratorKind>,
+    pub rtol: f64,
+    pub atol: f64,
+    /// Wave frequency ω, rad/s.
+    pub freq: f64,
+    /// Wave amplitude, degrees.
+    pub amp_deg: f64,
+    /// One value for every joint, or one per joint.
+    pub kp: Option<Vec<f64>>,
+    pub kd: Option<Vec<f64>>,
+    pub auto_tune: bool,
+    /// Interval of the tutorial CSV rows, s.
+    pub print_every: f64,
+    /// Hold every joint at 0.
+    #[serde(rename = "static")]
+    pub hold: bool,
+    pub no_ff: bool,
+    pub no_gravity: bool,
+    /// Step one joint (number from 1, or name) to `test_angle`.
+    pub test_joint: Option<String>,
+    pub test_angle: f64,
+    pub debug: bool,
+    /// The link whose origin is the tool tip.
+    pub tool: Option<String>,
+    /// Tracking error statistics cover every step with t ≥ this, s.
+    pub settle_time: f64,
+    /// A joint speed above this (rad/s or m/s) is divergence.
+    pub divergence_speed: f64,
+}
+
+pub const DEFAULT_URDF: &str = "assets/smallrobot_arm.urdf";
+
+impl Default for RunConfig {
+    fn default() -> Self {
+        Self {
+            urdf: PathBuf::from(DEFAULT_URDF),
+            duration: 30.0,
+            dt: 0.001,
+            time_step: None,
+            integrator: None,
+            rtol: 1e-8,
+            atol: 1e-10,
+            freq: 0.5,
+            amp_deg: 30.0,
+            kp: None,
+            kd: None,
+            auto_tune: false,
+            print_every: 0.5,
+            hold: false,
+            no_ff: false,
+            no_gravity: false,
+            test_joint: None,
+            test_angle: 0.3,
+            debug: false,
+            tool: None,
+            settle_time: 2.0,
+            divergence_speed: 1e4,
+        }
+    }
+}

@@ -1,0 +1,42 @@
+//! The tutorial's joint controller: PD on the command plus gravity feed-forward, clipped to the
+//! motors' limits.
+
+/// u = kp∘(cmd − q) + kd∘(cmd_dot − q̇) − τ_g(q), clipped to ±effort; zero on unactuated joints.
+#[derive(Clone, Debug)]
+pub struct PdGravityController {
+    pub kp: Vec<f64>,
+    pub kd: Vec<f64>,
+    /// Torque limit per joint (0 where the joint has no actuator).
+    pub effort: Vec<f64>,
+    pub actuated: Vec<bool>,
+    /// Gravity feed-forward (off with `--no-ff`).
+    pub feed_forward: bool,
+}
+
+/// One controller output.
+pub struct ControlOutput<'a> {
+    /// The torque applied (after clipping).
+    pub u: &'a mut [f64],
+    /// Whether the unclipped torque exceeded the limit.
+    pub saturated: &'a mut [bool],
+}
+
+impl PdGravityController {
+    #[allow(clippy::too_many_arguments)]
+    pub fn compute(&self, q: &[f64], v: &[f64], cmd: &[f64], cmd_dot: &[f64], tau_g: &[f64], out: ControlOutput) {
+        for i in 0..q.len() {
+            if !self.actuated[i] {
+                out.u[i] = 0.0;
+                out.saturated[i] = false;
+                continue;
+            }
+            let mut u = self.kp[i] * (cmd[i] - q[i]) + self.kd[i] * (cmd_dot[i] - v[i]);
+            if self.feed_forward {
+                u -= tau_g[i];
+            }
+            let limit = self.effort[i];
+            out.saturated[i] = u.abs() > limit;
+            out.u[i] = u.clamp(-limit, limit);
+        }
+    }
+}

@@ -1,0 +1,54 @@
+use super::{Data, forward_kinematics};
+use super::rnea::base_acceleration;
+use crate::model::Model;
+use crate::spatial::{cross_force, cross_motion};
+use nalgebra::Vector6;
+
+/// Forward dynamics q̈ = M⁻¹(τ + τ_g − C q̇) by the articulated-body algorithm, into `data.qdd`.
+/// Joint damping is not included: pass τ − D q̇ for it.
+pub fn aba<'d>(model: &Model, data: &'d mut Data, q: &[f64], v: &[f64], tau: &[f64]) -> &'d [f64] {
+    forward_kinematics(model, data, q);
+    aba_from_kinematics(model, data, v, tau);
+    &data.qdd
+}
+
+/// ABA assuming `forward_kinematics` was run for the current q.
+pub fn aba_from_kinematics(model: &Model, data: &mut Data, v: &[f64], tau: &[f64]) {
+    let n = model.dof();
+    for (i, joint) in model.joints.iter().enumerate() {
+        let s = data.motion_subspace[i];
+        let v_parent = joint.parent.map_or(Vector6::zeros(), |p| data.velocity[p]);
+        let joint_velocity = s * v[i];
+        let vel = v_parent + joint_velocity;
+        data.bias_acceleration[i] = cross_motion(&vel, &joint_velocity);
+        let inertia = data.body_inertia[i];
+        data.articulated_bias[i] = cross_force(&vel, &(inertia * vel));
+        data.articulated_inertia[i] = inertia;
+        data.velocity[i] = vel;
+    }
+    for i in (0..n).rev() {
+        let s = data.motion_subspace[i];
+        let ia = data.articulated_inertia[i];
+        let u_vec = ia * s;
+        let d = s.dot(&u_vec);
+        let u = tau[i] - s.dot(&data.articulated_bias[i]);
+        data.aba_u[i] = u_vec;
+        data.aba_d[i] = d;
+        data.aba_torque[i] = u;
+        if let Some(p) = model.joints[i].parent {
+            let inv_d = 1.0 / d;
+            let ia_reduced = ia - (u_vec * u_vec.transpose()) * inv_d;
+            let pa = data.articulated_bias[i] + ia_reduced * data.bias_acceleration[i] + u_vec * (u * inv_d);
+            data.articulated_inertia[p] += ia_reduced;
+            data.articulated_bias[p] += pa;
+        }
+    }
+    let a0 = base_acceleration(model);
+    for (i, joint) in model.joints.iter().enumerate() {
+        let a_parent = joint.parent.map_or(a0, |p| data.acceleration[p]);
+        let a_prime = a_parent + data.bias_acceleration[i];
+        let qdd = (data.aba_torque[i] - data.aba_u[i].dot(&a_prime)) / data.aba_d[i];
+        data.qdd[i] = qdd;
+        data.acceleration[i] = a_prime + data.motion_subspace[i] * qdd;
+    }
+}

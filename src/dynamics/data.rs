@@ -1,0 +1,65 @@
+use crate::model::Model;
+use crate::spatial::Pose;
+use nalgebra::{DMatrix, Matrix6, Vector6};
+
+/// The per-simulation workspace of the dynamics algorithms. Sized once for a model; the
+/// algorithms only write into it.
+#[derive(Clone, Debug)]
+pub struct Data {
+    /// World pose of each body (set by `forward_kinematics`).
+    pub body_pose: Vec<Pose>,
+    /// Joint motion subspace S_i in world coordinates (set by `forward_kinematics`).
+    pub motion_subspace: Vec<Vector6<f64>>,
+    /// Each body's spatial inertia in world coordinates (set by `forward_kinematics`).
+    pub body_inertia: Vec<Matrix6<f64>>,
+    /// Body spatial velocities and accelerations (RNEA, ABA).
+    pub velocity: Vec<Vector6<f64>>,
+    pub acceleration: Vec<Vector6<f64>>,
+    /// Body forces (RNEA) and gravity wrenches (gravity pass).
+    pub force: Vec<Vector6<f64>>,
+    pub gravity_force: Vec<Vector6<f64>>,
+    /// Composite rigid-body inertias (CRBA).
+    pub composite_inertia: Vec<Matrix6<f64>>,
+    /// ABA intermediates.
+    pub bias_acceleration: Vec<Vector6<f64>>,
+    pub articulated_inertia: Vec<Matrix6<f64>>,
+    pub articulated_bias: Vec<Vector6<f64>>,
+    pub aba_u: Vec<Vector6<f64>>,
+    pub aba_d: Vec<f64>,
+    pub aba_torque: Vec<f64>,
+    /// Outputs.
+    pub mass_matrix: DMatrix<f64>,
+    pub tau: Vec<f64>,
+    pub qdd: Vec<f64>,
+    /// τ_g(q): the generalized force of gravity.
+    pub gravity: Vec<f64>,
+    /// C(q, q̇)·q̇.
+    pub bias: Vec<f64>,
+}
+
+impl Data {
+    pub fn new(model: &Model) -> Self {
+        let n = model.dof();
+        Self {
+            body_pose: vec![Pose::identity(); n],
+            motion_subspace: vec![Vector6::zeros(); n],
+            body_inertia: vec![Matrix6::zeros(); n],
+            velocity: vec![Vector6::zeros(); n],
+            acceleration: vec![Vector6::zeros(); n],
+            force: vec![Vector6::zeros(); n],
+            gravity_force: vec![Vector6::zeros(); n],
+            composite_inertia: vec![Matrix6::zeros(); n],
+            bias_acceleration: vec![Vector6::zeros(); n],
+            articulated_inertia: vec![Matrix6::zeros(); n],
+            articulated_bias: vec![Vector6::zeros(); n],
+            aba_u: vec![Vector6::zeros(); n],
+            aba_d: vec![0.0; n],
+            aba_torque: vec![0.0; n],
+            mass_matrix: DMatrix::zeros(n, n),
+            tau: vec![0.0; n],
+            qdd: vec![0.0; n],
+            gravity: vec![0.0; n],
+            bias: vec![0.0; n],
+        }
+    }
+}

@@ -1,0 +1,23 @@
+use super::{Data, frame_pose};
+use crate::model::Model;
+use crate::spatial::{angular, linear};
+use nalgebra::DMatrix;
+
+/// Geometric Jacobian of a frame's origin in world axes (6 × dof): rows 0–2 angular velocity,
+/// rows 3–5 the velocity of the frame origin. Uses the last `forward_kinematics`.
+pub fn frame_jacobian(model: &Model, data: &Data, frame: usize, out: &mut DMatrix<f64>) {
+    let origin = frame_pose(model, data, frame).translation;
+    out.fill(0.0);
+    let mut body = model.frames[frame].body;
+    while let Some(j) = body {
+        let s = &data.motion_subspace[j];
+        let w = angular(s);
+        // S is referred to the world origin; shift its linear part to the frame origin.
+        let v = linear(s) + w.cross(&origin);
+        for r in 0..3 {
+            out[(r, j)] = w[r];
+            out[(r + 3, j)] = v[r];
+        }
+        body = model.joints[j].parent;
+    }
+}

@@ -1,0 +1,23 @@
+//! Rigid-body algorithms on a [`Model`](crate::model::Model), Pinocchio-style: each algorithm is a
+//! free function taking the read-only model and a mutable [`Data`] workspace, which holds every
+//! intermediate so that no step allocates.
+//!
+//! All spatial quantities are in world coordinates, referred to the world origin
+//! (see [`crate::spatial`]). Sign conventions follow Drake:
+//! `M(q) q̈ + C(q,q̇) q̇ = τ + τ_g(q) − D q̇`, with τ_g the generalized force gravity applies.
+
+mod aba;
+mod cholesky;
+mod crba;
+mod data;
+mod jacobian;
+mod kinematics;
+mod rnea;
+
+pub use aba::{aba, aba_from_kinematics};
+pub use cholesky::{cholesky_in_place, cholesky_solve_in_place};
+pub use crba::{crba, crba_from_kinematics};
+pub use data::Data;
+pub use jacobian::frame_jacobian;
+pub use kinematics::{forward_kinematics, frame_pose};
+pub use rnea::{bias_forces, gravity_and_bias_from_kinematics, gravity_forces, gravity_from_kinematics, rnea, rnea_from_kinematics};

@@ -1,0 +1,189 @@
+//! A [`RunConfig`] checked and resolved against its model: everything the simulation loop needs.
+
+use crate::config::{IntegratorKind, RunConfig};
+use crate::controller::PdGravityController;
+use crate::error::Error;
+use crate::gains::{Gains, TUTORIAL_KD, TUTORIAL_KP, auto_tune, is_tutorial_model};
+use crate::integrator::{ContinuousPlant, DiscretePlant, Plant, Tolerances};
+use crate::model::{Model, load_urdf};
+use crate::trajectory::{Hold, JointStep, Trajectory, Wave};
+use nalgebra::Vector3;
+use std::sync::Arc;
+
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+#[serde(tag = "kind", rename_all = "lowercase")]
+pub enum PlantSpec {
+    /// `substeps` plant steps of `time_step` per control period.
+    Discrete { time_step: f64, substeps: usize },
+    Continuous { rtol: f64, atol: f64 },
+}
+
+pub struct Experiment {
+    pub config: RunConfig,
+    pub model: Arc<Model>,
+    pub gains: Gains,
+    pub plant: PlantSpec,
+    pub trajectory: Box<dyn Trajectory>,
+    /// Number of control steps: the run records states k = 0..=steps.
+    pub steps: usize,
+}
+
+impl Experiment {
+    /// Load the model named by the config and check every setting against it.
+    pub fn prepare(config: RunConfig) -> Result<Self, Error> {
+        let model = load_urdf(&config.urdf)?;
+        Self::with_model(config, model)
+    }
+
+    pub fn with_model(config: RunConfig, mut model: Model) -> Result<Self, Error> {
+        let positive = |flag: &str, value: f64| {
+            if value.is_finite() && value > 0.0 { Ok(()) } else { Err(Error::flag(flag, format!("must be a positive number of seconds (got {value})"))) }
+        };
+        positive("--duration", config.duration)?;
+        positive("--dt", config.dt)?;
+        positive("--print-every", config.print_every)?;
+        if !(config.settle_time >= 0.0) {
+            return Err(Error::flag("--settle-time", "must not be negative"));
+        }
+        for (flag, v) in [("--freq", config.freq), ("--amp-deg", config.amp_deg), ("--test-angle", config.test_angle)] {
+            if !v.is_finite() {
+                return Err(Error::flag(flag, format!("must be a finite number (got {v})")));
+            }
+        }
+        if config.no_gravity {
+            model.gravity = Vector3::zeros();
+        }
+        if let Some(tool) = &config.tool {
+            model.set_tool_frame(tool).map_err(|m| Error::flag("--tool", m))?;
+        }
+        let plant = plant_spec(&config)?;
+        let trajectory = trajectory(&config, &model)?;
+        let gains = gains(&config, &model)?;
+        let steps = (config.duration / config.dt - 1e-9).ceil() as usize;
+        Ok(Self { config, model: Arc::new(model), gains, plant, trajectory, steps })
+    }
+
+    pub fn controller(&self) -> PdGravityController {
+        let n = self.model.dof();
+        PdGravityController {
+            kp: self.gains.kp.clone(),
+            kd: self.gains.kd.clone(),
+            effort: self.model.effort_limits(),
+            actuated: (0..n).map(|i| self.model.is_actuated(i)).collect(),
+            feed_forward: !self.config.no_ff,
+        }
+    }
+
+    pub fn make_plant(&self) -> Box<dyn Plant> {
+        match self.plant {
+            PlantSpec::Discrete { time_step, substeps } => Box::new(DiscretePlant::new(&self.model, time_step, substeps)),
+            PlantSpec::Continuous { rtol, atol } => {
+                Box::new(ContinuousPlant::new(&self.model, self.config.dt, Tolerances { rtol, atol }))
+            }
+        }
+    }
+
+    /// The start state: every joint at 0, at rest.
+    pub fn initial_state(&self) -> (Vec<f64>, Vec<f64>) {
+        (vec![0.0; self.model.dof()], vec![0.0; self.model.dof()])
+    }
+
+    pub fn dt(&self) -> f64 {
+        self.config.dt
+    }
+}
+
+fn plant_spec(config: &RunConfig) -> Result<PlantSpec, Error> {
+    let continuous_by_step = config.time_step == Some(0.0);
+    let kind = match (config.integrator, continuous_by_step) {
+        (Some(IntegratorKind::Discrete), true) => {
+            return Err(Error::flag("--time-step", "0 selects the continuous plant; it contradicts --integrator discrete"));
+        }
+        (Some(kind), _) => kind,
+        (None, true) => IntegratorKind::Continuous,
+        (None, false) => IntegratorKind::Discrete,
+    };
+    match kind {
+        IntegratorKind::Continuous => {
+            for (flag, v) in [("--rtol", config.rtol), ("--atol", config.atol)] {
+                if !(v.is_finite() && v > 0.0) {
+                    return Err(Error::flag(flag, format!("must be a positive number (got {v})")));
+                }
+            }
+            Ok(PlantSpec::Continuous { rtol: config.rtol, atol: config.atol })
+        }
+        IntegratorKind::Discrete => {
+            let h = config.time_step.unwrap_or(config.dt);
+            if !(h.is_finite() && h > 0.0) {
+                return Err(Error::flag("--time-step", format!("must be positive, or 0 for the continuous plant (got {h})")));
+            }
+            let ratio = config.dt / h;
+            let substeps = ratio.round();
+            if substeps < 1.0 || (ratio - substeps).abs() > 1e-9 * ratio {
+                return Err(Error::flag("--time-step", format!("{h} s must divide the control period --dt {} s a whole number of times", config.dt)));
+            }
+            Ok(PlantSpec::Discrete { time_step: config.dt / substeps, substeps: substeps as usize })
+        }
+    }
+}
+
+fn trajectory(config: &RunConfig, model: &Model) -> Result<Box<dyn Trajectory>, Error> {
+    if let Some(spec) = &config.test_joint {
+        if config.hold {
+            return Err(Error::flag("--test-joint", "cannot be combined with --static"));
+        }
+        let joint = resolve_joint(spec, model)?;
+        return Ok(Box::new(JointStep { joint, joint_name: model.joints[joint].name.clone(), angle: config.test_angle }));
+    }
+    if config.hold {
+        return Ok(Box::new(Hold));
+    }
+    Ok(Box::new(Wave { amplitude_rad: config.amp_deg.to_radians(), omega: config.freq }))
+}
+
+/// A joint given by number (1-based, as J1..J6) or by name.
+pub fn resolve_joint(spec: &str, model: &Model) -> Result<usize, Error> {
+    let names = || model.joints.iter().map(|j| j.name.as_str()).collect::<Vec<_>>().join(", ");
+    if let Ok(number) = spec.trim().parse::<usize>() {
+        if (1..=model.dof()).contains(&number) {
+            return Ok(number - 1);
+        }
+        return Err(Error::flag("--test-joint", format!("joint number {number} is out of range 1..{} for {}", model.dof(), model.source.display())));
+    }
+    model.joint_index(spec.trim()).ok_or_else(|| {
+        Error::flag("--test-joint", format!("no moving joint '{spec}' in {} (joints: {})", model.source.display(), names()))
+    })
+}
+
+fn gains(config: &RunConfig, model: &Model) -> Result<Gains, Error> {
+    let n = model.dof();
+    let base = if is_tutorial_model(model) && !config.auto_tune {
+        Gains { kp: TUTORIAL_KP.to_vec(), kd: TUTORIAL_KD.to_vec(), source: "tutorial".into(), effective_inertia: None }
+    } else {
+        auto_tune(model, &vec![0.0; n], config.dt)
+    };
+    let expand = |flag: &str, values: &Option<Vec<f64>>, default: Vec<f64>| -> Result<(Vec<f64>, bool), Error> {
+        match values {
+            None => Ok((default, false)),
+            Some(v) => {
+                if let Some(bad) = v.iter().find(|x| !(x.is_finite() && **x >= 0.0)) {
+                    return Err(Error::flag(flag, format!("gains must be finite and not negative (got {bad})")));
+                }
+                match v.len() {
+                    1 => Ok((vec![v[0]; n], true)),
+                    len if len == n => Ok((v.clone(), true)),
+                    len => Err(Error::flag(flag, format!("expected 1 value or {n} (one per joint), got {len}"))),
+                }
+            }
+        }
+    };
+    let (kp, kp_given) = expand("--kp", &config.kp, base.kp.clone())?;
+    let (kd, kd_given) = expand("--kd", &config.kd, base.kd.clone())?;
+    let source = match (kp_given, kd_given) {
+        (true, true) => "flags".to_string(),
+        (false, false) => base.source.clone(),
+        (true, false) => format!("kp from flags, kd {}", base.source),
+        (false, true) => format!("kp {}, kd from flags", base.source),
+    };
+    Ok(Gains { kp, kd, source, effective_inertia: base.effective_inertia })
+}

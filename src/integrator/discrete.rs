@@ -1,0 +1,169 @@
+use super::Plant;
+use crate::dynamics::{Data, cholesky_in_place, cholesky_solve_in_place, crba_from_kinematics, forward_kinematics, gravity_and_bias_from_kinematics};
+use crate::model::Model;
+use nalgebra::DMatrix;
+
+/// Drake's discrete MultibodyPlant without contact: semi-implicit Euler with the joint damping
+/// taken implicitly, everything evaluated at the start of the step,
+///
+/// ```text
+///   (M(q₀) + h·D) · v₁ = M(q₀)·v₀ + h·( u + τ_g(q₀) − C(q₀,v₀)·v₀ )
+///   q₁ = q₀ + h·v₁
+/// ```
+///
+/// plus position limits as rigid one-sided constraints on v₁: a joint that would pass its limit
+/// stops exactly at it (an active-set solve of the same system). Several substeps per control
+/// period when the plant step is shorter than the control period.
+pub struct DiscretePlant {
+    pub time_step: f64,
+    pub substeps: usize,
+    system: DMatrix<f64>,
+    factor: DMatrix<f64>,
+    rhs: Vec<f64>,
+    reduced_rhs: Vec<f64>,
+    v_next: Vec<f64>,
+    /// −1 lower limit, +1 upper limit, 0 free.
+    constraint: Vec<i8>,
+    limit_active: Vec<bool>,
+}
+
+impl DiscretePlant {
+    pub fn new(model: &Model, time_step: f64, substeps: usize) -> Self {
+        let n = model.dof();
+        Self {
+            time_step,
+            substeps,
+            system: DMatrix::zeros(n, n),
+            factor: DMatrix::zeros(n, n),
+            rhs: vec![0.0; n],
+            reduced_rhs: vec![0.0; n],
+            v_next: vec![0.0; n],
+            constraint: vec![0; n],
+            limit_active: vec![false; n],
+        }
+    }
+
+    /// One plant step; `data` must hold kinematics, τ_g and C·v at (q, v).
+    pub fn step(&mut self, model: &Model, data: &mut Data, u: &[f64], q: &mut [f64], v: &mut [f64]) {
+        let n = model.dof();
+        let h = self.time_step;
+        crba_from_kinematics(model, data);
+        let m = &data.mass_matrix;
+        for i in 0..n {
+            let mut mv = 0.0;
+            for j in 0..n {
+                mv += m[(i, j)] * v[j];
+            }
+            self.rhs[i] = mv + h * (u[i] + data.gravity[i] - data.bias[i]);
+        }
+        self.system.copy_from(m);
+        for (i, joint) in model.joints.iter().enumerate() {
+            self.system[(i, i)] += h * joint.damping;
+        }
+        self.constraint.fill(0);
+        self.solve_with_limits(model, q);
+        for i in 0..n {
+            v[i] = self.v_next[i];
+            q[i] += h * v[i];
+            if self.constraint[i] != 0 {
+                // land exactly on the limit, not a rounding error past it
+                q[i] = if self.constraint[i] > 0 { model.joints[i].upper } else { model.joints[i].lower };
+                self.limit_active[i] = true;
+            }
+        }
+    }
+
+    /// Active-set solve: start unconstrained, fix the velocity of every joint that would pass its
+    /// limit to the velocity that lands on it, release a joint whose constraint would have to pull.
+    fn solve_with_limits(&mut self, model: &Model, q: &[f64]) {
+        let n = model.dof();
+        let h = self.time_step;
+        for _ in 0..(2 * n + 2) {
+            self.solve_reduced(model, q);
+            let mut changed = false;
+            for i in 0..n {
+                let joint = &model.joints[i];
+                match self.constraint[i] {
+                    0 => {
+                        let q_next = q[i] + h * self.v_next[i];
+                        if q_next > joint.upper {
+                            self.constraint[i] = 1;
+                            changed = true;
+                        } else if q_next < joint.lower {
+                            self.constraint[i] = -1;
+                            changed = true;
+                        }
+                    }
+                    side => {
+                        // impulse the constraint applies: λ = (A v − b)_i; an upper stop may only push down
+                        let mut lambda = -self.rhs[i];
+                        for j in 0..n {
+                            lambda += self.system[(i, j)] * self.v_next[j];
+                        }
+                        if lambda * side as f64 > 0.0 {
+                            self.constraint[i] = 0;
+                            changed = true;
+                        }
+                    }
+                }
+            }
+            if !changed {
+                return;
+            }
+        }
+    }
+
+    fn solve_reduced(&mut self, model: &Model, q: &[f64]) {
+        let n = model.dof();
+        let h = self.time_step;
+        self.factor.copy_from(&self.system);
+        self.reduced_rhs.copy_from_slice(&self.rhs);
+        for j in 0..n {
+            if self.constraint[j] == 0 {
+                continue;
+            }
+            let limit = if self.constraint[j] > 0 { model.joints[j].upper } else { model.joints[j].lower };
+            let v_fixed = (limit - q[j]) / h;
+            for i in 0..n {
+                self.reduced_rhs[i] -= self.factor[(i, j)] * v_fixed;
+                self.factor[(i, j)] = 0.0;
+                self.factor[(j, i)] = 0.0;
+            }
+            self.factor[(j, j)] = 1.0;
+            self.reduced_rhs[j] = v_fixed;
+        }
+        // M + hD is symmetric positive definite for any valid model; a failure means the state is
+        // no longer finite, which the simulation loop reports as divergence.
+        if !cholesky_in_place(&mut self.factor) {
+            self.v_next.fill(f64::NAN);
+            return;
+        }
+        self.v_next.copy_from_slice(&self.reduced_rhs);
+        cholesky_solve_in_place(&self.factor, &mut self.v_next);
+    }
+}
+
+impl Plant for DiscretePlant {
+    fn advance(&mut self, model: &Model, data: &mut Data, u: &[f64], q: &mut [f64], v: &mut [f64]) {
+        self.limit_active.fill(false);
+        for s in 0..self.substeps {
+            if s > 0 {
+                forward_kinematics(model, data, q);
+                gravity_and_bias_from_kinematics(model, data, v);
+            }
+            self.step(model, data, u, q, v);
+        }
+    }
+
+    fn limit_active(&self) -> &[bool] {
+        &self.limit_active
+    }
+
+    fn describe(&self) -> String {
+        format!(
+            "discrete plant: semi-implicit Euler, implicit joint damping (Drake's update), h = {} ms{}",
+            self.time_step * 1e3,
+            if self.substeps > 1 { format!(", {} steps per control period", self.substeps) } else { String::new() }
+        )
+    }
+}

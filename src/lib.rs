@@ -1,0 +1,22 @@
+//! armscope: simulate a robot arm with real rigid-body dynamics and record every experiment.
+//!
+//! Data flows one way: [`config::RunConfig`] → [`model::Model`] → [`sim::simulate`] →
+//! [`sample::Sample`]s → [`recorder::Recorder`]s (console, CSV, trace, JSON, …).
+
+pub mod cli;
+pub mod config;
+pub mod controller;
+pub mod dynamics;
+pub mod error;
+pub mod experiment;
+pub mod gains;
+pub mod integrator;
+pub mod model;
+pub mod recorder;
+pub mod sample;
+pub mod sim;
+pub mod spatial;
+pub mod summary;
+pub mod trajectory;
+
+pub use error::Error;

@@ -1,0 +1,422 @@
+//! URDF → [`Model`]: parsing (urdf-rs, plus roxmltree for `<transmission>`, which urdf-rs drops),
+//! validation with one-line errors, fixed-joint merging and welding of a free root.
+
+use super::{Actuator, Frame, Geometry, Joint, JointKind, Model, ModelError, ModelErrorKind as K, Visual};
+use crate::spatial::{Pose, RigidInertia};
+use nalgebra::{Matrix3, SymmetricEigen, Vector3};
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+/// Gravity of every loaded model; `--no-gravity` replaces it.
+pub const STANDARD_GRAVITY: [f64; 3] = [0.0, 0.0, -9.81];
+
+pub fn load_urdf(path: &Path) -> Result<Model, ModelError> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| ModelError { file: path.to_path_buf(), kind: K::Io(e.to_string()) })?;
+    load_urdf_str(&text, path)
+}
+
+/// Load URDF text; `source` names it in messages and anchors relative mesh paths.
+pub fn load_urdf_str(text: &str, source: &Path) -> Result<Model, ModelError> {
+    let fail = |kind| ModelError { file: source.to_path_buf(), kind };
+    build(text, source).map_err(fail)
+}
+
+fn one_line(s: impl ToString) -> String {
+    s.to_string().split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
+fn build(text: &str, source: &Path) -> Result<Model, K> {
+    let doc = roxmltree::Document::parse(text).map_err(|e| K::Xml(one_line(e)))?;
+    if doc.root_element().tag_name().name() != "robot" {
+        return Err(K::Urdf(format!("root element is <{}>, expected <robot>", doc.root_element().tag_name().name())));
+    }
+    let robot = urdf_rs::read_from_string(text).map_err(|e| K::Urdf(one_line(e)))?;
+    let mut notices = Vec::new();
+
+    // Names.
+    let mut link_index: HashMap<&str, usize> = HashMap::new();
+    for (i, link) in robot.links.iter().enumerate() {
+        if link_index.insert(link.name.as_str(), i).is_some() {
+            return Err(K::DuplicateLink(link.name.clone()));
+        }
+    }
+    if robot.links.is_empty() {
+        return Err(K::Empty);
+    }
+    let mut joint_names: HashMap<&str, usize> = HashMap::new();
+    for (i, joint) in robot.joints.iter().enumerate() {
+        if joint_names.insert(joint.name.as_str(), i).is_some() {
+            return Err(K::DuplicateJoint(joint.name.clone()));
+        }
+    }
+
+    // Numbers, per element.
+    for link in &robot.links {
+        check_link(link)?;
+    }
+    for joint in &robot.joints {
+        check_joint(joint)?;
+    }
+
+    // Tree structure.
+    let mut parent_joint: Vec<Option<usize>> = vec![None; robot.links.len()];
+    let mut child_joints: Vec<Vec<usize>> = vec![Vec::new(); robot.links.len()];
+    for (j, joint) in robot.joints.iter().enumerate() {
+        let lookup = |role: &'static str, name: &str| {
+            link_index.get(name).copied().ok_or_else(|| K::UnknownLink {
+                joint: joint.name.clone(),
+                role,
+                link: name.to_string(),
+            })
+        };
+        let parent = lookup("parent", &joint.parent.link)?;
+        let child = lookup("child", &joint.child.link)?;
+        if let Some(first) = parent_joint[child] {
+            return Err(K::TwoParents {
+                link: joint.child.link.clone(),
+                first: robot.joints[first].name.clone(),
+                second: joint.name.clone(),
+            });
+        }
+        parent_joint[child] = Some(j);
+        child_joints[parent].push(j);
+    }
+    let roots: Vec<usize> = (0..robot.links.len()).filter(|&l| parent_joint[l].is_none()).collect();
+    let root = match roots.as_slice() {
+        [] => return Err(K::Cycle(robot.links[0].name.clone())),
+        [root] => *root,
+        [a, b, ..] => return Err(K::MultipleRoots(robot.links[*a].name.clone(), robot.links[*b].name.clone())),
+    };
+    if robot.links[root].name != "world" {
+        notices.push(format!(
+            "root link '{}' is not attached to 'world'; welding it to the world at the origin",
+            robot.links[root].name
+        ));
+    }
+
+    // Depth-first from the root, in document order: parents before children, subtrees contiguous.
+    let mut frames: Vec<Frame> = Vec::with_capacity(robot.links.len());
+    let mut frame_of_link: Vec<Option<usize>> = vec![None; robot.links.len()];
+    let mut depth: Vec<usize> = Vec::with_capacity(robot.links.len());
+    let mut joints: Vec<Joint> = Vec::new();
+    let mut body_inertia: Vec<RigidInertia> = Vec::new();
+    let base_dir = source.parent().unwrap_or(Path::new("."));
+
+    let mut stack: Vec<(usize, Option<usize>)> = vec![(root, None)]; // (link, joint that reached it)
+    while let Some((link, via)) = stack.pop() {
+        let (body, placement, parent_frame, d) = match via {
+            None => (None, Pose::identity(), None, 0),
+            Some(j) => {
+                let uj = &robot.joints[j];
+                let pf = frame_of_link[link_index[uj.parent.link.as_str()]].expect("parent visited first");
+                let joint_frame = frames[pf].placement.compose(&pose(&uj.origin));
+                match joint_kind(uj)? {
+                    None => (frames[pf].body, joint_frame, Some(pf), depth[pf] + 1),
+                    Some(kind) => {
+                        joints.push(make_joint(uj, kind, frames[pf].body, joint_frame, &mut notices));
+                        body_inertia.push(RigidInertia::zero());
+                        (Some(joints.len() - 1), Pose::identity(), Some(pf), depth[pf] + 1)
+                    }
+                }
+            }
+        };
+        let ul = &robot.links[link];
+        if let Some(b) = body {
+            body_inertia[b] = body_inertia[b].combined(&link_inertia(ul).transformed(&placement));
+        }
+        let visuals = ul
+            .visual
+            .iter()
+            .map(|v| make_visual(v, &ul.name, &robot.materials, base_dir))
+            .collect::<Result<Vec<_>, _>>()?;
+        frame_of_link[link] = Some(frames.len());
+        frames.push(Frame {
+            name: ul.name.clone(),
+            body,
+            placement,
+            parent_frame,
+            parent_joint: via.map(|j| robot.joints[j].name.clone()),
+            visuals,
+        });
+        depth.push(d);
+        for &j in child_joints[link].iter().rev() {
+            stack.push((link_index[robot.joints[j].child.link.as_str()], Some(j)));
+        }
+    }
+    if let Some(unreached) = frame_of_link.iter().position(|f| f.is_none()) {
+        return Err(K::Cycle(robot.links[unreached].name.clone()));
+    }
+    if joints.is_empty() {
+        return Err(K::NoMovingJoints);
+    }
+
+    // Moving bodies need mass, and an inertia a real body can have.
+    for (joint, inertia) in joints.iter_mut().zip(body_inertia) {
+        if !(inertia.mass > 0.0) {
+            return Err(K::NoMass { link: joint.child_link.clone(), joint: joint.name.clone(), mass: inertia.mass });
+        }
+        check_inertia(&joint.child_link, &inertia.inertia_com)?;
+        joint.inertia = inertia;
+    }
+
+    let actuators = actuators_from_transmissions(&doc, &joints)?;
+    let actuators = if actuators.is_empty() {
+        joints
+            .iter()
+            .enumerate()
+            .map(|(i, j)| Actuator { name: j.name.clone(), joint: i, effort: j.effort, gear_ratio: 1.0 })
+            .collect()
+    } else {
+        actuators
+    };
+
+    // Tool: the deepest leaf link (first one in tree order on a tie).
+    let is_leaf = |f: usize| !frames.iter().any(|g| g.parent_frame == Some(f));
+    let tool_frame = (0..frames.len()).filter(|&f| is_leaf(f)).fold(0, |best, f| if depth[f] > depth[best] { f } else { best });
+
+    Ok(Model {
+        name: robot.name.clone(),
+        source: source.to_path_buf(),
+        urdf_text: text.to_string(),
+        gravity: Vector3::from(STANDARD_GRAVITY),
+        joints,
+        frames,
+        actuators,
+        tool_frame,
+        notices,
+    })
+}
+
+fn pose(p: &urdf_rs::Pose) -> Pose {
+    Pose::from_xyz_rpy(p.xyz.0, p.rpy.0)
+}
+
+fn joint_kind(joint: &urdf_rs::Joint) -> Result<Option<JointKind>, K> {
+    use urdf_rs::JointType as T;
+    if joint.mimic.is_some() {
+        return Err(K::Mimic(joint.name.clone()));
+    }
+    match joint.joint_type {
+        T::Fixed => Ok(None),
+        T::Revolute => Ok(Some(JointKind::Revolute)),
+        T::Continuous => Ok(Some(JointKind::Continuous)),
+        T::Prismatic => Ok(Some(JointKind::Prismatic)),
+        T::Floating | T::Planar | T::Spherical => {
+            Err(K::UnsupportedJoint { joint: joint.name.clone(), kind: format!("{:?}", joint.joint_type).to_lowercase() })
+        }
+    }
+}
+
+fn make_joint(uj: &urdf_rs::Joint, kind: JointKind, parent: Option<usize>, placement: Pose, notices: &mut Vec<String>) -> Joint {
+    let axis = Vector3::from(uj.axis.xyz.0);
+    let (lower, upper) = match kind {
+        JointKind::Continuous => (f64::NEG_INFINITY, f64::INFINITY),
+        _ => (uj.limit.lower, uj.limit.upper),
+    };
+    let effort = if uj.limit.effort > 0.0 {
+        uj.limit.effort
+    } else {
+        notices.push(format!("joint '{}' has no effort limit; its motor is treated as unlimited", uj.name));
+        f64::INFINITY
+    };
+    Joint {
+        name: uj.name.clone(),
+        kind,
+        parent,
+        placement,
+        axis: axis / axis.norm(),
+        inertia: RigidInertia::zero(),
+        lower,
+        upper,
+        effort,
+        velocity: uj.limit.velocity,
+        damping: uj.dynamics.as_ref().map_or(0.0, |d| d.damping),
+        child_link: uj.child.link.clone(),
+    }
+}
+
+fn link_inertia(link: &urdf_rs::Link) -> RigidInertia {
+    let i = &link.inertial.inertia;
+    let tensor = Matrix3::new(i.ixx, i.ixy, i.ixz, i.ixy, i.iyy, i.iyz, i.ixz, i.iyz, i.izz);
+    let origin = pose(&link.inertial.origin);
+    RigidInertia {
+        mass: link.inertial.mass.value,
+        com: origin.translation,
+        inertia_com: origin.rotation * tensor * origin.rotation.transpose(),
+    }
+}
+
+fn finite(element: &str, field: &'static str, values: &[f64]) -> Result<(), K> {
+    match values.iter().find(|v| !v.is_finite()) {
+        Some(&value) => Err(K::NonFinite { element: element.to_string(), field, value }),
+        None => Ok(()),
+    }
+}
+
+fn check_link(link: &urdf_rs::Link) -> Result<(), K> {
+    let element = format!("link '{}'", link.name);
+    let inertial = &link.inertial;
+    finite(&element, "inertial origin", &[inertial.origin.xyz.0, inertial.origin.rpy.0].concat())?;
+    finite(&element, "mass", &[inertial.mass.value])?;
+    let i = &inertial.inertia;
+    finite(&element, "inertia", &[i.ixx, i.ixy, i.ixz, i.iyy, i.iyz, i.izz])?;
+    for v in &link.visual {
+        finite(&element, "visual origin", &[v.origin.xyz.0, v.origin.rpy.0].concat())?;
+        let sizes: Vec<f64> = match &v.geometry {
+            urdf_rs::Geometry::Box { size } => size.0.to_vec(),
+            urdf_rs::Geometry::Cylinder { radius, length } | urdf_rs::Geometry::Capsule { radius, length } => vec![*radius, *length],
+            urdf_rs::Geometry::Sphere { radius } => vec![*radius],
+            urdf_rs::Geometry::Mesh { scale, .. } => scale.map_or(vec![], |s| s.0.to_vec()),
+        };
+        finite(&element, "visual geometry", &sizes)?;
+    }
+    if inertial.mass.value < 0.0 {
+        return Err(K::NegativeMass { link: link.name.clone(), mass: inertial.mass.value });
+    }
+    if inertial.mass.value > 0.0 {
+        check_inertia(&link.name, &link_inertia(link).inertia_com)?;
+    }
+    Ok(())
+}
+
+/// A rotational inertia a rigid body can have: positive definite, and each principal moment at most
+/// the sum of the other two (up to the rounding of six-digit URDF numbers).
+fn check_inertia(link: &str, tensor: &Matrix3<f64>) -> Result<(), K> {
+    if tensor.iter().any(|x| !x.is_finite()) {
+        return Err(K::NonFinite { element: format!("link '{link}'"), field: "combined inertia", value: f64::INFINITY });
+    }
+    let mut moments: Vec<f64> = SymmetricEigen::new(*tensor).eigenvalues.iter().copied().collect();
+    moments.sort_by(f64::total_cmp);
+    let listed = || moments.iter().map(|m| format!("{m:.6e}")).collect::<Vec<_>>().join(", ");
+    if !(moments[0] > 0.0) {
+        return Err(K::InertiaNotPositive { link: link.to_string(), moments: listed() });
+    }
+    let tolerance = 1e-6 * (moments[0] + moments[1] + moments[2]);
+    if moments[0] + moments[1] < moments[2] - tolerance {
+        return Err(K::InertiaTriangle { link: link.to_string(), moments: listed() });
+    }
+    Ok(())
+}
+
+fn check_joint(joint: &urdf_rs::Joint) -> Result<(), K> {
+    let element = format!("joint '{}'", joint.name);
+    finite(&element, "origin", &[joint.origin.xyz.0, joint.origin.rpy.0].concat())?;
+    let moving = joint.joint_type != urdf_rs::JointType::Fixed;
+    if moving {
+        finite(&element, "axis", &joint.axis.xyz.0)?;
+        if Vector3::from(joint.axis.xyz.0).norm() < 1e-9 {
+            return Err(K::ZeroAxis(joint.name.clone()));
+        }
+    }
+    let limit = &joint.limit;
+    for (field, value) in [("lower limit", limit.lower), ("upper limit", limit.upper), ("effort", limit.effort), ("velocity", limit.velocity)] {
+        if value.is_nan() {
+            return Err(K::NonFinite { element: element.clone(), field, value });
+        }
+    }
+    if let Some(d) = &joint.dynamics {
+        finite(&element, "dynamics", &[d.damping, d.friction])?;
+        if d.damping < 0.0 {
+            return Err(K::Negative { joint: joint.name.clone(), field: "damping", value: d.damping });
+        }
+    }
+    if moving {
+        if limit.effort < 0.0 {
+            return Err(K::Negative { joint: joint.name.clone(), field: "effort", value: limit.effort });
+        }
+        let limited = matches!(joint.joint_type, urdf_rs::JointType::Revolute | urdf_rs::JointType::Prismatic);
+        if limited && limit.lower > limit.upper {
+            return Err(K::BadLimits { joint: joint.name.clone(), lower: limit.lower, upper: limit.upper });
+        }
+    }
+    Ok(())
+}
+
+fn make_visual(v: &urdf_rs::Visual, link: &str, materials: &[urdf_rs::Material], base_dir: &Path) -> Result<Visual, K> {
+    let geometry = match &v.geometry {
+        urdf_rs::Geometry::Box { size } => Geometry::Box { size: size.0 },
+        urdf_rs::Geometry::Cylinder { radius, length } => Geometry::Cylinder { radius: *radius, length: *length },
+        urdf_rs::Geometry::Capsule { radius, length } => Geometry::Capsule { radius: *radius, length: *length },
+        urdf_rs::Geometry::Sphere { radius } => Geometry::Sphere { radius: *radius },
+        urdf_rs::Geometry::Mesh { filename, scale } => Geometry::Mesh {
+            path: resolve_mesh(filename, base_dir).map_err(|looked| K::MeshNotFound {
+                link: link.to_string(),
+                filename: filename.clone(),
+                looked,
+            })?,
+            scale: scale.map_or([1.0; 3], |s| s.0),
+        },
+    };
+    let rgba = v.material.as_ref().and_then(|m| {
+        m.color
+            .as_ref()
+            .or_else(|| materials.iter().find(|g| g.name == m.name).and_then(|g| g.color.as_ref()))
+            .map(|c| c.rgba.0.map(|x| x as f32))
+    });
+    Ok(Visual { origin: pose(&v.origin), geometry, rgba })
+}
+
+/// Resolve a mesh reference: `package://PKG/rest` (searched for a folder PKG, or a folder named PKG,
+/// at or above the URDF's folder), `file://` and plain paths (relative to the URDF's folder).
+fn resolve_mesh(filename: &str, base_dir: &Path) -> Result<PathBuf, String> {
+    let mut candidates: Vec<PathBuf> = Vec::new();
+    if let Some(rest) = filename.strip_prefix("package://") {
+        let (package, relative) = rest.split_once('/').unwrap_or((rest, ""));
+        for dir in base_dir.ancestors() {
+            if dir.file_name().is_some_and(|n| n == package) {
+                candidates.push(dir.join(relative));
+            }
+            candidates.push(dir.join(package).join(relative));
+        }
+        candidates.push(base_dir.join(relative));
+    } else {
+        let plain = filename.strip_prefix("file://").unwrap_or(filename);
+        candidates.push(base_dir.join(plain));
+    }
+    match candidates.iter().find(|c| c.is_file()) {
+        Some(found) => Ok(found.clone()),
+        None => Err(candidates.iter().take(3).map(|c| c.display().to_string()).collect::<Vec<_>>().join(", ")),
+    }
+}
+
+/// One actuator per `<transmission>`; empty when the URDF declares none.
+fn actuators_from_transmissions(doc: &roxmltree::Document, joints: &[Joint]) -> Result<Vec<Actuator>, K> {
+    let mut actuators: Vec<Actuator> = Vec::new();
+    for t in doc.root_element().children().filter(|n| n.has_tag_name("transmission")) {
+        let name = t.attribute("name").unwrap_or("(unnamed)").to_string();
+        let fail = |what: String| K::Transmission { transmission: name.clone(), what };
+        let joint_nodes: Vec<_> = t.children().filter(|n| n.has_tag_name("joint")).collect();
+        let actuator_nodes: Vec<_> = t.children().filter(|n| n.has_tag_name("actuator")).collect();
+        if joint_nodes.len() != 1 || actuator_nodes.len() > 1 {
+            return Err(fail(format!(
+                "has {} joints and {} actuators; only simple transmissions (one joint, one actuator) are supported",
+                joint_nodes.len(),
+                actuator_nodes.len()
+            )));
+        }
+        let joint_name = joint_nodes[0].attribute("name").ok_or_else(|| fail("<joint> has no name".into()))?;
+        let joint = joints
+            .iter()
+            .position(|j| j.name == joint_name)
+            .ok_or_else(|| fail(format!("joint '{joint_name}' is not a moving joint of this model")))?;
+        if actuators.iter().any(|a| a.joint == joint) {
+            return Err(fail(format!("joint '{joint_name}' already has an actuator")));
+        }
+        let actuator_name = actuator_nodes.first().and_then(|a| a.attribute("name")).unwrap_or(&name).to_string();
+        let reduction_node = actuator_nodes
+            .first()
+            .and_then(|a| a.children().find(|n| n.has_tag_name("mechanicalReduction")))
+            .or_else(|| t.children().find(|n| n.has_tag_name("mechanicalReduction")));
+        let gear_ratio = match reduction_node.and_then(|n| n.text()) {
+            None => 1.0,
+            Some(text) => match text.trim().parse::<f64>() {
+                Ok(r) if r.is_finite() && r != 0.0 => r,
+                _ => return Err(fail(format!("mechanicalReduction '{}' is not a finite non-zero number", text.trim()))),
+            },
+        };
+        actuators.push(Actuator { name: actuator_name, joint, effort: joints[joint].effort, gear_ratio });
+    }
+    Ok(actuators)
+}
+

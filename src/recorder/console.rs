@@ -1,0 +1,152 @@
+use super::{Recorder, RunInfo, fmt_list, is_on_period};
+use crate::error::Error;
+use crate::sample::Sample;
+use crate::summary::{RunStatus, Summary};
+use std::io::Write;
+
+/// The tutorial's console: a start line, one line per whole second (with `--debug`, the command,
+/// error, τ_g and torque under it), and the summary.
+pub struct Console {
+    out: Box<dyn Write + Send>,
+    dt: f64,
+    debug: bool,
+    err: Vec<f64>,
+    closed: bool,
+}
+
+impl Console {
+    pub fn new(out: Box<dyn Write + Send>) -> Self {
+        Self { out, dt: 0.0, debug: false, err: Vec::new(), closed: false }
+    }
+
+    pub fn stdout() -> Self {
+        Self::new(Box::new(std::io::stdout()))
+    }
+}
+
+fn io(e: std::io::Error) -> Error {
+    Error::Output { path: "console".into(), message: e.to_string() }
+}
+
+/// A closed pipe (`armscope run | head`) ends the console's output, not the run.
+fn quiet_on_broken_pipe(result: Result<(), Error>, closed: &mut bool) -> Result<(), Error> {
+    match result {
+        Err(Error::Output { message, .. }) if message.contains("Broken pipe") => {
+            *closed = true;
+            Ok(())
+        }
+        other => other,
+    }
+}
+
+impl Recorder for Console {
+    fn start(&mut self, run: &RunInfo) -> Result<(), Error> {
+        let result = self.write_start(run);
+        quiet_on_broken_pipe(result, &mut self.closed)
+    }
+
+    fn record(&mut self, s: &Sample) -> Result<(), Error> {
+        if self.closed || !is_on_period(s.k, self.dt, 1.0) {
+            return Ok(());
+        }
+        let result = self.write_line(s);
+        quiet_on_broken_pipe(result, &mut self.closed)
+    }
+
+    fn finish(&mut self, _run: &RunInfo, s: &Summary) -> Result<(), Error> {
+        if self.closed {
+            return Ok(());
+        }
+        let result = write_summary(&mut self.out, s).map_err(io);
+        quiet_on_broken_pipe(result, &mut self.closed)
+    }
+}
+
+impl Console {
+    fn write_start(&mut self, run: &RunInfo) -> Result<(), Error> {
+        let e = run.experiment;
+        let m = &e.model;
+        self.dt = e.config.dt;
+        self.debug = e.config.debug;
+        let g = m.gravity;
+        writeln!(
+            self.out,
+            "armscope: {} ({}), {} dof, gravity ({}, {}, {}) m/s², tool link '{}'",
+            m.name,
+            m.source.display(),
+            m.dof(),
+            g.x,
+            g.y,
+            g.z,
+            m.frames[m.tool_frame].name
+        )
+        .map_err(io)?;
+        writeln!(self.out, "  plant: {}", run.plant).map_err(io)?;
+        writeln!(self.out, "  command: {}", run.trajectory).map_err(io)?;
+        writeln!(
+            self.out,
+            "  controller: PD{} every {} ms, gains ({}): kp = {:?}, kd = {:?}",
+            if e.config.no_ff { " without gravity feed-forward (--no-ff)" } else { " + gravity feed-forward" },
+            e.config.dt * 1e3,
+            e.gains.source,
+            e.gains.kp,
+            e.gains.kd
+        )
+        .map_err(io)?;
+        writeln!(self.out, "  duration {} s ({} steps)", e.config.duration, e.steps).map_err(io)?;
+        Ok(())
+    }
+
+    fn write_line(&mut self, s: &Sample) -> Result<(), Error> {
+        let p = s.tool_position;
+        writeln!(self.out, "t = {:6.2} s  q = {} rad  tool = ({:.4}, {:.4}, {:.4}) m", s.t, fmt_list(s.q, 4), p.x, p.y, p.z)
+            .map_err(io)?;
+        if self.debug {
+            self.err.clear();
+            self.err.extend(s.cmd.iter().zip(s.q).map(|(c, q)| c - q));
+            writeln!(self.out, "    cmd   = {}", fmt_list(s.cmd, 4)).map_err(io)?;
+            writeln!(self.out, "    error = {}", fmt_list(&self.err, 4)).map_err(io)?;
+            writeln!(self.out, "    tau_g = {}", fmt_list(s.tau_g, 4)).map_err(io)?;
+            writeln!(self.out, "    u     = {}", fmt_list(s.u, 4)).map_err(io)?;
+        }
+        Ok(())
+    }
+}
+
+/// The console summary (also used by `batch`).
+pub fn write_summary(out: &mut dyn Write, s: &Summary) -> std::io::Result<()> {
+    writeln!(out)?;
+    match &s.status {
+        RunStatus::Completed => {}
+        RunStatus::Interrupted { time } => writeln!(out, "INTERRUPTED at t = {time:.3} s: the summary covers the run up to there")?,
+        RunStatus::Diverged { message, .. } => writeln!(out, "DIVERGED: {message}")?,
+    }
+    let speed = if s.wall_time > 0.0 { s.simulated_time / s.wall_time } else { f64::INFINITY };
+    writeln!(
+        out,
+        "Summary: {:.3} s simulated in {} steps, {:.3} s wall time ({:.0}x real time)",
+        s.simulated_time, s.steps, s.wall_time, speed
+    )?;
+    let w = 9;
+    let row = |label: &str, cells: Vec<String>| format!("  {label:<22}{}", cells.iter().map(|c| format!("{c:>w$}")).collect::<String>());
+    writeln!(out, "{}", row("joint", s.joints.clone()))?;
+    let opt = |v: &Option<f64>| v.map_or("n/a".to_string(), |x| format!("{x:.4}"));
+    writeln!(
+        out,
+        "{}   (every step with t >= {} s)",
+        row("max |error| (rad)", s.max_abs_error.iter().map(opt).collect()),
+        s.error_window_start
+    )?;
+    writeln!(out, "{}", row("RMS error (rad)", s.rms_error.iter().map(opt).collect()))?;
+    writeln!(out, "{}", row("saturation (%)", s.saturation_percent.iter().map(|p| format!("{p:.1}")).collect()))?;
+    writeln!(out, "{}", row("peak |u| (N·m)", s.peak_abs_torque.iter().map(|p| format!("{p:.3}")).collect()))?;
+    writeln!(out, "{}", row("effort limit (N·m)", s.effort_limit.iter().map(|p| format!("{p}")).collect()))?;
+    writeln!(out, "{}", row("limit hits (steps)", s.limit_hits.iter().map(|p| format!("{p}")).collect()))?;
+    let r = &s.tool_range;
+    writeln!(
+        out,
+        "  tool range: x [{:.3}, {:.3}]  y [{:.3}, {:.3}]  z [{:.3}, {:.3}] m",
+        r.x.min, r.x.max, r.y.min, r.y.max, r.z.min, r.z.max
+    )?;
+    out.flush()
+}

@@ -1,0 +1,60 @@
+//! Recorders: everything that turns samples into output. The simulation loop knows only this
+//! trait; a new format is one new file.
+
+mod console;
+mod summary_json;
+mod trace;
+mod tutorial_csv;
+
+pub use console::Console;
+pub use summary_json::SummaryJson;
+pub use trace::Trace;
+pub use tutorial_csv::TutorialCsv;
+
+use crate::error::Error;
+use crate::experiment::Experiment;
+use crate::sample::Sample;
+use crate::summary::Summary;
+
+/// What a recorder is told about the run before the first sample.
+pub struct RunInfo<'a> {
+    pub experiment: &'a Experiment,
+    /// One line each, for humans and for the recordings' configuration.
+    pub plant: String,
+    pub trajectory: String,
+}
+
+pub trait Recorder {
+    fn start(&mut self, run: &RunInfo) -> Result<(), Error>;
+    fn record(&mut self, sample: &Sample) -> Result<(), Error>;
+    /// Called once after the last sample, also when the run was interrupted or diverged.
+    fn finish(&mut self, run: &RunInfo, summary: &Summary) -> Result<(), Error>;
+}
+
+/// Whether t_k = k·dt is the first sample at or after a multiple of `period`.
+pub fn is_on_period(k: usize, dt: f64, period: f64) -> bool {
+    if k == 0 {
+        return true;
+    }
+    // tolerance: k·dt carries rounding error, a whole multiple must still count as one
+    let index = |k: usize| (k as f64 * dt / period + 1e-9).floor();
+    index(k) > index(k - 1)
+}
+
+pub(crate) fn fmt_list(values: &[f64], decimals: usize) -> String {
+    let items: Vec<String> = values.iter().map(|v| format!("{v:+.decimals$}")).collect();
+    format!("[{}]", items.join(" "))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::is_on_period;
+
+    #[test]
+    fn period_boundaries_are_hit_exactly_once() {
+        let hits: Vec<usize> = (0..=3000).filter(|&k| is_on_period(k, 0.001, 0.5)).collect();
+        assert_eq!(hits, vec![0, 500, 1000, 1500, 2000, 2500, 3000]);
+        let hits: Vec<usize> = (0..=1000).filter(|&k| is_on_period(k, 0.003, 1.0)).collect();
+        assert_eq!(hits, vec![0, 334, 667, 1000]);
+    }
+}

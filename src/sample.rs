@@ -1,0 +1,28 @@
+//! One instant of a run, as the simulation loop hands it to every recorder.
+
+use crate::spatial::Pose;
+use nalgebra::Vector3;
+
+/// The state at t_k = k·dt, the command and the torque the controller holds over [t_k, t_k + dt).
+/// Every value is at the same instant. Borrowed from the loop's buffers: recorders copy what they keep.
+#[derive(Clone, Copy, Debug)]
+pub struct Sample<'a> {
+    pub k: usize,
+    pub t: f64,
+    /// The last sample of the run: its torque is computed but never applied.
+    pub is_final: bool,
+    pub q: &'a [f64],
+    pub v: &'a [f64],
+    pub cmd: &'a [f64],
+    pub cmd_dot: &'a [f64],
+    pub u: &'a [f64],
+    /// The generalized force of gravity at q (what the feed-forward cancels).
+    pub tau_g: &'a [f64],
+    /// The controller asked for more than the motor's limit.
+    pub saturated: &'a [bool],
+    /// The joint was stopped at a position limit in the step that led here.
+    pub at_limit: &'a [bool],
+    pub tool_position: Vector3<f64>,
+    /// World pose of every body (joint i moves body i), for drawing.
+    pub body_pose: &'a [Pose],
+}

@@ -1,0 +1,94 @@
+//! The simulation loop: controller and plant at the control rate, every sample to every recorder.
+
+use crate::dynamics::{Data, forward_kinematics, frame_pose, gravity_and_bias_from_kinematics};
+use crate::error::Error;
+use crate::experiment::Experiment;
+use crate::controller::ControlOutput;
+use crate::recorder::{Recorder, RunInfo};
+use crate::sample::Sample;
+use crate::summary::{RunStatus, Summary, SummaryBuilder};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+
+/// Run one experiment, feeding each recorder every sample. Returns the summary also when the run
+/// was interrupted (`stop` set) or diverged (see [`Summary::status`]); recorders are finished in
+/// every case, so their files are whole up to the last recorded sample.
+pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], stop: Option<&AtomicBool>) -> Result<Summary, Error> {
+    let model = &*experiment.model;
+    let n = model.dof();
+    let dt = experiment.dt();
+    let mut data = Data::new(model);
+    let mut plant = experiment.make_plant();
+    let controller = experiment.controller();
+    let info = RunInfo { experiment, plant: plant.describe(), trajectory: experiment.trajectory.describe() };
+    for r in recorders.iter_mut() {
+        r.start(&info)?;
+    }
+
+    let (mut q, mut v) = experiment.initial_state();
+    let (mut cmd, mut cmd_dot, mut u) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+    let mut saturated = vec![false; n];
+    let mut at_limit = vec![false; n];
+    let joint_names: Vec<String> = model.joints.iter().map(|j| j.name.clone()).collect();
+    let mut stats = SummaryBuilder::new(joint_names, controller.effort.clone(), dt, experiment.config.settle_time);
+    let started = Instant::now();
+    let mut status = RunStatus::Completed;
+
+    for k in 0..=experiment.steps {
+        let t = k as f64 * dt;
+        forward_kinematics(model, &mut data, &q);
+        gravity_and_bias_from_kinematics(model, &mut data, &v);
+        experiment.trajectory.sample(t, &mut cmd, &mut cmd_dot);
+        controller.compute(&q, &v, &cmd, &cmd_dot, &data.gravity, ControlOutput { u: &mut u, saturated: &mut saturated });
+        let interrupted = stop.is_some_and(|s| s.load(Ordering::Relaxed));
+        let sample = Sample {
+            k,
+            t,
+            is_final: k == experiment.steps || interrupted,
+            q: &q,
+            v: &v,
+            cmd: &cmd,
+            cmd_dot: &cmd_dot,
+            u: &u,
+            tau_g: &data.gravity,
+            saturated: &saturated,
+            at_limit: &at_limit,
+            tool_position: frame_pose(model, &data, model.tool_frame).translation,
+            body_pose: &data.body_pose,
+        };
+        stats.record(&sample);
+        for r in recorders.iter_mut() {
+            r.record(&sample)?;
+        }
+        if sample.is_final {
+            if interrupted {
+                status = RunStatus::Interrupted { time: t };
+            }
+            break;
+        }
+        plant.advance(model, &mut data, &u, &mut q, &mut v);
+        at_limit.copy_from_slice(plant.limit_active());
+        if let Some(diverged) = divergence(experiment, &q, &v, t + dt) {
+            status = diverged;
+            break;
+        }
+    }
+    let summary = stats.finish(status, started.elapsed().as_secs_f64());
+    for r in recorders.iter_mut() {
+        r.finish(&info, &summary)?;
+    }
+    Ok(summary)
+}
+
+/// A state that is not finite, or a joint faster than any real arm moves, is divergence.
+fn divergence(experiment: &Experiment, q: &[f64], v: &[f64], time: f64) -> Option<RunStatus> {
+    let limit = experiment.config.divergence_speed;
+    let bad = (0..q.len()).find(|&i| !q[i].is_finite() || !v[i].is_finite() || v[i].abs() > limit)?;
+    let joint = experiment.model.joints[bad].name.clone();
+    let message = format!(
+        "simulation diverged at t = {time:.3} s: joint {joint} reached q = {:.3e}, q̇ = {:.3e} (limit {limit:.0e}); \
+         the discrete plant is unstable for this model and dt, try the continuous plant with --time-step 0",
+        q[bad], v[bad]
+    );
+    Some(RunStatus::Diverged { joint, time, message })
+}

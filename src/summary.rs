@@ -1,0 +1,149 @@
+//! The numbers a run ends with: tracking error, saturation, limit hits, tool range.
+
+use crate::sample::Sample;
+use serde::Serialize;
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(tag = "state", rename_all = "lowercase")]
+pub enum RunStatus {
+    Completed,
+    /// Stopped by the user (SIGINT) at `time`.
+    Interrupted { time: f64 },
+    /// The state became non-finite or absurd.
+    Diverged { joint: String, time: f64, message: String },
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct Range {
+    pub min: f64,
+    pub max: f64,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct ToolRange {
+    pub x: Range,
+    pub y: Range,
+    pub z: Range,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct Summary {
+    pub status: RunStatus,
+    pub joints: Vec<String>,
+    /// Simulated time covered, s.
+    pub simulated_time: f64,
+    /// Control steps taken.
+    pub steps: usize,
+    pub dt: f64,
+    /// Tracking error statistics cover every step with t ≥ this.
+    pub error_window_start: f64,
+    /// max |cmd − q| per joint over the window, rad (null when the run is shorter than the window).
+    pub max_abs_error: Vec<Option<f64>>,
+    pub rms_error: Vec<Option<f64>>,
+    /// Share of control steps where the controller asked for more than the limit, %.
+    pub saturation_percent: Vec<f64>,
+    pub peak_abs_torque: Vec<f64>,
+    pub effort_limit: Vec<f64>,
+    /// Steps at which the joint was stopped at a position limit.
+    pub limit_hits: Vec<u64>,
+    pub tool_range: ToolRange,
+    pub wall_time: f64,
+}
+
+/// Accumulates a [`Summary`] sample by sample, without allocating.
+pub struct SummaryBuilder {
+    joints: Vec<String>,
+    dt: f64,
+    window_start: f64,
+    first_window_step: usize,
+    max_err: Vec<f64>,
+    sum_sq_err: Vec<f64>,
+    window_samples: u64,
+    saturated_steps: Vec<u64>,
+    control_steps: u64,
+    peak_torque: Vec<f64>,
+    effort: Vec<f64>,
+    limit_hits: Vec<u64>,
+    tool_min: [f64; 3],
+    tool_max: [f64; 3],
+    last_t: f64,
+}
+
+impl SummaryBuilder {
+    pub fn new(joints: Vec<String>, effort: Vec<f64>, dt: f64, window_start: f64) -> Self {
+        let n = joints.len();
+        Self {
+            joints,
+            dt,
+            window_start,
+            first_window_step: (window_start / dt - 1e-9).ceil().max(0.0) as usize,
+            max_err: vec![0.0; n],
+            sum_sq_err: vec![0.0; n],
+            window_samples: 0,
+            saturated_steps: vec![0; n],
+            control_steps: 0,
+            peak_torque: vec![0.0; n],
+            effort,
+            limit_hits: vec![0; n],
+            tool_min: [f64::INFINITY; 3],
+            tool_max: [f64::NEG_INFINITY; 3],
+            last_t: 0.0,
+        }
+    }
+
+    pub fn record(&mut self, s: &Sample) {
+        let n = self.joints.len();
+        if s.k >= self.first_window_step {
+            self.window_samples += 1;
+            for i in 0..n {
+                let e = (s.cmd[i] - s.q[i]).abs();
+                self.max_err[i] = self.max_err[i].max(e);
+                self.sum_sq_err[i] += e * e;
+            }
+        }
+        if !s.is_final {
+            self.control_steps += 1;
+            for i in 0..n {
+                self.saturated_steps[i] += s.saturated[i] as u64;
+                self.peak_torque[i] = self.peak_torque[i].max(s.u[i].abs());
+            }
+        }
+        for i in 0..n {
+            self.limit_hits[i] += s.at_limit[i] as u64;
+        }
+        for a in 0..3 {
+            self.tool_min[a] = self.tool_min[a].min(s.tool_position[a]);
+            self.tool_max[a] = self.tool_max[a].max(s.tool_position[a]);
+        }
+        self.last_t = s.t;
+    }
+
+    pub fn finish(&self, status: RunStatus, wall_time: f64) -> Summary {
+        let in_window = self.window_samples > 0;
+        let range = |a: usize| Range { min: self.tool_min[a], max: self.tool_max[a] };
+        Summary {
+            status,
+            joints: self.joints.clone(),
+            simulated_time: self.last_t,
+            steps: self.control_steps as usize,
+            dt: self.dt,
+            error_window_start: self.window_start,
+            max_abs_error: self.max_err.iter().map(|&e| in_window.then_some(e)).collect(),
+            rms_error: self
+                .sum_sq_err
+                .iter()
+                .map(|&s| in_window.then(|| (s / self.window_samples as f64).sqrt()))
+                .collect(),
+            saturation_percent: self
+                .saturated_steps
+                .iter()
+                .map(|&c| if self.control_steps == 0 { 0.0 } else { 100.0 * c as f64 / self.control_steps as f64 })
+                .collect(),
+            peak_abs_torque: self.peak_torque.clone(),
+            effort_limit: self.effort.clone(),
+            limit_hits: self.limit_hits.clone(),
+            tool_range: ToolRange { x: range(0), y: range(1), z: range(2) },
+            wall_time,
+        }
+    }
+}

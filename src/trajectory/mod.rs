@@ -1,0 +1,16 @@
+//! Joint commands over time. A new kind of command is one new file implementing [`Trajectory`].
+
+mod hold;
+mod step;
+mod wave;
+
+pub use hold::Hold;
+pub use step::JointStep;
+pub use wave::Wave;
+
+/// A joint-space command schedule: position and velocity targets at time t.
+pub trait Trajectory: Send + Sync {
+    fn sample(&self, t: f64, cmd: &mut [f64], cmd_dot: &mut [f64]);
+    /// One line for the console and the recordings' configuration.
+    fn describe(&self) -> String;
+}

@@ -1,0 +1,64 @@
+//! Helpers shared by the integration tests.
+#![allow(dead_code)]
+
+use std::io::Read;
+use std::path::{Path, PathBuf};
+
+pub mod random_tree;
+
+pub fn repo() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+pub fn box_urdf() -> PathBuf {
+    repo().join("assets/smallrobot_arm.urdf")
+}
+
+/// `../shared/reference/` beside the repository.
+pub fn reference(file: &str) -> PathBuf {
+    repo().join("../shared/reference").join(file)
+}
+
+/// A parsed CSV: header and rows of numbers (`nan` allowed).
+pub struct Table {
+    pub header: Vec<String>,
+    pub rows: Vec<Vec<f64>>,
+}
+
+impl Table {
+    pub fn col(&self, name: &str) -> usize {
+        self.header.iter().position(|h| h == name).unwrap_or_else(|| panic!("no column {name} in {:?}", self.header))
+    }
+
+    pub fn column(&self, name: &str) -> Vec<f64> {
+        let c = self.col(name);
+        self.rows.iter().map(|r| r[c]).collect()
+    }
+}
+
+pub fn parse_csv(text: &str) -> Table {
+    let mut lines = text.lines().filter(|l| !l.starts_with('#') && !l.trim().is_empty());
+    let header: Vec<String> = lines.next().expect("header").split(',').map(|s| s.trim().to_string()).collect();
+    let rows = lines
+        .map(|l| l.split(',').map(|x| x.trim().parse::<f64>().unwrap_or_else(|_| panic!("bad number {x:?}"))).collect())
+        .collect();
+    Table { header, rows }
+}
+
+pub fn read_csv(path: &Path) -> Table {
+    parse_csv(&std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display())))
+}
+
+pub fn read_csv_gz(path: &Path) -> Table {
+    let file = std::fs::File::open(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let mut text = String::new();
+    flate2::read::GzDecoder::new(file).read_to_string(&mut text).expect("gunzip");
+    parse_csv(&text)
+}
+
+/// Run the CLI in-process; returns the exit code.
+pub fn armscope(args: &[&str]) -> i32 {
+    let mut argv = vec!["armscope"];
+    argv.extend_from_slice(args);
+    armscope::cli::main_with_args(argv)
+}

@@ -1,0 +1,109 @@
+//! Thousands of mutated URDF texts through the loader: never a panic, always a model or a
+//! one-line error that names the file.
+
+mod common;
+
+use armscope::model::load_urdf_str;
+use proptest::prelude::*;
+use std::path::Path;
+
+fn base_text() -> String {
+    std::fs::read_to_string(common::box_urdf()).unwrap()
+}
+
+#[derive(Clone, Debug)]
+enum Mutation {
+    DeleteRange(usize, usize),
+    Insert(usize, String),
+    ReplaceNumber(usize, String),
+    SwapLines(usize, usize),
+    DuplicateLine(usize),
+}
+
+fn mutation() -> impl Strategy<Value = Mutation> {
+    let junk = prop::sample::select(vec![
+        "<", ">", "/>", "\"", "<link name=\"x\"/>", "<joint name=\"J1\" type=\"fixed\"><parent link=\"a\"/><child link=\"b\"/></joint>",
+        "nan", "-inf", "1e400", "-1", "0", "&amp;", "<!--", "type=\"floating\"", "<mimic joint=\"J2\"/>", "\u{0}", "é",
+    ])
+    .prop_map(String::from);
+    let number = prop::sample::select(vec!["nan", "inf", "-inf", "-1", "0", "1e308", "-0", "abc", "", "1 2", "0x10"]).prop_map(String::from);
+    prop_oneof![
+        (any::<usize>(), 0usize..40).prop_map(|(a, l)| Mutation::DeleteRange(a, l)),
+        (any::<usize>(), junk).prop_map(|(a, s)| Mutation::Insert(a, s)),
+        (any::<usize>(), number).prop_map(|(a, s)| Mutation::ReplaceNumber(a, s)),
+        (any::<usize>(), any::<usize>()).prop_map(|(a, b)| Mutation::SwapLines(a, b)),
+        any::<usize>().prop_map(Mutation::DuplicateLine),
+    ]
+}
+
+fn apply(text: &str, m: &Mutation) -> String {
+    let boundary = |s: &str, mut i: usize| {
+        i %= s.len() + 1;
+        while !s.is_char_boundary(i) {
+            i -= 1;
+        }
+        i
+    };
+    match m {
+        Mutation::DeleteRange(a, l) => {
+            let a = boundary(text, *a);
+            let b = boundary(text, (a + l).min(text.len()));
+            format!("{}{}", &text[..a], &text[b.max(a)..])
+        }
+        Mutation::Insert(a, s) => {
+            let a = boundary(text, *a);
+            format!("{}{}{}", &text[..a], s, &text[a..])
+        }
+        Mutation::ReplaceNumber(a, s) => {
+            // the first number after position a
+            let a = boundary(text, *a);
+            let rest = &text[a..];
+            match rest.find(|c: char| c.is_ascii_digit()) {
+                Some(start) => {
+                    let len = rest[start..].find(|c: char| !(c.is_ascii_digit() || c == '.' || c == 'e' || c == '-')).unwrap_or(rest.len() - start);
+                    format!("{}{}{}{}", &text[..a], &rest[..start], s, &rest[start + len..])
+                }
+                None => text.to_string(),
+            }
+        }
+        Mutation::SwapLines(a, b) => {
+            let mut lines: Vec<&str> = text.lines().collect();
+            let n = lines.len();
+            lines.swap(a % n, b % n);
+            lines.join("\n")
+        }
+        Mutation::DuplicateLine(a) => {
+            let mut lines: Vec<&str> = text.lines().collect();
+            let i = a % lines.len();
+            lines.insert(i, lines[i]);
+            lines.join("\n")
+        }
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 4000, failure_persistence: None, .. ProptestConfig::default() })]
+
+    #[test]
+    fn mutated_urdf_loads_or_fails_with_one_line_error(mutations in prop::collection::vec(mutation(), 1..4)) {
+        let mut text = base_text();
+        for m in &mutations {
+            text = apply(&text, m);
+        }
+        let result = std::panic::catch_unwind(|| load_urdf_str(&text, Path::new("mutated.urdf")));
+        prop_assert!(result.is_ok(), "loader panicked on {mutations:?}");
+        match result.unwrap() {
+            Ok(model) => {
+                prop_assert!(model.dof() > 0);
+                for j in &model.joints {
+                    prop_assert!(j.inertia.mass > 0.0 && j.inertia.mass.is_finite());
+                }
+            }
+            Err(e) => {
+                let msg = e.to_string();
+                prop_assert!(msg.starts_with("mutated.urdf: "), "{msg}");
+                prop_assert!(!msg.contains('\n'), "multi-line error: {msg:?}");
+            }
+        }
+    }
+}
