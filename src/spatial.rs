@@ -75,9 +75,21 @@ pub fn rotation_from_rpy([roll, pitch, yaw]: [f64; 3]) -> Matrix3<f64> {
 /// Rotation by `angle` about the unit vector `axis` (Rodrigues).
 #[inline]
 pub fn rotation_about_axis(axis: &Vector3<f64>, angle: f64) -> Matrix3<f64> {
+    // R = c·I + s·[a]× + (1 − c)·a·aᵀ
     let (s, c) = angle.sin_cos();
-    let k = skew(axis);
-    Matrix3::identity() + k * s + (k * k) * (1.0 - c)
+    let t = 1.0 - c;
+    let (x, y, z) = (axis.x, axis.y, axis.z);
+    Matrix3::new(
+        c + t * x * x,
+        t * x * y - s * z,
+        t * x * z + s * y,
+        t * x * y + s * z,
+        c + t * y * y,
+        t * y * z - s * x,
+        t * x * z - s * y,
+        t * y * z + s * x,
+        c + t * z * z,
+    )
 }
 
 #[inline]

@@ -1,0 +1,62 @@
+//! A control step (kinematics, τ_g and C·q̇, controller, plant) allocates nothing, for the discrete
+//! and the continuous plant. Counted with a global allocator that tallies every allocation.
+
+mod common;
+
+use armscope::config::RunConfig;
+use armscope::controller::ControlOutput;
+use armscope::dynamics::{Data, forward_kinematics, frame_pose, gravity_and_bias_from_kinematics};
+use armscope::experiment::Experiment;
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+struct Counting;
+static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+fn allocations_in_steps(config: RunConfig) -> usize {
+    let experiment = Experiment::prepare(config).unwrap();
+    let model = &*experiment.model;
+    let n = model.dof();
+    let mut data = Data::new(model);
+    let mut plant = experiment.make_plant();
+    let controller = experiment.controller();
+    let (mut q, mut v) = experiment.initial_state();
+    let (mut cmd, mut cmd_dot, mut u, mut sat) = (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![false; n]);
+    let mut step = |k: usize, q: &mut Vec<f64>, v: &mut Vec<f64>| {
+        forward_kinematics(model, &mut data, q);
+        gravity_and_bias_from_kinematics(model, &mut data, v);
+        experiment.trajectory.sample(k as f64 * 0.001, &mut cmd, &mut cmd_dot);
+        controller.compute(q, v, &cmd, &cmd_dot, &data.gravity, ControlOutput { u: &mut u, saturated: &mut sat });
+        std::hint::black_box(frame_pose(model, &data, model.tool_frame));
+        plant.advance(model, &mut data, &u, q, v);
+    };
+    step(0, &mut q, &mut v); // warm-up: nothing lazy left
+    let before = ALLOCATIONS.load(Ordering::SeqCst);
+    for k in 1..500 {
+        step(k, &mut q, &mut v);
+    }
+    ALLOCATIONS.load(Ordering::SeqCst) - before
+}
+
+#[test]
+fn discrete_and_continuous_steps_do_not_allocate() {
+    let urdf = common::box_urdf();
+    let discrete = allocations_in_steps(RunConfig { urdf: urdf.clone(), ..RunConfig::default() });
+    let continuous = allocations_in_steps(RunConfig { urdf: urdf.clone(), time_step: Some(0.0), ..RunConfig::default() });
+    // a step that passes a joint limit takes the active-set path
+    let limited = allocations_in_steps(RunConfig { urdf, test_joint: Some("2".into()), test_angle: 3.0, ..RunConfig::default() });
+    assert_eq!((discrete, continuous, limited), (0, 0, 0), "allocations in 499 steps: discrete, continuous, at a limit");
+}
