@@ -3,12 +3,13 @@
 use crate::config::{IntegratorKind, RunConfig};
 use crate::error::Error;
 use crate::experiment::Experiment;
-use crate::recorder::{Console, Recorder, SummaryJson, Trace, TutorialCsv};
+use crate::recorder::{Console, LiveViewer, McapRecorder, Pacer, Recorder, RerunOptions, RerunRecorder, SummaryJson, Threaded, Trace, TutorialCsv};
 use crate::sim::simulate;
 use crate::summary::RunStatus;
 use clap::{Args, Parser, Subcommand};
 use std::ffi::OsString;
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 #[derive(Parser, Debug)]
 #[command(name = "armscope", version, about = "Simulate a robot arm with real rigid-body dynamics and record every experiment")]
@@ -108,6 +109,76 @@ pub struct RunArgs {
     /// No console output.
     #[arg(long, short)]
     pub quiet: bool,
+
+    /// Name of the recordings (default: from the flags, e.g. "default", "no-ff").
+    #[arg(long)]
+    pub name: Option<String>,
+    /// Where to write the Rerun recording (default: recordings/NAME.rrd).
+    #[arg(long, value_name = "PATH")]
+    pub rrd: Option<PathBuf>,
+    /// Where to write the MCAP for Foxglove (default: recordings/NAME.mcap).
+    #[arg(long, value_name = "PATH")]
+    pub mcap: Option<PathBuf>,
+    /// No Rerun recording file.
+    #[arg(long)]
+    pub no_rrd: bool,
+    /// No MCAP file.
+    #[arg(long)]
+    pub no_mcap: bool,
+    /// Start a Rerun viewer and stream the run to it (the files are written too).
+    #[arg(long)]
+    pub spawn: bool,
+    /// Stream to a running Rerun viewer (default URL: rerun+http://127.0.0.1:9876/proxy).
+    #[arg(long, value_name = "URL", num_args = 0..=1, default_missing_value = crate::recorder::DEFAULT_CONNECT_URL)]
+    pub connect: Option<String>,
+    /// Pace the simulation to the wall clock, FACTOR × real time (default 1).
+    #[arg(long, value_name = "FACTOR", num_args = 0..=1, default_missing_value = "1")]
+    pub realtime: Option<f64>,
+}
+
+/// A file-name-safe name for a run, from the flags that differ from the tutorial's defaults.
+pub fn default_run_name(config: &RunConfig) -> String {
+    let d = RunConfig::default();
+    let mut parts: Vec<String> = Vec::new();
+    if config.urdf != d.urdf {
+        parts.push(config.urdf.file_stem().map_or("model".into(), |s| s.to_string_lossy().to_string()));
+    }
+    if config.hold {
+        parts.push("static".into());
+    }
+    if let Some(j) = &config.test_joint {
+        parts.push(format!("test-joint-{j}"));
+    }
+    if config.no_ff {
+        parts.push("no-ff".into());
+    }
+    if config.no_gravity {
+        parts.push("no-gravity".into());
+    }
+    if config.freq != d.freq {
+        parts.push(format!("freq{}", config.freq));
+    }
+    if config.amp_deg != d.amp_deg {
+        parts.push(format!("amp{}", config.amp_deg));
+    }
+    if config.kp.is_some() || config.kd.is_some() || config.auto_tune {
+        parts.push("gains".into());
+    }
+    if config.time_step == Some(0.0) || config.integrator == Some(IntegratorKind::Continuous) {
+        parts.push("continuous".into());
+    } else if let Some(h) = config.time_step {
+        parts.push(format!("h{h}"));
+    }
+    if config.dt != d.dt {
+        parts.push(format!("dt{}", config.dt));
+    }
+    if config.duration != d.duration {
+        parts.push(format!("{}s", config.duration));
+    }
+    if parts.is_empty() {
+        parts.push("default".into());
+    }
+    parts.join("_").chars().map(|c| if c.is_ascii_alphanumeric() || "-_.".contains(c) { c } else { '-' }).collect()
 }
 
 impl RunArgs {
@@ -181,15 +252,61 @@ fn create_parent(path: &std::path::Path) -> Result<(), Error> {
     }
 }
 
+/// How long a recorder thread may wait for samples (keeps a live viewer current).
+const RECORDER_LATENCY: std::time::Duration = std::time::Duration::from_millis(20);
+
+/// Set by SIGINT (Ctrl-C): the run stops after the current step and finishes its files.
+static INTERRUPTED: AtomicBool = AtomicBool::new(false);
+
+fn install_interrupt_handler() {
+    static INSTALLED: std::sync::Once = std::sync::Once::new();
+    INSTALLED.call_once(|| {
+        // a second handler cannot be installed (e.g. by an embedding program): then Ctrl-C just kills
+        let _ = ctrlc::set_handler(|| INTERRUPTED.store(true, Ordering::SeqCst));
+    });
+}
+
 /// `armscope run`.
 pub fn run(args: &RunArgs) -> Result<i32, Error> {
-    let experiment = Experiment::prepare(args.config())?;
+    let config = args.config();
+    let name = args.name.clone().unwrap_or_else(|| default_run_name(&config));
+    let experiment = Experiment::prepare(config)?;
     for notice in &experiment.model.notices {
         eprintln!("armscope: notice: {notice}");
     }
+    if let Some(f) = args.realtime {
+        if !(f.is_finite() && f > 0.0) {
+            return Err(Error::flag("--realtime", format!("must be a positive factor (got {f})")));
+        }
+    }
+    let recordings = PathBuf::from("recordings");
+    let rrd_path = (!args.no_rrd).then(|| args.rrd.clone().unwrap_or_else(|| recordings.join(format!("{name}.rrd"))));
+    let mcap_path = (!args.no_mcap).then(|| args.mcap.clone().unwrap_or_else(|| recordings.join(format!("{name}.mcap"))));
+    let live = if args.spawn {
+        Some(LiveViewer::Spawn)
+    } else {
+        args.connect.clone().map(LiveViewer::Connect)
+    };
+
     let mut recorders: Vec<Box<dyn Recorder>> = Vec::new();
     if !args.quiet {
         recorders.push(Box::new(Console::stdout()));
+    }
+    if rrd_path.is_some() || live.is_some() {
+        if let Some(path) = &rrd_path {
+            create_parent(path)?;
+        }
+        let mut rrd = RerunRecorder::new(RerunOptions { file: rrd_path.clone(), live, name: name.clone() });
+        // the viewer connection is made in start(); report what could not be reached right away
+        rrd.on_notice(|n| eprintln!("armscope: notice: {n}"));
+        recorders.push(Box::new(Threaded::new(rrd, RECORDER_LATENCY)));
+    }
+    if let Some(path) = &mcap_path {
+        create_parent(path)?;
+        recorders.push(Box::new(Threaded::new(McapRecorder::new(path.clone()), RECORDER_LATENCY)));
+    }
+    if let Some(factor) = args.realtime {
+        recorders.push(Box::new(Pacer::new(factor)));
     }
     for (path, make) in [
         (&args.csv, (|p| Box::new(TutorialCsv::new(p)) as Box<dyn Recorder>) as fn(PathBuf) -> Box<dyn Recorder>),
@@ -202,7 +319,21 @@ pub fn run(args: &RunArgs) -> Result<i32, Error> {
         }
     }
     let mut refs: Vec<&mut dyn Recorder> = recorders.iter_mut().map(|r| r.as_mut() as &mut dyn Recorder).collect();
-    let summary = simulate(&experiment, &mut refs, None)?;
+    install_interrupt_handler();
+    INTERRUPTED.store(false, Ordering::SeqCst);
+    let summary = simulate(&experiment, &mut refs, Some(&INTERRUPTED))?;
+    if !args.quiet {
+        let mut files = Vec::new();
+        if let Some(p) = &rrd_path {
+            files.push(format!("  {}   open in Rerun: rerun {}", p.display(), p.display()));
+        }
+        if let Some(p) = &mcap_path {
+            files.push(format!("  {}  open in Foxglove: Open local file… → {}", p.display(), p.display()));
+        }
+        if !files.is_empty() {
+            println!("\nRecordings{}:\n{}", if matches!(summary.status, RunStatus::Completed) { "" } else { " (complete up to the last step simulated)" }, files.join("\n"));
+        }
+    }
     match summary.status {
         RunStatus::Diverged { message, .. } => Err(Error::Diverged(message)),
         RunStatus::Interrupted { .. } => Ok(130),

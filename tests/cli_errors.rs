@@ -25,7 +25,7 @@ fn run_with_urdf(text: &str, extra: &[&str]) -> (i32, String) {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("bad.urdf");
     std::fs::write(&path, text).unwrap();
-    let mut args = vec!["run", "--quiet", "--duration", "0.01", "--urdf", path.to_str().unwrap()];
+    let mut args = vec!["run", "--quiet", "--no-rrd", "--no-mcap", "--duration", "0.01", "--urdf", path.to_str().unwrap()];
     args.extend_from_slice(extra);
     run(&args)
 }

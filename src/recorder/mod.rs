@@ -2,12 +2,20 @@
 //! trait; a new format is one new file.
 
 mod console;
+mod mcap;
+mod pacer;
+mod rrd;
 mod summary_json;
+mod threaded;
 mod trace;
 mod tutorial_csv;
 
 pub use console::Console;
+pub use mcap::{ControllerTelemetry, McapRecorder};
+pub use pacer::Pacer;
+pub use rrd::{DEFAULT_CONNECT_URL, LiveViewer, RerunOptions, RerunRecorder};
 pub use summary_json::SummaryJson;
+pub use threaded::Threaded;
 pub use trace::Trace;
 pub use tutorial_csv::TutorialCsv;
 

@@ -42,14 +42,14 @@ impl Recorder for Trace {
     fn record(&mut self, s: &Sample) -> Result<(), Error> {
         use std::fmt::Write as _;
         self.line.clear();
-        let _ = write!(self.line, "{}", s.t);
+        let _ = write!(self.line, "{:?}", s.t);
         for series in [s.q, s.v, s.cmd, s.cmd_dot, s.u, s.tau_g] {
             for x in series {
-                let _ = write!(self.line, ",{x}");
+                let _ = write!(self.line, ",{x:?}");
             }
         }
         let p = s.tool_position;
-        let _ = writeln!(self.line, ",{},{},{}", p.x, p.y, p.z);
+        let _ = writeln!(self.line, ",{:?},{:?},{:?}", p.x, p.y, p.z);
         let out = self.out.as_mut().expect("started");
         out.write_all(self.line.as_bytes()).map_err(|e| Error::output(&self.path, e))
     }

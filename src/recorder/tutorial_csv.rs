@@ -40,12 +40,12 @@ impl Recorder for TutorialCsv {
             return Ok(());
         }
         let out = self.out.as_mut().expect("started");
-        let mut line = format!("{}", s.t);
+        let mut line = format!("{:?}", s.t);
         for q in s.q {
-            line.push_str(&format!(",{q}"));
+            line.push_str(&format!(",{q:?}"));
         }
         let p = s.tool_position;
-        line.push_str(&format!(",{},{},{}", p.x, p.y, p.z));
+        line.push_str(&format!(",{:?},{:?},{:?}", p.x, p.y, p.z));
         writeln!(out, "{line}").map_err(|err| Error::output(&self.path, err))
     }
 

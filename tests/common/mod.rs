@@ -56,9 +56,12 @@ pub fn read_csv_gz(path: &Path) -> Table {
     parse_csv(&text)
 }
 
-/// Run the CLI in-process; returns the exit code.
+/// Run the CLI in-process; returns the exit code. `run` writes no .rrd/.mcap unless the test asks.
 pub fn armscope(args: &[&str]) -> i32 {
     let mut argv = vec!["armscope"];
     argv.extend_from_slice(args);
+    if args.first() == Some(&"run") && !args.iter().any(|a| *a == "--rrd" || *a == "--mcap") {
+        argv.extend_from_slice(&["--no-rrd", "--no-mcap"]);
+    }
     armscope::cli::main_with_args(argv)
 }

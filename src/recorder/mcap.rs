@@ -1,0 +1,420 @@
+//! MCAP recorder for Foxglove: joint transforms, link geometry, joint states, controller telemetry,
+//! the tool's pose and path, the URDF, and the run's configuration and summary as metadata.
+//! Timestamps are simulation time offset by the wall-clock start of the run (in the metadata).
+
+use super::{Recorder, RunInfo};
+use crate::dynamics::{Data, forward_kinematics, frame_pose};
+use crate::error::Error;
+use crate::model::{Geometry, Model};
+use crate::sample::Sample;
+use crate::spatial::Pose;
+use crate::summary::Summary;
+use foxglove::messages::{
+    Color, CubePrimitive, CylinderPrimitive, FrameTransform, FrameTransforms, JointState, JointStates, LinePrimitive, ModelPrimitive,
+    Point3, PoseInFrame, Quaternion, SceneEntity, SceneUpdate, SpherePrimitive, Timestamp, Vector3,
+};
+use foxglove::{Channel, Context, McapCompression, McapWriteOptions, McapWriterHandle};
+use nalgebra::{Rotation3, UnitQuaternion};
+use schemars::JsonSchema;
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::fs::File;
+use std::io::BufWriter;
+use std::path::PathBuf;
+use std::sync::Arc;
+
+pub const TOPIC_TF: &str = "/tf";
+pub const TOPIC_SCENE: &str = "/robot/geometry";
+pub const TOPIC_JOINT_STATES: &str = "/joint_states";
+pub const TOPIC_CONTROLLER: &str = "/controller";
+pub const TOPIC_TOOL_POSE: &str = "/tool/pose";
+pub const TOPIC_TOOL_PATH: &str = "/tool/path";
+pub const TOPIC_COMMANDED_PATH: &str = "/tool/commanded_path";
+pub const TOPIC_ROBOT_DESCRIPTION: &str = "/robot_description";
+
+/// Per-step controller telemetry, one array entry per joint (Foxglove plots `/controller.torque[1]`).
+#[derive(Clone, Debug, Default, Serialize, JsonSchema)]
+pub struct ControllerTelemetry {
+    /// Simulation time, s.
+    pub time: f64,
+    pub target: Vec<f64>,
+    pub error: Vec<f64>,
+    /// Applied (clipped) torque, N·m.
+    pub torque: Vec<f64>,
+    /// Generalized gravity force τ_g, N·m.
+    pub tau_g: Vec<f64>,
+    /// 1 when the controller asked for more than the limit.
+    pub saturated: Vec<u8>,
+}
+
+/// The URDF text (as ROS's std_msgs/String carries it).
+#[derive(Clone, Debug, Serialize, JsonSchema)]
+pub struct RobotDescription {
+    pub data: String,
+}
+
+struct Channels {
+    tf: Channel<FrameTransforms>,
+    scene: Channel<SceneUpdate>,
+    joint_states: Channel<JointStates>,
+    controller: Channel<ControllerTelemetry>,
+    tool_pose: Channel<PoseInFrame>,
+    tool_path: Channel<SceneUpdate>,
+    commanded_path: Channel<SceneUpdate>,
+    robot_description: Channel<RobotDescription>,
+}
+
+pub struct McapRecorder {
+    path: PathBuf,
+    context: Arc<Context>,
+    writer: Option<McapWriterHandle<BufWriter<File>>>,
+    channels: Option<Channels>,
+    start_ns: u64,
+    /// (parent frame, child frame) per transform; parent `None` is "world" for a root not named so.
+    tf_pairs: Vec<(Option<usize>, usize)>,
+    frame_world: Vec<Pose>,
+    frame_body: Vec<(Option<usize>, Pose)>,
+    tool_frame: usize,
+    tf_msg: FrameTransforms,
+    /// The transforms of fixed joints (sent with the geometry, once a simulated second).
+    fixed_tf_msg: FrameTransforms,
+    fixed_tf_pairs: Vec<(Option<usize>, usize)>,
+    joints_msg: JointStates,
+    telemetry: ControllerTelemetry,
+    scene: SceneUpdate,
+    dt: f64,
+    steps_per_path_point: usize,
+    path_points: Vec<Point3>,
+    path_segment: usize,
+    last_scene_second: i64,
+}
+
+impl McapRecorder {
+    pub fn new(path: PathBuf) -> Self {
+        Self {
+            path,
+            context: Context::new(),
+            writer: None,
+            channels: None,
+            start_ns: 0,
+            tf_pairs: Vec::new(),
+            frame_world: Vec::new(),
+            frame_body: Vec::new(),
+            tool_frame: 0,
+            tf_msg: FrameTransforms::default(),
+            fixed_tf_msg: FrameTransforms::default(),
+            fixed_tf_pairs: Vec::new(),
+            joints_msg: JointStates::default(),
+            telemetry: ControllerTelemetry::default(),
+            scene: SceneUpdate::default(),
+            dt: 0.001,
+            steps_per_path_point: 20,
+            path_points: Vec::new(),
+            path_segment: 0,
+            last_scene_second: -1,
+        }
+    }
+
+    fn err(&self, e: impl std::fmt::Display) -> Error {
+        Error::output(&self.path, e)
+    }
+
+    fn stamp(&self, t: f64) -> u64 {
+        self.start_ns + (t * 1e9).round() as u64
+    }
+
+    fn timestamp(&self, t: f64) -> Timestamp {
+        let ns = self.stamp(t);
+        Timestamp::new((ns / 1_000_000_000) as u32, (ns % 1_000_000_000) as u32)
+    }
+
+    fn write_metadata(&self, name: &str, entries: BTreeMap<String, String>) -> Result<(), Error> {
+        match &self.writer {
+            Some(w) => w.write_metadata(name, entries).map_err(|e| self.err(e)),
+            None => Ok(()),
+        }
+    }
+
+    fn publish_path_segment(&mut self, t: f64) {
+        if self.path_points.len() < 2 {
+            return;
+        }
+        let Some(ch) = &self.channels else { return };
+        let entity = SceneEntity {
+            timestamp: Some(self.timestamp(t)),
+            frame_id: "world".into(),
+            id: format!("path/{}", self.path_segment),
+            lines: vec![line(self.path_points.clone(), color([0.9, 0.2, 0.2, 1.0]), 0.003)],
+            ..Default::default()
+        };
+        ch.tool_path.log_with_time(&SceneUpdate { deletions: vec![], entities: vec![entity] }, self.stamp(t));
+        self.path_segment += 1;
+        let last = *self.path_points.last().unwrap();
+        self.path_points.clear();
+        self.path_points.push(last);
+    }
+}
+
+/// Each child link's pose in its parent link's frame.
+fn fill_transforms(msg: &mut FrameTransforms, pairs: &[(Option<usize>, usize)], frame_world: &[Pose], ts: Option<Timestamp>) {
+    for (m, &(parent, child)) in msg.transforms.iter_mut().zip(pairs) {
+        let relative = match parent {
+            Some(p) => frame_world[p].inverse().compose(&frame_world[child]),
+            None => frame_world[child],
+        };
+        m.timestamp = ts;
+        m.translation = Some(vec3(&relative.translation));
+        m.rotation = Some(quaternion(&relative));
+    }
+}
+
+fn color(c: [f32; 4]) -> Color {
+    Color { r: c[0] as f64, g: c[1] as f64, b: c[2] as f64, a: c[3] as f64 }
+}
+
+fn line(points: Vec<Point3>, color: Color, thickness: f64) -> LinePrimitive {
+    LinePrimitive { r#type: 0, thickness, scale_invariant: false, points, color: Some(color), ..Default::default() }
+}
+
+fn vec3(v: &nalgebra::Vector3<f64>) -> Vector3 {
+    Vector3 { x: v.x, y: v.y, z: v.z }
+}
+
+fn quaternion(pose: &Pose) -> Quaternion {
+    let q = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(pose.rotation));
+    Quaternion { x: q.i, y: q.j, z: q.k, w: q.w }
+}
+
+fn fox_pose(pose: &Pose) -> foxglove::messages::Pose {
+    foxglove::messages::Pose { position: Some(vec3(&pose.translation)), orientation: Some(quaternion(pose)) }
+}
+
+fn media_type(path: &std::path::Path) -> &'static str {
+    match path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()).as_deref() {
+        Some("stl") => "model/stl",
+        Some("obj") => "model/obj",
+        Some("dae") => "model/vnd.collada+xml",
+        Some("glb") => "model/gltf-binary",
+        _ => "model/gltf+json",
+    }
+}
+
+/// One scene entity per link with visuals, locked to the link's frame.
+fn scene_from_model(model: &Model) -> Result<SceneUpdate, (PathBuf, std::io::Error)> {
+    let mut entities = Vec::new();
+    for frame in &model.frames {
+        if frame.visuals.is_empty() {
+            continue;
+        }
+        let mut entity = SceneEntity { frame_id: frame.name.clone(), id: frame.name.clone(), frame_locked: true, ..Default::default() };
+        for v in &frame.visuals {
+            let c = color(v.rgba.unwrap_or([0.67, 0.67, 0.7, 1.0]));
+            let pose = Some(fox_pose(&v.origin));
+            match &v.geometry {
+                Geometry::Box { size } => entity.cubes.push(CubePrimitive { pose, size: Some(Vector3 { x: size[0], y: size[1], z: size[2] }), color: Some(c) }),
+                Geometry::Cylinder { radius, length } => entity.cylinders.push(CylinderPrimitive {
+                    pose,
+                    size: Some(Vector3 { x: 2.0 * radius, y: 2.0 * radius, z: *length }),
+                    bottom_scale: 1.0,
+                    top_scale: 1.0,
+                    color: Some(c),
+                }),
+                Geometry::Capsule { radius, length } => {
+                    entity.cylinders.push(CylinderPrimitive {
+                        pose,
+                        size: Some(Vector3 { x: 2.0 * radius, y: 2.0 * radius, z: *length }),
+                        bottom_scale: 1.0,
+                        top_scale: 1.0,
+                        color: Some(c),
+                    });
+                    for end in [-0.5, 0.5] {
+                        let cap = v.origin.compose(&Pose::new(nalgebra::Matrix3::identity(), nalgebra::Vector3::new(0.0, 0.0, end * length)));
+                        entity.spheres.push(SpherePrimitive { pose: Some(fox_pose(&cap)), size: Some(Vector3 { x: 2.0 * radius, y: 2.0 * radius, z: 2.0 * radius }), color: Some(c) });
+                    }
+                }
+                Geometry::Sphere { radius } => entity.spheres.push(SpherePrimitive { pose, size: Some(Vector3 { x: 2.0 * radius, y: 2.0 * radius, z: 2.0 * radius }), color: Some(c) }),
+                Geometry::Mesh { path, scale } => {
+                    let data = std::fs::read(path).map_err(|e| (path.clone(), e))?;
+                    entity.models.push(ModelPrimitive {
+                        pose,
+                        scale: Some(Vector3 { x: scale[0], y: scale[1], z: scale[2] }),
+                        color: Some(c),
+                        override_color: v.rgba.is_some(),
+                        url: String::new(),
+                        media_type: media_type(path).into(),
+                        data: data.into(),
+                    });
+                }
+            }
+        }
+        entities.push(entity);
+    }
+    Ok(SceneUpdate { deletions: vec![], entities })
+}
+
+impl Recorder for McapRecorder {
+    fn start(&mut self, run: &RunInfo) -> Result<(), Error> {
+        let e = run.experiment;
+        let model = &*e.model;
+        let file = File::create(&self.path).map_err(|err| self.err(err))?;
+        let options = McapWriteOptions::new().compression(Some(McapCompression::Zstd)).compression_level(1);
+        let writer = self.context.mcap_writer_with_options(options).create(BufWriter::new(file)).map_err(|err| self.err(err))?;
+        let ctx = &self.context;
+        self.channels = Some(Channels {
+            tf: ctx.channel_builder(TOPIC_TF).build(),
+            scene: ctx.channel_builder(TOPIC_SCENE).build(),
+            joint_states: ctx.channel_builder(TOPIC_JOINT_STATES).build(),
+            // joint order and limits are constant: channel metadata, not repeated in every message
+            controller: ctx
+                .channel_builder(TOPIC_CONTROLLER)
+                .add_metadata("joints", &serde_json::to_string(&model.joints.iter().map(|j| &j.name).collect::<Vec<_>>()).unwrap_or_default())
+                .add_metadata("torque_limit", &serde_json::to_string(&e.controller().effort).unwrap_or_default())
+                .build(),
+            tool_pose: ctx.channel_builder(TOPIC_TOOL_POSE).build(),
+            tool_path: ctx.channel_builder(TOPIC_TOOL_PATH).build(),
+            commanded_path: ctx.channel_builder(TOPIC_COMMANDED_PATH).build(),
+            robot_description: ctx.channel_builder(TOPIC_ROBOT_DESCRIPTION).build(),
+        });
+        self.writer = Some(writer);
+        let now = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).unwrap_or_default();
+        self.start_ns = now.as_nanos() as u64;
+        self.dt = e.config.dt;
+        self.steps_per_path_point = ((0.02 / self.dt).round() as usize).max(1);
+
+        // transforms: every link from its parent link; "world" → root when the root is not "world"
+        self.frame_body = model.frames.iter().map(|f| (f.body, f.placement)).collect();
+        self.frame_world = vec![Pose::identity(); model.frames.len()];
+        self.tool_frame = model.tool_frame;
+        let pairs = model.frames.iter().enumerate().filter(|(_, f)| f.parent_frame.is_some() || f.name != "world");
+        // a link moves relative to its parent when its joint is a moving joint
+        let (moving, fixed): (Vec<_>, Vec<_>) = pairs.partition(|(_, f)| f.parent_frame.is_some_and(|p| model.frames[p].body != f.body));
+        self.tf_pairs = moving.iter().map(|(i, f)| (f.parent_frame, *i)).collect();
+        self.fixed_tf_pairs = fixed.iter().map(|(i, f)| (f.parent_frame, *i)).collect();
+        let name_of = |f: Option<usize>| f.map_or("world".to_string(), |i| model.frames[i].name.clone());
+        let message = |pairs: &[(Option<usize>, usize)]| FrameTransforms {
+            transforms: pairs
+                .iter()
+                .map(|&(p, c)| FrameTransform { timestamp: None, parent_frame_id: name_of(p), child_frame_id: name_of(Some(c)), translation: None, rotation: None })
+                .collect(),
+        };
+        self.tf_msg = message(&self.tf_pairs);
+        self.fixed_tf_msg = message(&self.fixed_tf_pairs);
+        let names: Vec<String> = model.joints.iter().map(|j| j.name.clone()).collect();
+        self.joints_msg = JointStates {
+            timestamp: None,
+            joints: names.iter().map(|n| JointState { name: n.clone(), ..Default::default() }).collect(),
+        };
+        let n = model.dof();
+        self.telemetry = ControllerTelemetry {
+            time: 0.0,
+            target: vec![0.0; n],
+            error: vec![0.0; n],
+            torque: vec![0.0; n],
+            tau_g: vec![0.0; n],
+            saturated: vec![0; n],
+        };
+        self.scene = scene_from_model(model).map_err(|(path, err)| Error::output(&path, err))?;
+
+        let ch = self.channels.as_ref().unwrap();
+        let t0 = self.stamp(0.0);
+        ch.robot_description.log_with_time(&RobotDescription { data: model.urdf_text.clone() }, t0);
+        // the commanded tool path, from forward kinematics of the command
+        let mut data = Data::new(model);
+        let (mut cmd, mut cmd_dot) = (vec![0.0; n], vec![0.0; n]);
+        let samples = (e.config.duration / 0.01).ceil() as usize;
+        let points: Vec<Point3> = (0..=samples)
+            .map(|i| {
+                e.trajectory.sample((i as f64 * 0.01).min(e.config.duration), &mut cmd, &mut cmd_dot);
+                forward_kinematics(model, &mut data, &cmd);
+                let p = frame_pose(model, &data, model.tool_frame).translation;
+                Point3 { x: p.x, y: p.y, z: p.z }
+            })
+            .collect();
+        let commanded = SceneEntity {
+            timestamp: Some(self.timestamp(0.0)),
+            frame_id: "world".into(),
+            id: "commanded".into(),
+            lines: vec![line(points, color([0.5, 0.5, 0.5, 1.0]), 0.002)],
+            ..Default::default()
+        };
+        ch.commanded_path.log_with_time(&SceneUpdate { deletions: vec![], entities: vec![commanded] }, t0);
+
+        let mut meta = BTreeMap::new();
+        meta.insert("model".into(), model.name.clone());
+        meta.insert("urdf".into(), model.source.display().to_string());
+        meta.insert("config".into(), serde_json::to_string(&e.config).unwrap_or_default());
+        meta.insert("gains".into(), serde_json::to_string(&e.gains).unwrap_or_default());
+        meta.insert("plant".into(), run.plant.clone());
+        meta.insert("command".into(), run.trajectory.clone());
+        meta.insert("start_time_unix_ns".into(), self.start_ns.to_string());
+        meta.insert("timestamps".into(), "log time = start_time_unix_ns + simulation time (s) × 1e9".into());
+        self.write_metadata("armscope.config", meta)
+    }
+
+    fn record(&mut self, s: &Sample) -> Result<(), Error> {
+        for (i, (body, placement)) in self.frame_body.iter().enumerate() {
+            self.frame_world[i] = match body {
+                Some(b) => s.body_pose[*b].compose(placement),
+                None => *placement,
+            };
+        }
+        let stamp = self.stamp(s.t);
+        let ts = Some(self.timestamp(s.t));
+        fill_transforms(&mut self.tf_msg, &self.tf_pairs, &self.frame_world, ts);
+        self.joints_msg.timestamp = ts;
+        for (j, state) in self.joints_msg.joints.iter_mut().enumerate() {
+            state.position = Some(s.q[j]);
+            state.velocity = Some(s.v[j]);
+            state.effort = Some(s.u[j]);
+        }
+        let tel = &mut self.telemetry;
+        tel.time = s.t;
+        for j in 0..s.q.len() {
+            tel.target[j] = s.cmd[j];
+            tel.error[j] = s.cmd[j] - s.q[j];
+            tel.torque[j] = s.u[j];
+            tel.tau_g[j] = s.tau_g[j];
+            tel.saturated[j] = s.saturated[j] as u8;
+        }
+        let tool = self.frame_world[self.tool_frame];
+        let ch = self.channels.as_ref().expect("started");
+        ch.tf.log_with_time(&self.tf_msg, stamp);
+        ch.joint_states.log_with_time(&self.joints_msg, stamp);
+        ch.controller.log_with_time(&self.telemetry, stamp);
+        ch.tool_pose.log_with_time(&PoseInFrame { timestamp: ts, frame_id: "world".into(), pose: Some(fox_pose(&tool)) }, stamp);
+        // geometry once a simulated second, so a viewer that seeks always has it
+        let second = s.t.floor() as i64;
+        if second > self.last_scene_second {
+            self.last_scene_second = second;
+            for entity in &mut self.scene.entities {
+                entity.timestamp = ts;
+            }
+            ch.scene.log_with_time(&self.scene, stamp);
+            if !self.fixed_tf_pairs.is_empty() {
+                fill_transforms(&mut self.fixed_tf_msg, &self.fixed_tf_pairs, &self.frame_world, ts);
+                ch.tf.log_with_time(&self.fixed_tf_msg, stamp);
+            }
+        }
+        if s.k % self.steps_per_path_point == 0 || s.is_final {
+            let p = tool.translation;
+            self.path_points.push(Point3 { x: p.x, y: p.y, z: p.z });
+            if self.path_points.len() > 5 || s.is_final {
+                self.publish_path_segment(s.t);
+            }
+        }
+        Ok(())
+    }
+
+    fn finish(&mut self, run: &RunInfo, summary: &Summary) -> Result<(), Error> {
+        let _ = run;
+        let mut meta = BTreeMap::new();
+        meta.insert("summary".into(), serde_json::to_string(summary).unwrap_or_default());
+        meta.insert("status".into(), serde_json::to_string(&summary.status).unwrap_or_default());
+        self.write_metadata("armscope.summary", meta)?;
+        self.channels = None;
+        if let Some(writer) = self.writer.take() {
+            writer.close().map_err(|e| self.err(e))?;
+        }
+        Ok(())
+    }
+}

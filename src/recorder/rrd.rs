@@ -1,0 +1,593 @@
+//! Rerun recorder: every joint series at the control rate on the `sim_time` timeline, the arm in
+//! 3D, the tool's trail and paths, the run's configuration and summary, and a blueprint. Columns
+//! are buffered and sent with `send_columns` in blocks (per-step `log` calls cost ~170 µs here).
+
+use super::{Recorder, RunInfo};
+use crate::dynamics::{Data, forward_kinematics, frame_pose};
+use crate::error::Error;
+use crate::model::{Geometry, Model};
+use crate::sample::Sample;
+use crate::spatial::Pose;
+use crate::summary::Summary;
+use rerun::blueprint::{Blueprint, BlueprintActivation, BlueprintPanel, Grid, Horizontal, SelectionPanel, Spatial3DView, TimePanel, TimeSeriesView, Vertical};
+use rerun::blueprint::components::{PanelState, PlayState};
+use rerun::{RecordingStream, TimeColumn};
+use std::collections::VecDeque;
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+
+pub const TIMELINE: &str = "sim_time";
+
+/// Where the recording goes besides the file.
+#[derive(Clone, Debug)]
+pub enum LiveViewer {
+    /// Start a viewer (`rerun` on the PATH) and stream to it.
+    Spawn,
+    /// Stream to a running viewer at this gRPC URL.
+    Connect(String),
+}
+
+pub const DEFAULT_CONNECT_URL: &str = "rerun+http://127.0.0.1:9876/proxy";
+
+#[derive(Clone, Debug, Default)]
+pub struct RerunOptions {
+    pub file: Option<PathBuf>,
+    pub live: Option<LiveViewer>,
+    /// The recording's name in the viewer.
+    pub name: String,
+}
+
+struct JointColumns {
+    angle: Vec<f64>,
+    target: Vec<f64>,
+    error: Vec<f64>,
+    torque: Vec<f64>,
+    gravity_torque: Vec<f64>,
+    saturated: Vec<f64>,
+    saturated_times: Vec<f64>,
+    saturated_torque: Vec<f64>,
+}
+
+impl JointColumns {
+    fn with_capacity(n: usize) -> Self {
+        let v = || Vec::with_capacity(n);
+        Self {
+            angle: v(),
+            target: v(),
+            error: v(),
+            torque: v(),
+            gravity_torque: v(),
+            saturated: v(),
+            saturated_times: Vec::new(),
+            saturated_torque: Vec::new(),
+        }
+    }
+
+    fn clear(&mut self) {
+        for c in [&mut self.angle, &mut self.target, &mut self.error, &mut self.torque, &mut self.gravity_torque, &mut self.saturated, &mut self.saturated_times, &mut self.saturated_torque] {
+            c.clear();
+        }
+    }
+}
+
+/// A link frame that moves: its entity and per-step world poses.
+struct MovingLink {
+    body: usize,
+    placement: Pose,
+    entity: String,
+    translations: Vec<[f32; 3]>,
+    rotations: Vec<rerun::Quaternion>,
+}
+
+pub struct RerunRecorder {
+    options: RerunOptions,
+    rec: Option<RecordingStream>,
+    joint_names: Vec<String>,
+    effort: Vec<f64>,
+    times: Vec<f64>,
+    joints: Vec<JointColumns>,
+    tool: [Vec<f64>; 3],
+    tool_points: Vec<[f32; 3]>,
+    links: Vec<MovingLink>,
+    trail: VecDeque<[f32; 3]>,
+    path: Vec<[f32; 3]>,
+    block_steps: usize,
+    steps_per_trail_point: usize,
+    live: bool,
+    last_flush: Instant,
+    last_t: f64,
+    /// Messages for the user (no viewer found, …).
+    pub notices: Vec<String>,
+    notice_sink: Option<Box<dyn Fn(&str) + Send>>,
+}
+
+/// Steps per block in a file-only recording: ~1 s of simulation per chunk.
+const FILE_BLOCK_STEPS: usize = 1000;
+/// A live viewer gets a block at least this often.
+const LIVE_FLUSH: Duration = Duration::from_millis(40);
+const TRAIL_SECONDS: f64 = 2.0;
+const TRAIL_RATE_HZ: f64 = 50.0;
+
+impl RerunRecorder {
+    pub fn new(options: RerunOptions) -> Self {
+        Self {
+            options,
+            rec: None,
+            joint_names: Vec::new(),
+            effort: Vec::new(),
+            times: Vec::new(),
+            joints: Vec::new(),
+            tool: [Vec::new(), Vec::new(), Vec::new()],
+            tool_points: Vec::new(),
+            links: Vec::new(),
+            trail: VecDeque::new(),
+            path: Vec::new(),
+            block_steps: FILE_BLOCK_STEPS,
+            steps_per_trail_point: 20,
+            live: false,
+            last_flush: Instant::now(),
+            last_t: 0.0,
+            notices: Vec::new(),
+            notice_sink: None,
+        }
+    }
+
+    /// Called with each notice as it happens (e.g. to print it).
+    pub fn on_notice(&mut self, sink: impl Fn(&str) + Send + 'static) {
+        self.notice_sink = Some(Box::new(sink));
+    }
+
+    fn err(&self, e: impl std::fmt::Display) -> Error {
+        let path = self.options.file.clone().unwrap_or_else(|| PathBuf::from("rerun viewer"));
+        Error::output(&path, e)
+    }
+
+    fn open_stream(&mut self) -> Result<RecordingStream, Error> {
+        use rerun::sink::{FileSink, GrpcSink, LogSink};
+        let mut sinks: Vec<Box<dyn LogSink>> = Vec::new();
+        if let Some(path) = &self.options.file {
+            sinks.push(Box::new(FileSink::new(path.clone()).map_err(|e| Error::output(path, e))?));
+        }
+        match &self.options.live {
+            None => {}
+            Some(live) => {
+                let url = match live {
+                    LiveViewer::Connect(url) => Some(url.clone()),
+                    LiveViewer::Spawn => match rerun::spawn(&rerun::SpawnOptions::default()) {
+                        Ok(_) => Some(DEFAULT_CONNECT_URL.to_string()),
+                        Err(e) => {
+                            self.notices.push(format!(
+                                "could not start the Rerun viewer ({e}); install it with `cargo install rerun-cli@0.36.3 --locked` or `pip install rerun-sdk==0.36.3`; writing the files only"
+                            ));
+                            None
+                        }
+                    },
+                };
+                if let Some(url) = url {
+                    match viewer_reachable(&url) {
+                        Ok(uri) => {
+                            sinks.push(Box::new(GrpcSink::new(uri)));
+                            self.live = true;
+                        }
+                        Err(why) => self.notices.push(format!("no Rerun viewer at {url} ({why}); writing the files only")),
+                    }
+                }
+            }
+        }
+        if let Some(report) = &self.notice_sink {
+            for n in &self.notices {
+                report(n);
+            }
+        }
+        if sinks.is_empty() {
+            return Err(self.err("no Rerun viewer reachable and no file to write"));
+        }
+        rerun::RecordingStreamBuilder::new("armscope")
+            .recording_name(self.options.name.clone())
+            .set_sinks(sinks)
+            .map_err(|e| self.err(e))
+    }
+
+    fn log_static_scene(&self, rec: &RecordingStream, model: &Model, data: &Data) -> Result<(), Error> {
+        let e = |err: rerun::RecordingStreamError| self.err(err);
+        rec.log_static("world", &rerun::ViewCoordinates::RIGHT_HAND_Z_UP()).map_err(e)?;
+        for (f, frame) in model.frames.iter().enumerate() {
+            let entity = link_entity(&frame.name);
+            if frame.body.is_none() {
+                let pose = frame_pose(model, data, f);
+                rec.log_static(entity.as_str(), &transform(&pose)).map_err(e)?;
+            }
+            for (i, visual) in frame.visuals.iter().enumerate() {
+                let path = format!("{entity}/visual_{i}");
+                let mut t = transform(&visual.origin);
+                if let Geometry::Mesh { scale, .. } = &visual.geometry {
+                    t = t.with_scale([scale[0] as f32, scale[1] as f32, scale[2] as f32]);
+                }
+                rec.log_static(path.as_str(), &t).map_err(e)?;
+                let color = visual.rgba.map(|c| rerun::Color::from_unmultiplied_rgba((c[0] * 255.0) as u8, (c[1] * 255.0) as u8, (c[2] * 255.0) as u8, (c[3] * 255.0) as u8));
+                let color = color.unwrap_or(rerun::Color::from_rgb(170, 170, 180));
+                match &visual.geometry {
+                    Geometry::Box { size } => rec.log_static(
+                        path.as_str(),
+                        &rerun::Boxes3D::from_half_sizes([[size[0] as f32 / 2.0, size[1] as f32 / 2.0, size[2] as f32 / 2.0]])
+                            .with_colors([color])
+                            .with_fill_mode(rerun::FillMode::Solid),
+                    ),
+                    Geometry::Cylinder { radius, length } => rec.log_static(
+                        path.as_str(),
+                        &rerun::Cylinders3D::from_lengths_and_radii([*length as f32], [*radius as f32])
+                            .with_colors([color])
+                            .with_fill_mode(rerun::FillMode::Solid),
+                    ),
+                    Geometry::Capsule { radius, length } => rec.log_static(
+                        path.as_str(),
+                        &rerun::Capsules3D::from_lengths_and_radii([*length as f32], [*radius as f32]).with_colors([color]),
+                    ),
+                    Geometry::Sphere { radius } => rec.log_static(
+                        path.as_str(),
+                        &rerun::Ellipsoids3D::from_radii([*radius as f32]).with_colors([color]).with_fill_mode(rerun::FillMode::Solid),
+                    ),
+                    Geometry::Mesh { path: file, .. } => {
+                        let asset = rerun::Asset3D::from_file_path(file).map_err(|err| Error::output(file, err))?;
+                        rec.log_static(path.as_str(), &asset.with_albedo_factor(color.0))
+                    }
+                }
+                .map_err(e)?;
+            }
+        }
+        Ok(())
+    }
+
+    fn log_series_styles(&self, rec: &RecordingStream) -> Result<(), Error> {
+        let e = |err: rerun::RecordingStreamError| self.err(err);
+        for (j, name) in self.joint_names.iter().enumerate() {
+            let base = format!("joints/{name}");
+            let c = joint_color(j);
+            let line = |label: &str, color: rerun::Color, width: f32| rerun::SeriesLines::new().with_names([label]).with_colors([color]).with_widths([width]);
+            rec.log_static(format!("{base}/angle"), &line(&format!("{name} angle (rad)"), c, 2.0)).map_err(e)?;
+            rec.log_static(format!("{base}/target"), &line(&format!("{name} target (rad)"), rerun::Color::from_rgb(140, 140, 140), 1.0)).map_err(e)?;
+            rec.log_static(format!("{base}/error"), &line(&format!("{name} error (rad)"), c, 1.5)).map_err(e)?;
+            rec.log_static(format!("{base}/torque"), &line(&format!("{name} torque (N·m)"), c, 1.5)).map_err(e)?;
+            rec.log_static(format!("{base}/gravity_torque"), &line(&format!("{name} τ_g (N·m)"), rerun::Color::from_rgb(90, 170, 90), 1.0)).map_err(e)?;
+            rec.log_static(format!("{base}/saturated"), &line(&format!("{name} saturated (0/1)"), rerun::Color::from_rgb(220, 50, 50), 1.0)).map_err(e)?;
+            for side in ["upper", "lower"] {
+                rec.log_static(format!("{base}/torque_limit/{side}"), &line(&format!("{name} ±effort"), rerun::Color::from_rgb(220, 50, 50), 1.0)).map_err(e)?;
+            }
+            rec.log_static(
+                format!("{base}/saturated_torque"),
+                &rerun::SeriesPoints::new()
+                    .with_names([format!("{name} saturated")])
+                    .with_colors([rerun::Color::from_rgb(230, 40, 40)])
+                    .with_markers([rerun::components::MarkerShape::Circle])
+                    .with_marker_sizes([1.5]),
+            )
+            .map_err(e)?;
+        }
+        for (axis, color) in ["x", "y", "z"].iter().zip([(220, 60, 60), (60, 170, 60), (60, 90, 220)]) {
+            rec.log_static(
+                format!("tool/{axis}"),
+                &rerun::SeriesLines::new().with_names([format!("tool {axis} (m)")]).with_colors([rerun::Color::from_rgb(color.0, color.1, color.2)]),
+            )
+            .map_err(e)?;
+        }
+        Ok(())
+    }
+
+    fn flush_block(&mut self) -> Result<(), Error> {
+        let Some(rec) = self.rec.clone() else { return Ok(()) };
+        if self.times.is_empty() {
+            return Ok(());
+        }
+        let e = |err: rerun::RecordingStreamError| self.err(err);
+        let time = || TimeColumn::new_duration_secs(TIMELINE, self.times.iter().copied());
+        let scalars = |values: &[f64]| rerun::Scalars::new(values.iter().copied()).columns_of_unit_batches();
+        for (j, name) in self.joint_names.iter().enumerate() {
+            let c = &self.joints[j];
+            let base = format!("joints/{name}");
+            for (leaf, values) in [
+                ("angle", &c.angle),
+                ("target", &c.target),
+                ("error", &c.error),
+                ("torque", &c.torque),
+                ("gravity_torque", &c.gravity_torque),
+                ("saturated", &c.saturated),
+            ] {
+                rec.send_columns(format!("{base}/{leaf}"), [time()], scalars(values).map_err(|x| self.err(x))?).map_err(e)?;
+            }
+            if !c.saturated_times.is_empty() {
+                rec.send_columns(
+                    format!("{base}/saturated_torque"),
+                    [TimeColumn::new_duration_secs(TIMELINE, c.saturated_times.iter().copied())],
+                    scalars(&c.saturated_torque).map_err(|x| self.err(x))?,
+                )
+                .map_err(e)?;
+            }
+            // the limits as lines spanning the block: two points each
+            let ends = [self.times[0], *self.times.last().unwrap()];
+            for (side, value) in [("upper", self.effort[j]), ("lower", -self.effort[j])] {
+                if value.is_finite() {
+                    rec.send_columns(
+                        format!("{base}/torque_limit/{side}"),
+                        [TimeColumn::new_duration_secs(TIMELINE, ends)],
+                        scalars(&[value, value]).map_err(|x| self.err(x))?,
+                    )
+                    .map_err(e)?;
+                }
+            }
+        }
+        for (axis, values) in ["x", "y", "z"].iter().zip(&self.tool) {
+            rec.send_columns(format!("tool/{axis}"), [time()], scalars(values).map_err(|x| self.err(x))?).map_err(e)?;
+        }
+        rec.send_columns(
+            "world/tool/tip",
+            [time()],
+            rerun::Points3D::update_fields()
+                .with_positions(self.tool_points.iter().copied())
+                .columns_of_unit_batches()
+                .map_err(|x| self.err(x))?,
+        )
+        .map_err(e)?;
+        for link in &self.links {
+            rec.send_columns(
+                link.entity.as_str(),
+                [time()],
+                rerun::Transform3D::update_fields()
+                    .with_many_translation(link.translations.iter().copied())
+                    .with_many_quaternion(link.rotations.iter().copied())
+                    .columns_of_unit_batches()
+                    .map_err(|x| self.err(x))?,
+            )
+            .map_err(e)?;
+        }
+        self.times.clear();
+        for j in &mut self.joints {
+            j.clear();
+        }
+        for t in &mut self.tool {
+            t.clear();
+        }
+        self.tool_points.clear();
+        for link in &mut self.links {
+            link.translations.clear();
+            link.rotations.clear();
+        }
+        if self.live {
+            let _ = rec.flush_async();
+        }
+        self.last_flush = Instant::now();
+        Ok(())
+    }
+}
+
+fn viewer_reachable(url: &str) -> Result<rerun::external::re_uri::ProxyUri, String> {
+    let uri: rerun::external::re_uri::RedapUri = url.parse().map_err(|e| format!("{e}"))?;
+    let rerun::external::re_uri::RedapUri::Proxy(proxy) = uri else {
+        return Err("not a proxy URL like rerun+http://HOST:PORT/proxy".into());
+    };
+    let origin = &proxy.origin;
+    let address = format!("{}:{}", origin.host, origin.port);
+    let addrs = std::net::ToSocketAddrs::to_socket_addrs(&address).map_err(|e| e.to_string())?;
+    for a in addrs {
+        if std::net::TcpStream::connect_timeout(&a, Duration::from_millis(500)).is_ok() {
+            return Ok(proxy);
+        }
+    }
+    Err("connection refused".into())
+}
+
+fn link_entity(name: &str) -> String {
+    format!("world/robot/{name}")
+}
+
+fn transform(pose: &Pose) -> rerun::Transform3D {
+    let t = pose.translation;
+    rerun::Transform3D::from_translation_mat3x3([t.x as f32, t.y as f32, t.z as f32], mat3(pose))
+}
+
+fn quaternion(pose: &Pose) -> rerun::Quaternion {
+    let q = nalgebra::UnitQuaternion::from_rotation_matrix(&nalgebra::Rotation3::from_matrix_unchecked(pose.rotation));
+    rerun::Quaternion::from_xyzw([q.i as f32, q.j as f32, q.k as f32, q.w as f32])
+}
+
+fn mat3(pose: &Pose) -> rerun::components::TransformMat3x3 {
+    let m = pose.rotation.as_slice(); // column-major, as Rerun's Mat3x3
+    let mut cols = [0f32; 9];
+    for (c, v) in cols.iter_mut().zip(m) {
+        *c = *v as f32;
+    }
+    rerun::components::TransformMat3x3::from(rerun::datatypes::Mat3x3(cols))
+}
+
+pub fn joint_color(j: usize) -> rerun::Color {
+    const PALETTE: [(u8, u8, u8); 8] = [(31, 119, 180), (255, 127, 14), (44, 160, 44), (214, 39, 40), (148, 103, 189), (140, 86, 75), (227, 119, 194), (23, 190, 207)];
+    let (r, g, b) = PALETTE[j % PALETTE.len()];
+    rerun::Color::from_rgb(r, g, b)
+}
+
+/// The layout the file opens to: the arm in 3D with the tool's position below it, and per joint
+/// its angle against the target and its torque against the motor's limits, saturated steps marked.
+pub fn blueprint(joint_names: &[String], prefix: &str) -> Blueprint {
+    let angle_views = joint_names.iter().map(|j| {
+        TimeSeriesView::new(format!("{j} angle vs target"))
+            .with_origin(format!("{prefix}joints/{j}"))
+            .with_contents(["$origin/angle", "$origin/target"])
+            .into()
+    });
+    let torque_views = joint_names.iter().map(|j| {
+        TimeSeriesView::new(format!("{j} torque vs ±limit"))
+            .with_origin(format!("{prefix}joints/{j}"))
+            .with_contents(["$origin/torque", "$origin/torque_limit/**", "$origin/saturated_torque"])
+            .into()
+    });
+    let columns = joint_names.len().div_ceil(2).clamp(1, 4) as u32;
+    let left = Vertical::new([
+        Spatial3DView::new("arm").with_origin(format!("{prefix}world")).into(),
+        TimeSeriesView::new("tool position").with_origin(format!("{prefix}tool")).into(),
+    ])
+    .with_row_shares([3.0, 1.0]);
+    let right = Vertical::new([
+        Grid::new(angle_views).with_grid_columns(columns).with_name("joint angles").into(),
+        Grid::new(torque_views).with_grid_columns(columns).with_name("joint torques").into(),
+    ]);
+    Blueprint::new(Horizontal::new([left.into(), right.into()]).with_column_shares([2.0, 3.0]))
+        .with_time_panel(TimePanel::new().with_timeline(TIMELINE).with_play_state(PlayState::Following).with_state(PanelState::Collapsed))
+        .with_selection_panel(SelectionPanel::new().with_state(PanelState::Collapsed))
+        .with_blueprint_panel(BlueprintPanel::new().with_state(PanelState::Collapsed))
+}
+
+/// The run's configuration as Markdown, for the recording.
+pub fn config_markdown(run: &RunInfo) -> String {
+    let e = run.experiment;
+    let m = &e.model;
+    format!(
+        "# armscope run\n\n* model: **{}** (`{}`), {} dof, gravity ({}, {}, {}) m/s²\n* plant: {}\n* command: {}\n* controller: PD{}, control period {} ms\n* gains ({}): kp = {:?}, kd = {:?}\n* duration: {} s ({} steps)\n\n```json\n{}\n```\n",
+        m.name,
+        m.source.display(),
+        m.dof(),
+        m.gravity.x,
+        m.gravity.y,
+        m.gravity.z,
+        run.plant,
+        run.trajectory,
+        if e.config.no_ff { " without gravity feed-forward" } else { " + gravity feed-forward" },
+        e.config.dt * 1e3,
+        e.gains.source,
+        e.gains.kp,
+        e.gains.kd,
+        e.config.duration,
+        e.steps,
+        serde_json::to_string_pretty(&e.config).unwrap_or_default()
+    )
+}
+
+pub fn summary_markdown(summary: &Summary) -> String {
+    let mut text = Vec::new();
+    let _ = super::console::write_summary(&mut text, summary);
+    format!("# summary\n\n```\n{}\n```\n\n```json\n{}\n```\n", String::from_utf8_lossy(&text).trim(), serde_json::to_string_pretty(summary).unwrap_or_default())
+}
+
+/// The tool positions the command asks for (forward kinematics of the command), every 10 ms.
+fn commanded_path(run: &RunInfo) -> Vec<[f32; 3]> {
+    let e = run.experiment;
+    let model = &*e.model;
+    let n = model.dof();
+    let mut data = Data::new(model);
+    let (mut cmd, mut cmd_dot) = (vec![0.0; n], vec![0.0; n]);
+    let samples = (e.config.duration / 0.01).ceil() as usize;
+    (0..=samples)
+        .map(|i| {
+            e.trajectory.sample((i as f64 * 0.01).min(e.config.duration), &mut cmd, &mut cmd_dot);
+            forward_kinematics(model, &mut data, &cmd);
+            let p = frame_pose(model, &data, model.tool_frame).translation;
+            [p.x as f32, p.y as f32, p.z as f32]
+        })
+        .collect()
+}
+
+impl Recorder for RerunRecorder {
+    fn start(&mut self, run: &RunInfo) -> Result<(), Error> {
+        let e = run.experiment;
+        let model = &*e.model;
+        let rec = self.open_stream()?;
+        self.joint_names = model.joints.iter().map(|j| j.name.clone()).collect();
+        self.effort = e.controller().effort;
+        self.block_steps = FILE_BLOCK_STEPS;
+        let cap = self.block_steps + 1;
+        self.times = Vec::with_capacity(cap);
+        self.joints = (0..model.dof()).map(|_| JointColumns::with_capacity(cap)).collect();
+        self.tool = [Vec::with_capacity(cap), Vec::with_capacity(cap), Vec::with_capacity(cap)];
+        self.links = model
+            .frames
+            .iter()
+            .enumerate()
+            .filter(|(_, f)| f.body.is_some())
+            .map(|(_, f)| MovingLink { body: f.body.expect("filtered"), placement: f.placement, entity: link_entity(&f.name), translations: Vec::with_capacity(cap), rotations: Vec::with_capacity(cap) })
+            .collect();
+        self.steps_per_trail_point = ((1.0 / TRAIL_RATE_HZ) / e.config.dt).round().max(1.0) as usize;
+
+        blueprint(&self.joint_names, "").send(&rec, BlueprintActivation { make_active: true, make_default: true }).map_err(|x| self.err(x))?;
+        let mut data = Data::new(model);
+        let (q0, _) = e.initial_state();
+        forward_kinematics(model, &mut data, &q0);
+        self.log_static_scene(&rec, model, &data)?;
+        self.log_series_styles(&rec)?;
+        rec.log_static("config", &rerun::TextDocument::from_markdown(config_markdown(run))).map_err(|x| self.err(x))?;
+        let commanded = commanded_path(run);
+        let spread = commanded.iter().any(|p| (0..3).any(|a| (p[a] - commanded[0][a]).abs() > 1e-4));
+        if spread {
+            rec.log_static(
+                "world/tool/commanded_path",
+                &rerun::LineStrips3D::new([commanded]).with_colors([rerun::Color::from_rgb(120, 120, 120)]).with_radii([0.0015]),
+            )
+            .map_err(|x| self.err(x))?;
+        }
+        rec.log_static(
+            "world/tool/tip",
+            &rerun::Points3D::update_fields().with_radii([0.006]).with_colors([rerun::Color::from_rgb(230, 40, 40)]),
+        )
+        .map_err(|x| self.err(x))?;
+        self.rec = Some(rec);
+        self.last_flush = Instant::now();
+        Ok(())
+    }
+
+    fn record(&mut self, s: &Sample) -> Result<(), Error> {
+        self.times.push(s.t);
+        for (j, c) in self.joints.iter_mut().enumerate() {
+            c.angle.push(s.q[j]);
+            c.target.push(s.cmd[j]);
+            c.error.push(s.cmd[j] - s.q[j]);
+            c.torque.push(s.u[j]);
+            c.gravity_torque.push(s.tau_g[j]);
+            c.saturated.push(if s.saturated[j] { 1.0 } else { 0.0 });
+            if s.saturated[j] {
+                c.saturated_times.push(s.t);
+                c.saturated_torque.push(s.u[j]);
+            }
+        }
+        let p = s.tool_position;
+        for a in 0..3 {
+            self.tool[a].push(p[a]);
+        }
+        let tip = [p.x as f32, p.y as f32, p.z as f32];
+        self.tool_points.push(tip);
+        for link in &mut self.links {
+            let pose = s.body_pose[link.body].compose(&link.placement);
+            let t = pose.translation;
+            link.translations.push([t.x as f32, t.y as f32, t.z as f32]);
+            link.rotations.push(quaternion(&pose));
+        }
+        self.last_t = s.t;
+        if s.k % self.steps_per_trail_point == 0 {
+            self.trail.push_back(tip);
+            let keep = (TRAIL_SECONDS * TRAIL_RATE_HZ) as usize;
+            while self.trail.len() > keep {
+                self.trail.pop_front();
+            }
+            self.path.push(tip);
+            if let Some(rec) = &self.rec {
+                rec.set_duration_secs(TIMELINE, s.t);
+                rec.log("world/tool/trail", &rerun::LineStrips3D::new([self.trail.iter().copied().collect::<Vec<_>>()]).with_colors([rerun::Color::from_rgb(230, 60, 60)]).with_radii([0.002]))
+                    .map_err(|x| self.err(x))?;
+            }
+        }
+        let due = self.times.len() >= self.block_steps || (self.live && self.last_flush.elapsed() >= LIVE_FLUSH) || s.is_final;
+        if due {
+            self.flush_block()?;
+        }
+        Ok(())
+    }
+
+    fn finish(&mut self, _run: &RunInfo, summary: &Summary) -> Result<(), Error> {
+        self.flush_block()?;
+        let Some(rec) = self.rec.take() else { return Ok(()) };
+        if self.path.len() > 1 {
+            rec.log_static("world/tool/path", &rerun::LineStrips3D::new([self.path.clone()]).with_colors([rerun::Color::from_rgb(230, 60, 60)]).with_radii([0.001]))
+                .map_err(|x| self.err(x))?;
+        }
+        rec.log_static("summary", &rerun::TextDocument::from_markdown(summary_markdown(summary))).map_err(|x| self.err(x))?;
+        rec.flush_blocking().map_err(|x| self.err(x))?;
+        drop(rec);
+        Ok(())
+    }
+}

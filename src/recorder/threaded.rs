@@ -1,0 +1,207 @@
+use super::{Recorder, RunInfo};
+use crate::error::Error;
+use crate::sample::Sample;
+use crate::spatial::Pose;
+use crate::summary::Summary;
+use nalgebra::Vector3;
+use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
+
+/// Runs a recorder on its own thread: the simulation loop only copies each sample into a block,
+/// and the recorder encodes and writes on another core. `start` and `finish` run on the caller's
+/// thread (they need the run's configuration); `record` runs on the worker, in order.
+pub struct Threaded<R: Recorder + Send + 'static> {
+    inner: Option<R>,
+    block: SampleBlock,
+    tx: Option<SyncSender<SampleBlock>>,
+    recycled: Option<Receiver<SampleBlock>>,
+    worker: Option<JoinHandle<(R, Result<(), Error>)>>,
+    last_send: Instant,
+    block_samples: usize,
+    max_latency: Duration,
+}
+
+/// Samples copied out of the loop's buffers, stored flat.
+struct SampleBlock {
+    n: usize,
+    bodies: usize,
+    k: Vec<usize>,
+    t: Vec<f64>,
+    is_final: Vec<bool>,
+    q: Vec<f64>,
+    v: Vec<f64>,
+    cmd: Vec<f64>,
+    cmd_dot: Vec<f64>,
+    u: Vec<f64>,
+    tau_g: Vec<f64>,
+    saturated: Vec<bool>,
+    at_limit: Vec<bool>,
+    tool: Vec<Vector3<f64>>,
+    body_pose: Vec<Pose>,
+}
+
+impl SampleBlock {
+    fn new(n: usize, bodies: usize, capacity: usize) -> Self {
+        let f = || Vec::with_capacity(capacity * n);
+        Self {
+            n,
+            bodies,
+            k: Vec::with_capacity(capacity),
+            t: Vec::with_capacity(capacity),
+            is_final: Vec::with_capacity(capacity),
+            q: f(),
+            v: f(),
+            cmd: f(),
+            cmd_dot: f(),
+            u: f(),
+            tau_g: f(),
+            saturated: Vec::with_capacity(capacity * n),
+            at_limit: Vec::with_capacity(capacity * n),
+            tool: Vec::with_capacity(capacity),
+            body_pose: Vec::with_capacity(capacity * bodies),
+        }
+    }
+
+    fn len(&self) -> usize {
+        self.k.len()
+    }
+
+    fn clear(&mut self) {
+        self.k.clear();
+        self.t.clear();
+        self.is_final.clear();
+        for v in [&mut self.q, &mut self.v, &mut self.cmd, &mut self.cmd_dot, &mut self.u, &mut self.tau_g] {
+            v.clear();
+        }
+        self.saturated.clear();
+        self.at_limit.clear();
+        self.tool.clear();
+        self.body_pose.clear();
+    }
+
+    fn push(&mut self, s: &Sample) {
+        self.k.push(s.k);
+        self.t.push(s.t);
+        self.is_final.push(s.is_final);
+        self.q.extend_from_slice(s.q);
+        self.v.extend_from_slice(s.v);
+        self.cmd.extend_from_slice(s.cmd);
+        self.cmd_dot.extend_from_slice(s.cmd_dot);
+        self.u.extend_from_slice(s.u);
+        self.tau_g.extend_from_slice(s.tau_g);
+        self.saturated.extend_from_slice(s.saturated);
+        self.at_limit.extend_from_slice(s.at_limit);
+        self.tool.push(s.tool_position);
+        self.body_pose.extend_from_slice(s.body_pose);
+    }
+
+    fn sample(&self, i: usize) -> Sample<'_> {
+        let (a, b) = (i * self.n, (i + 1) * self.n);
+        Sample {
+            k: self.k[i],
+            t: self.t[i],
+            is_final: self.is_final[i],
+            q: &self.q[a..b],
+            v: &self.v[a..b],
+            cmd: &self.cmd[a..b],
+            cmd_dot: &self.cmd_dot[a..b],
+            u: &self.u[a..b],
+            tau_g: &self.tau_g[a..b],
+            saturated: &self.saturated[a..b],
+            at_limit: &self.at_limit[a..b],
+            tool_position: self.tool[i],
+            body_pose: &self.body_pose[i * self.bodies..(i + 1) * self.bodies],
+        }
+    }
+}
+
+impl<R: Recorder + Send + 'static> Threaded<R> {
+    /// `max_latency`: a block is handed over at least this often (for live viewers).
+    pub fn new(inner: R, max_latency: Duration) -> Self {
+        Self {
+            inner: Some(inner),
+            block: SampleBlock::new(0, 0, 0),
+            tx: None,
+            recycled: None,
+            worker: None,
+            last_send: Instant::now(),
+            block_samples: 250,
+            max_latency,
+        }
+    }
+
+    fn send_block(&mut self) -> Result<(), Error> {
+        let Some(tx) = &self.tx else { return Ok(()) };
+        if self.block.len() == 0 {
+            return Ok(());
+        }
+        let fresh = match self.recycled.as_ref().and_then(|r| r.try_recv().ok()) {
+            Some(mut b) => {
+                b.clear();
+                b
+            }
+            None => SampleBlock::new(self.block.n, self.block.bodies, self.block_samples),
+        };
+        let full = std::mem::replace(&mut self.block, fresh);
+        self.last_send = Instant::now();
+        if tx.send(full).is_err() {
+            // the worker stopped on an error: report it
+            return self.join().map(|_| ());
+        }
+        Ok(())
+    }
+
+    fn join(&mut self) -> Result<(), Error> {
+        self.tx = None;
+        if let Some(worker) = self.worker.take() {
+            let (inner, result) = worker.join().expect("recorder thread panicked");
+            self.inner = Some(inner);
+            result?;
+        }
+        Ok(())
+    }
+}
+
+impl<R: Recorder + Send + 'static> Recorder for Threaded<R> {
+    fn start(&mut self, run: &RunInfo) -> Result<(), Error> {
+        let mut inner = self.inner.take().expect("started once");
+        inner.start(run)?;
+        let model = &run.experiment.model;
+        self.block = SampleBlock::new(model.dof(), model.dof(), self.block_samples);
+        let (tx, rx) = sync_channel::<SampleBlock>(4);
+        let (back_tx, back_rx) = sync_channel::<SampleBlock>(4);
+        self.tx = Some(tx);
+        self.recycled = Some(back_rx);
+        self.worker = Some(std::thread::spawn(move || {
+            for block in rx {
+                for i in 0..block.len() {
+                    if let Err(e) = inner.record(&block.sample(i)) {
+                        return (inner, Err(e));
+                    }
+                }
+                let _ = back_tx.try_send(block);
+            }
+            (inner, Ok(()))
+        }));
+        self.last_send = Instant::now();
+        Ok(())
+    }
+
+    fn record(&mut self, s: &Sample) -> Result<(), Error> {
+        self.block.push(s);
+        if self.block.len() >= self.block_samples || s.is_final || self.last_send.elapsed() >= self.max_latency {
+            self.send_block()?;
+        }
+        Ok(())
+    }
+
+    fn finish(&mut self, run: &RunInfo, summary: &Summary) -> Result<(), Error> {
+        self.send_block()?;
+        self.join()?;
+        match self.inner.as_mut() {
+            Some(inner) => inner.finish(run, summary),
+            None => Ok(()),
+        }
+    }
+}

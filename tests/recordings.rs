@@ -1,0 +1,271 @@
+//! Recordings read back by readers independent of the code that wrote them: the `.mcap` through
+//! the mcap crate (JSON through serde_json, protobuf through the official Foxglove types), the
+//! `.rrd` through the Python rerun-sdk 0.36.3 of `../shared/viewers` (installed by its setup.sh),
+//! compared value by value with the run's own per-step trace.
+
+mod common;
+
+use common::{Table, read_csv, repo};
+use foxglove::messages::{FrameTransforms, JointStates, PoseInFrame};
+use prost::Message as _;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn kit(script: &str) -> PathBuf {
+    repo().join("../shared/viewers").join(script)
+}
+
+fn viewers_home() -> PathBuf {
+    std::env::var_os("VIEWERS_HOME").map(PathBuf::from).unwrap_or_else(|| PathBuf::from(std::env::var("HOME").unwrap()).join(".cache/armscope-viewers"))
+}
+
+/// Run the armscope binary; returns (exit code, stdout, stderr).
+fn armscope(args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_armscope")).args(args).current_dir(repo()).output().unwrap();
+    (out.status.code().unwrap_or(-1), String::from_utf8_lossy(&out.stdout).into(), String::from_utf8_lossy(&out.stderr).into())
+}
+
+struct Run {
+    _dir: tempfile::TempDir,
+    rrd: PathBuf,
+    mcap: PathBuf,
+    trace: Table,
+}
+
+fn record(extra: &[&str]) -> Run {
+    let dir = tempfile::tempdir().unwrap();
+    let (rrd, mcap, trace) = (dir.path().join("run.rrd"), dir.path().join("run.mcap"), dir.path().join("trace.csv"));
+    let mut args = vec!["run", "--quiet", "--rrd", rrd.to_str().unwrap(), "--mcap", mcap.to_str().unwrap(), "--trace", trace.to_str().unwrap()];
+    args.extend_from_slice(extra);
+    let (code, _, err) = armscope(&args);
+    assert_eq!(code, 0, "{err}");
+    Run { trace: read_csv(&trace), rrd, mcap, _dir: dir }
+}
+
+/// Every message of the file, by topic: (log time ns, schema name, encoding, payload).
+fn mcap_messages(path: &Path) -> BTreeMap<String, Vec<(u64, String, String, Vec<u8>)>> {
+    let bytes = std::fs::read(path).unwrap();
+    let mut by_topic: BTreeMap<String, Vec<_>> = BTreeMap::new();
+    for m in mcap::MessageStream::new(&bytes).unwrap() {
+        let m = m.expect("readable message");
+        let schema = m.channel.schema.as_ref().map_or(String::new(), |s| s.name.clone());
+        by_topic.entry(m.channel.topic.clone()).or_default().push((m.log_time, schema, m.channel.message_encoding.clone(), m.data.to_vec()));
+    }
+    by_topic
+}
+
+fn col(trace: &Table, prefix: &str, j: usize) -> Vec<f64> {
+    trace.column(&format!("{prefix}{}", j + 1))
+}
+
+#[test]
+fn mcap_has_the_channels_schemas_and_per_step_messages_and_equals_the_trace() {
+    let run = record(&["--duration", "1.5", "--no-rrd"]);
+    let steps = run.trace.rows.len();
+    assert_eq!(steps, 1501);
+    let topics = mcap_messages(&run.mcap);
+    let expect = [
+        ("/tf", "foxglove.FrameTransforms", "protobuf", Some(steps)),
+        ("/joint_states", "foxglove.JointStates", "protobuf", Some(steps)),
+        ("/controller", "armscope::recorder::mcap::ControllerTelemetry", "json", Some(steps)),
+        ("/tool/pose", "foxglove.PoseInFrame", "protobuf", Some(steps)),
+        ("/robot/geometry", "foxglove.SceneUpdate", "protobuf", None),
+        ("/tool/path", "foxglove.SceneUpdate", "protobuf", None),
+        ("/tool/commanded_path", "foxglove.SceneUpdate", "protobuf", Some(1)),
+        ("/robot_description", "armscope::recorder::mcap::RobotDescription", "json", Some(1)),
+    ];
+    for (topic, schema, encoding, count) in expect {
+        let msgs = topics.get(topic).unwrap_or_else(|| panic!("no {topic}"));
+        assert_eq!(msgs[0].1, schema, "{topic} schema");
+        assert_eq!(msgs[0].2, encoding, "{topic} encoding");
+        // the per-step topics carry one message per step (/tf has the fixed joints once a second on top)
+        if let Some(n) = count {
+            let per_step = if topic == "/tf" { msgs.iter().filter(|m| FrameTransforms::decode(&m.3[..]).unwrap().transforms.len() == 6).count() } else { msgs.len() };
+            assert_eq!(per_step, n, "{topic} messages");
+        }
+    }
+    // timestamps: start time + simulation time, exactly one control period apart
+    let controller = &topics["/controller"];
+    let t0 = controller[0].0;
+    for (k, m) in controller.iter().enumerate() {
+        assert_eq!(m.0 - t0, k as u64 * 1_000_000, "log time of step {k}");
+    }
+    // decoded values equal the trace
+    for (k, m) in controller.iter().enumerate() {
+        let v: serde_json::Value = serde_json::from_slice(&m.3).unwrap();
+        assert_eq!(v["time"].as_f64().unwrap(), run.trace.rows[k][0]);
+        for j in 0..6 {
+            let get = |field: &str| v[field][j].as_f64().unwrap();
+            assert_eq!(get("target"), col(&run.trace, "cmd", j)[k], "target J{} step {k}", j + 1);
+            assert_eq!(get("torque"), col(&run.trace, "u", j)[k]);
+            assert_eq!(get("tau_g"), col(&run.trace, "tau_g", j)[k]);
+            assert_eq!(get("error"), col(&run.trace, "cmd", j)[k] - col(&run.trace, "q", j)[k]);
+            let effort = [8.0, 12.0, 8.0, 5.0, 3.0, 1.5][j];
+            assert_eq!(get("saturated") == 1.0, col(&run.trace, "u", j)[k].abs() == effort);
+        }
+    }
+    for (k, m) in topics["/joint_states"].iter().enumerate() {
+        let js = JointStates::decode(&m.3[..]).unwrap();
+        assert_eq!(js.joints.iter().map(|j| j.name.as_str()).collect::<Vec<_>>(), ["J1", "J2", "J3", "J4", "J5", "J6"]);
+        for (j, state) in js.joints.iter().enumerate() {
+            assert_eq!(state.position, Some(col(&run.trace, "q", j)[k]));
+            assert_eq!(state.velocity, Some(col(&run.trace, "qd", j)[k]));
+            assert_eq!(state.effort, Some(col(&run.trace, "u", j)[k]));
+        }
+    }
+    for (k, m) in topics["/tool/pose"].iter().enumerate() {
+        let p = PoseInFrame::decode(&m.3[..]).unwrap().pose.unwrap().position.unwrap();
+        for (got, name) in [(p.x, "x"), (p.y, "y"), (p.z, "z")] {
+            assert_eq!(got, run.trace.rows[k][run.trace.col(name)], "tool {name} step {k}");
+        }
+    }
+    // chaining /tf from world to tool_link reproduces the tool position (the transforms are right)
+    let fixed = FrameTransforms::decode(&topics["/tf"].iter().find(|m| FrameTransforms::decode(&m.3[..]).unwrap().transforms.len() != 6).unwrap().3[..]).unwrap();
+    assert_eq!(fixed.transforms[0].parent_frame_id, "world");
+    assert_eq!(fixed.transforms[0].child_frame_id, "base_link");
+    let last = topics["/tf"].iter().rev().find(|m| FrameTransforms::decode(&m.3[..]).unwrap().transforms.len() == 6).unwrap();
+    let tf = FrameTransforms::decode(&last.3[..]).unwrap();
+    let chain: Vec<(&str, &str)> = tf.transforms.iter().map(|t| (t.parent_frame_id.as_str(), t.child_frame_id.as_str())).collect();
+    assert_eq!(chain, [("base_link", "carrier_link"), ("carrier_link", "upper_arm_link"), ("upper_arm_link", "forearm_link"), ("forearm_link", "wrist1_link"), ("wrist1_link", "wrist2_link"), ("wrist2_link", "tool_link")]);
+    let mut pose = nalgebra::Isometry3::identity();
+    for t in &tf.transforms {
+        let (tr, r) = (t.translation.unwrap(), t.rotation.unwrap());
+        let q = nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(r.w, r.x, r.y, r.z));
+        pose *= nalgebra::Isometry3::from_parts(nalgebra::Translation3::new(tr.x, tr.y, tr.z), q);
+    }
+    let k = run.trace.rows.len() - 1;
+    for (a, name) in ["x", "y", "z"].iter().enumerate() {
+        let want = run.trace.rows[k][run.trace.col(name)];
+        assert!((pose.translation.vector[a] - want).abs() < 1e-12, "tf chain {name}: {} vs {want}", pose.translation.vector[a]);
+    }
+    // zstd chunks; configuration and summary as metadata
+    let bytes = std::fs::read(&run.mcap).unwrap();
+    let summary = mcap::Summary::read(&bytes).unwrap().expect("summary section");
+    assert!(!summary.chunk_indexes.is_empty());
+    assert!(summary.chunk_indexes.iter().all(|c| c.compression == "zstd"));
+    let names: Vec<String> = summary.metadata_indexes.iter().map(|m| m.name.clone()).collect();
+    assert_eq!(names, ["armscope.config", "armscope.summary"]);
+    let config = mcap::read::metadata(&bytes, &summary.metadata_indexes[0]).unwrap();
+    assert!(config.metadata["start_time_unix_ns"].parse::<u64>().unwrap() == t0);
+    assert!(config.metadata["config"].contains("\"duration\":1.5"));
+    let done = mcap::read::metadata(&bytes, &summary.metadata_indexes[1]).unwrap();
+    assert!(done.metadata["summary"].contains("\"saturation_percent\""));
+}
+
+fn rrd_series(rrd: &Path, entity: &str) -> Vec<(f64, f64)> {
+    let out = tempfile::NamedTempFile::new().unwrap();
+    let status = Command::new("bash")
+        .arg(kit("rrd-query.sh"))
+        .args([rrd.to_str().unwrap(), "--entity", entity, "--timeline", "sim_time", "--out", out.path().to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(status.status.success(), "rrd-query {entity}: {}", String::from_utf8_lossy(&status.stderr));
+    read_csv(out.path()).rows.iter().map(|r| (r[0], r[1])).collect()
+}
+
+#[test]
+fn rrd_holds_every_joint_series_with_one_row_per_step_equal_to_the_trace() {
+    let run = record(&["--duration", "1.2", "--no-mcap"]);
+    let steps = run.trace.rows.len();
+    let t = run.trace.column("t");
+    for j in 0..6 {
+        let name = format!("J{}", j + 1);
+        let (q, cmd, u, tau_g) = (col(&run.trace, "q", j), col(&run.trace, "cmd", j), col(&run.trace, "u", j), col(&run.trace, "tau_g", j));
+        let effort = [8.0, 12.0, 8.0, 5.0, 3.0, 1.5][j];
+        let expected: [(&str, Vec<f64>); 6] = [
+            ("angle", q.clone()),
+            ("target", cmd.clone()),
+            ("error", cmd.iter().zip(&q).map(|(c, q)| c - q).collect()),
+            ("torque", u.clone()),
+            ("gravity_torque", tau_g),
+            ("saturated", u.iter().map(|u| if u.abs() == effort { 1.0 } else { 0.0 }).collect()),
+        ];
+        for (leaf, want) in expected {
+            let got = rrd_series(&run.rrd, &format!("/joints/{name}/{leaf}"));
+            assert_eq!(got.len(), steps, "{name}/{leaf}: one row per step");
+            for (k, (time, value)) in got.iter().enumerate() {
+                assert!((time - t[k]).abs() < 1e-9, "{name}/{leaf} time {time} vs {}", t[k]);
+                assert_eq!(*value, want[k], "{name}/{leaf} at step {k}");
+            }
+        }
+    }
+    for axis in ["x", "y", "z"] {
+        let got = rrd_series(&run.rrd, &format!("/tool/{axis}"));
+        assert_eq!(got.iter().map(|r| r.1).collect::<Vec<_>>(), run.trace.column(axis), "tool {axis}");
+    }
+}
+
+#[test]
+fn rrd_has_the_3d_scene_configuration_summary_and_blueprint_and_passes_rerun_verify() {
+    let run = record(&["--duration", "0.5", "--no-mcap"]);
+    let out = Command::new("bash").arg(kit("rrd-query.sh")).args([run.rrd.to_str().unwrap(), "--json"]).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8_lossy(&out.stdout);
+    for entity in ["/config", "/summary", "/world/robot/upper_arm_link", "/world/robot/upper_arm_link/visual_0", "/world/tool/tip", "/world/tool/trail", "/world/tool/commanded_path", "/world/tool/path"] {
+        assert!(text.contains(&format!("\"{entity}\"")), "entity {entity} missing from the recording");
+    }
+    let listing = Command::new("bash").arg(kit("rrd-query.sh")).arg(run.rrd.to_str().unwrap()).output().unwrap();
+    let listing = String::from_utf8_lossy(&listing.stdout);
+    assert!(listing.contains("blueprints in file: 1"), "{listing}");
+    assert!(listing.contains("Boxes3D:half_sizes"), "link geometry");
+    let rerun = viewers_home().join("bin/rerun");
+    let verify = Command::new(&rerun).args(["rrd", "verify", run.rrd.to_str().unwrap()]).output().expect("rerun CLI from the viewers kit");
+    assert!(verify.status.success(), "rerun rrd verify: {}{}", String::from_utf8_lossy(&verify.stdout), String::from_utf8_lossy(&verify.stderr));
+}
+
+#[test]
+fn an_interrupted_run_leaves_both_files_readable_up_to_that_point() {
+    let dir = tempfile::tempdir().unwrap();
+    let (rrd, mcap) = (dir.path().join("cut.rrd"), dir.path().join("cut.mcap"));
+    // paced to real time so that it is still running when interrupted
+    let mut child = Command::new(env!("CARGO_BIN_EXE_armscope"))
+        .args(["run", "--quiet", "--duration", "30", "--realtime", "1", "--rrd", rrd.to_str().unwrap(), "--mcap", mcap.to_str().unwrap()])
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    assert!(Command::new("kill").args(["-INT", &child.id().to_string()]).status().unwrap().success());
+    let status = child.wait().unwrap();
+    assert_eq!(status.code(), Some(130), "interrupted runs exit with 130");
+    let topics = mcap_messages(&mcap);
+    let n = topics["/controller"].len();
+    assert!(n > 500 && n < 10_000, "{n} steps recorded before the interrupt");
+    let bytes = std::fs::read(&mcap).unwrap();
+    let summary = mcap::Summary::read(&bytes).unwrap().expect("the MCAP was closed properly");
+    let done = mcap::read::metadata(&bytes, &summary.metadata_indexes[1]).unwrap();
+    assert!(done.metadata["status"].contains("interrupted"));
+    let rows = rrd_series(&rrd, "/joints/J2/angle");
+    assert_eq!(rows.len(), n, "the .rrd holds the same steps as the .mcap");
+    let verify = Command::new(viewers_home().join("bin/rerun")).args(["rrd", "verify", rrd.to_str().unwrap()]).output().unwrap();
+    assert!(verify.status.success(), "{}", String::from_utf8_lossy(&verify.stderr));
+}
+
+#[test]
+fn no_viewer_listening_is_reported_and_the_files_are_still_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let (rrd, mcap) = (dir.path().join("a.rrd"), dir.path().join("a.mcap"));
+    let (code, _, err) = armscope(&["run", "--quiet", "--duration", "0.2", "--connect", "rerun+http://127.0.0.1:9/proxy", "--rrd", rrd.to_str().unwrap(), "--mcap", mcap.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    assert!(err.contains("no Rerun viewer at rerun+http://127.0.0.1:9/proxy"), "{err}");
+    assert!(rrd.metadata().unwrap().len() > 0 && mcap.metadata().unwrap().len() > 0);
+    // --spawn with no viewer on the PATH
+    let out = Command::new(env!("CARGO_BIN_EXE_armscope"))
+        .args(["run", "--quiet", "--duration", "0.2", "--spawn", "--rrd", rrd.to_str().unwrap(), "--no-mcap"])
+        .current_dir(repo())
+        .env("PATH", "/nonexistent")
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    assert!(err.contains("could not start the Rerun viewer") && err.contains("install"), "{err}");
+    assert_eq!(rrd_series(&rrd, "/joints/J1/angle").len(), 201);
+}
+
+#[test]
+fn a_run_prints_where_its_recordings_are_and_how_to_open_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let rrd = dir.path().join("x.rrd");
+    let (code, out, _) = armscope(&["run", "--duration", "0.1", "--rrd", rrd.to_str().unwrap(), "--no-mcap"]);
+    assert_eq!(code, 0);
+    assert!(out.contains(&format!("open in Rerun: rerun {}", rrd.display())), "{out}");
+}
