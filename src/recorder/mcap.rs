@@ -1,6 +1,9 @@
 //! MCAP recorder for Foxglove: joint transforms, link geometry, joint states, controller telemetry,
 //! the tool's pose and path, the URDF, and the run's configuration and summary as metadata.
 //! Timestamps are simulation time offset by the wall-clock start of the run (in the metadata).
+//!
+//! The foxglove SDK provides the well-known schemas and their encoders; the mcap crate writes the
+//! file directly (the SDK's sink machinery costs more per message than the encoding itself).
 
 use super::{Recorder, RunInfo};
 use crate::dynamics::{Data, forward_kinematics, frame_pose};
@@ -13,7 +16,8 @@ use foxglove::messages::{
     Color, CubePrimitive, CylinderPrimitive, FrameTransform, FrameTransforms, JointState, JointStates, LinePrimitive, ModelPrimitive,
     Point3, PoseInFrame, Quaternion, SceneEntity, SceneUpdate, SpherePrimitive, Timestamp, Vector3,
 };
-use foxglove::{Channel, Context, McapCompression, McapWriteOptions, McapWriterHandle};
+use foxglove::Encode;
+use mcap::records::MessageHeader;
 use nalgebra::{Rotation3, UnitQuaternion};
 use schemars::JsonSchema;
 use serde::Serialize;
@@ -21,7 +25,7 @@ use std::collections::BTreeMap;
 use std::fs::File;
 use std::io::BufWriter;
 use std::path::PathBuf;
-use std::sync::Arc;
+use std::marker::PhantomData;
 
 pub const TOPIC_TF: &str = "/tf";
 pub const TOPIC_SCENE: &str = "/robot/geometry";
@@ -53,21 +57,52 @@ pub struct RobotDescription {
     pub data: String,
 }
 
+/// A channel of messages of type T.
+struct Topic<T> {
+    id: u16,
+    sequence: u32,
+    _message: PhantomData<T>,
+}
+
+/// The MCAP file and a reusable encoding buffer.
+struct Out {
+    writer: mcap::Writer<BufWriter<File>>,
+    buf: Vec<u8>,
+}
+
+impl Out {
+    fn channel<T: Encode>(&mut self, topic: &str, metadata: BTreeMap<String, String>) -> mcap::McapResult<Topic<T>> {
+        let schema_id = match T::get_schema() {
+            Some(s) => self.writer.add_schema(&s.name, &s.encoding, &s.data)?,
+            None => 0,
+        };
+        let id = self.writer.add_channel(schema_id, topic, &T::get_message_encoding(), &metadata)?;
+        Ok(Topic { id, sequence: 0, _message: PhantomData })
+    }
+
+    fn log<T: Encode>(&mut self, topic: &mut Topic<T>, msg: &T, time_ns: u64) -> Result<(), String> {
+        self.buf.clear();
+        msg.encode(&mut self.buf).map_err(|e| e.to_string())?;
+        let header = MessageHeader { channel_id: topic.id, sequence: topic.sequence, log_time: time_ns, publish_time: time_ns };
+        topic.sequence += 1;
+        self.writer.write_to_known_channel(&header, &self.buf).map_err(|e| e.to_string())
+    }
+}
+
 struct Channels {
-    tf: Channel<FrameTransforms>,
-    scene: Channel<SceneUpdate>,
-    joint_states: Channel<JointStates>,
-    controller: Channel<ControllerTelemetry>,
-    tool_pose: Channel<PoseInFrame>,
-    tool_path: Channel<SceneUpdate>,
-    commanded_path: Channel<SceneUpdate>,
-    robot_description: Channel<RobotDescription>,
+    tf: Topic<FrameTransforms>,
+    scene: Topic<SceneUpdate>,
+    joint_states: Topic<JointStates>,
+    controller: Topic<ControllerTelemetry>,
+    tool_pose: Topic<PoseInFrame>,
+    tool_path: Topic<SceneUpdate>,
+    commanded_path: Topic<SceneUpdate>,
+    robot_description: Topic<RobotDescription>,
 }
 
 pub struct McapRecorder {
     path: PathBuf,
-    context: Arc<Context>,
-    writer: Option<McapWriterHandle<BufWriter<File>>>,
+    out: Option<Out>,
     channels: Option<Channels>,
     start_ns: u64,
     /// (parent frame, child frame) per transform; parent `None` is "world" for a root not named so.
@@ -85,7 +120,6 @@ pub struct McapRecorder {
     dt: f64,
     steps_per_path_point: usize,
     path_points: Vec<Point3>,
-    path_segment: usize,
     last_scene_second: i64,
 }
 
@@ -93,8 +127,7 @@ impl McapRecorder {
     pub fn new(path: PathBuf) -> Self {
         Self {
             path,
-            context: Context::new(),
-            writer: None,
+            out: None,
             channels: None,
             start_ns: 0,
             tf_pairs: Vec::new(),
@@ -110,7 +143,6 @@ impl McapRecorder {
             dt: 0.001,
             steps_per_path_point: 20,
             path_points: Vec::new(),
-            path_segment: 0,
             last_scene_second: -1,
         }
     }
@@ -128,30 +160,31 @@ impl McapRecorder {
         Timestamp::new((ns / 1_000_000_000) as u32, (ns % 1_000_000_000) as u32)
     }
 
-    fn write_metadata(&self, name: &str, entries: BTreeMap<String, String>) -> Result<(), Error> {
-        match &self.writer {
-            Some(w) => w.write_metadata(name, entries).map_err(|e| self.err(e)),
+    fn write_metadata(&mut self, name: &str, entries: BTreeMap<String, String>) -> Result<(), Error> {
+        let record = mcap::records::Metadata { name: name.into(), metadata: entries };
+        match self.out.as_mut() {
+            Some(out) => out.writer.write_metadata(&record).map_err(|e| Error::output(&self.path, e)),
             None => Ok(()),
         }
     }
 
-    fn publish_path_segment(&mut self, t: f64) {
+    fn publish_path(&mut self, t: f64) -> Result<(), Error> {
         if self.path_points.len() < 2 {
-            return;
+            return Ok(());
         }
-        let Some(ch) = &self.channels else { return };
         let entity = SceneEntity {
             timestamp: Some(self.timestamp(t)),
             frame_id: "world".into(),
-            id: format!("path/{}", self.path_segment),
-            lines: vec![line(self.path_points.clone(), color([0.9, 0.2, 0.2, 1.0]), 0.003)],
+            // one entity, replaced as the path grows: a viewer that seeks shows only a topic's
+            // latest message, so each message carries the whole path so far
+            id: "path".into(),
+            lines: vec![line(self.path_points.clone(), color([1.0, 0.25, 0.2, 1.0]), 3.0)],
             ..Default::default()
         };
-        ch.tool_path.log_with_time(&SceneUpdate { deletions: vec![], entities: vec![entity] }, self.stamp(t));
-        self.path_segment += 1;
-        let last = *self.path_points.last().unwrap();
-        self.path_points.clear();
-        self.path_points.push(last);
+        let stamp = self.stamp(t);
+        let (out, ch) = (self.out.as_mut().expect("started"), self.channels.as_mut().expect("started"));
+        out.log(&mut ch.tool_path, &SceneUpdate { deletions: vec![], entities: vec![entity] }, stamp).map_err(|e| Error::output(&self.path, e))?;
+        Ok(())
     }
 }
 
@@ -172,8 +205,9 @@ fn color(c: [f32; 4]) -> Color {
     Color { r: c[0] as f64, g: c[1] as f64, b: c[2] as f64, a: c[3] as f64 }
 }
 
+/// A line strip `thickness` pixels wide at any zoom.
 fn line(points: Vec<Point3>, color: Color, thickness: f64) -> LinePrimitive {
-    LinePrimitive { r#type: 0, thickness, scale_invariant: false, points, color: Some(color), ..Default::default() }
+    LinePrimitive { r#type: 0, thickness, scale_invariant: true, points, color: Some(color), ..Default::default() }
 }
 
 fn vec3(v: &nalgebra::Vector3<f64>) -> Vector3 {
@@ -257,29 +291,38 @@ impl Recorder for McapRecorder {
         let e = run.experiment;
         let model = &*e.model;
         let file = File::create(&self.path).map_err(|err| self.err(err))?;
-        let options = McapWriteOptions::new().compression(Some(McapCompression::Zstd)).compression_level(1);
-        let writer = self.context.mcap_writer_with_options(options).create(BufWriter::new(file)).map_err(|err| self.err(err))?;
-        let ctx = &self.context;
-        self.channels = Some(Channels {
-            tf: ctx.channel_builder(TOPIC_TF).build(),
-            scene: ctx.channel_builder(TOPIC_SCENE).build(),
-            joint_states: ctx.channel_builder(TOPIC_JOINT_STATES).build(),
-            // joint order and limits are constant: channel metadata, not repeated in every message
-            controller: ctx
-                .channel_builder(TOPIC_CONTROLLER)
-                .add_metadata("joints", &serde_json::to_string(&model.joints.iter().map(|j| &j.name).collect::<Vec<_>>()).unwrap_or_default())
-                .add_metadata("torque_limit", &serde_json::to_string(&e.controller().effort).unwrap_or_default())
-                .build(),
-            tool_pose: ctx.channel_builder(TOPIC_TOOL_POSE).build(),
-            tool_path: ctx.channel_builder(TOPIC_TOOL_PATH).build(),
-            commanded_path: ctx.channel_builder(TOPIC_COMMANDED_PATH).build(),
-            robot_description: ctx.channel_builder(TOPIC_ROBOT_DESCRIPTION).build(),
-        });
-        self.writer = Some(writer);
+        // zstd level 1 on this (recorder) thread: zstd's own worker threads cost more than they save here
+        let options = mcap::WriteOptions::new()
+            .compression(Some(mcap::Compression::Zstd))
+            .compression_level(1)
+            .compression_threads(0)
+            .library(format!("armscope {} (foxglove-sdk schemas, mcap-rust)", env!("CARGO_PKG_VERSION")));
+        let writer = options.create(BufWriter::new(file)).map_err(|err| self.err(err))?;
+        let mut out = Out { writer, buf: Vec::with_capacity(4096) };
+        let none = BTreeMap::new;
+        // joint order and limits are constant: channel metadata, not repeated in every message
+        let mut controller_meta = BTreeMap::new();
+        controller_meta.insert("joints".to_string(), serde_json::to_string(&model.joints.iter().map(|j| &j.name).collect::<Vec<_>>()).unwrap_or_default());
+        controller_meta.insert("torque_limit".to_string(), serde_json::to_string(&e.controller().effort).unwrap_or_default());
+        let channels = (|| -> mcap::McapResult<Channels> {
+            Ok(Channels {
+                tf: out.channel(TOPIC_TF, none())?,
+                scene: out.channel(TOPIC_SCENE, none())?,
+                joint_states: out.channel(TOPIC_JOINT_STATES, none())?,
+                controller: out.channel(TOPIC_CONTROLLER, controller_meta)?,
+                tool_pose: out.channel(TOPIC_TOOL_POSE, none())?,
+                tool_path: out.channel(TOPIC_TOOL_PATH, none())?,
+                commanded_path: out.channel(TOPIC_COMMANDED_PATH, none())?,
+                robot_description: out.channel(TOPIC_ROBOT_DESCRIPTION, none())?,
+            })
+        })()
+        .map_err(|err| self.err(err))?;
+        self.channels = Some(channels);
+        self.out = Some(out);
         let now = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).unwrap_or_default();
         self.start_ns = now.as_nanos() as u64;
         self.dt = e.config.dt;
-        self.steps_per_path_point = ((0.02 / self.dt).round() as usize).max(1);
+        self.steps_per_path_point = ((0.05 / self.dt).round() as usize).max(1);
 
         // transforms: every link from its parent link; "world" → root when the root is not "world"
         self.frame_body = model.frames.iter().map(|f| (f.body, f.placement)).collect();
@@ -315,9 +358,13 @@ impl Recorder for McapRecorder {
         };
         self.scene = scene_from_model(model).map_err(|(path, err)| Error::output(&path, err))?;
 
-        let ch = self.channels.as_ref().unwrap();
         let t0 = self.stamp(0.0);
-        ch.robot_description.log_with_time(&RobotDescription { data: model.urdf_text.clone() }, t0);
+        let path = self.path.clone();
+        let fail = |e: String| Error::output(&path, e);
+        {
+            let (out, ch) = (self.out.as_mut().unwrap(), self.channels.as_mut().unwrap());
+            out.log(&mut ch.robot_description, &RobotDescription { data: model.urdf_text.clone() }, t0).map_err(fail)?;
+        }
         // the commanded tool path, from forward kinematics of the command
         let mut data = Data::new(model);
         let (mut cmd, mut cmd_dot) = (vec![0.0; n], vec![0.0; n]);
@@ -334,10 +381,11 @@ impl Recorder for McapRecorder {
             timestamp: Some(self.timestamp(0.0)),
             frame_id: "world".into(),
             id: "commanded".into(),
-            lines: vec![line(points, color([0.5, 0.5, 0.5, 1.0]), 0.002)],
+            lines: vec![line(points, color([0.6, 0.6, 0.6, 1.0]), 1.5)],
             ..Default::default()
         };
-        ch.commanded_path.log_with_time(&SceneUpdate { deletions: vec![], entities: vec![commanded] }, t0);
+        let (out, ch) = (self.out.as_mut().unwrap(), self.channels.as_mut().unwrap());
+        out.log(&mut ch.commanded_path, &SceneUpdate { deletions: vec![], entities: vec![commanded] }, t0).map_err(fail)?;
 
         let mut meta = BTreeMap::new();
         meta.insert("model".into(), model.name.clone());
@@ -377,11 +425,13 @@ impl Recorder for McapRecorder {
             tel.saturated[j] = s.saturated[j] as u8;
         }
         let tool = self.frame_world[self.tool_frame];
-        let ch = self.channels.as_ref().expect("started");
-        ch.tf.log_with_time(&self.tf_msg, stamp);
-        ch.joint_states.log_with_time(&self.joints_msg, stamp);
-        ch.controller.log_with_time(&self.telemetry, stamp);
-        ch.tool_pose.log_with_time(&PoseInFrame { timestamp: ts, frame_id: "world".into(), pose: Some(fox_pose(&tool)) }, stamp);
+        let path = &self.path;
+        let fail = |e: String| Error::output(path, e);
+        let (out, ch) = (self.out.as_mut().expect("started"), self.channels.as_mut().expect("started"));
+        out.log(&mut ch.tf, &self.tf_msg, stamp).map_err(fail)?;
+        out.log(&mut ch.joint_states, &self.joints_msg, stamp).map_err(fail)?;
+        out.log(&mut ch.controller, &self.telemetry, stamp).map_err(fail)?;
+        out.log(&mut ch.tool_pose, &PoseInFrame { timestamp: ts, frame_id: "world".into(), pose: Some(fox_pose(&tool)) }, stamp).map_err(fail)?;
         // geometry once a simulated second, so a viewer that seeks always has it
         let second = s.t.floor() as i64;
         if second > self.last_scene_second {
@@ -389,17 +439,17 @@ impl Recorder for McapRecorder {
             for entity in &mut self.scene.entities {
                 entity.timestamp = ts;
             }
-            ch.scene.log_with_time(&self.scene, stamp);
+            out.log(&mut ch.scene, &self.scene, stamp).map_err(fail)?;
             if !self.fixed_tf_pairs.is_empty() {
                 fill_transforms(&mut self.fixed_tf_msg, &self.fixed_tf_pairs, &self.frame_world, ts);
-                ch.tf.log_with_time(&self.fixed_tf_msg, stamp);
+                out.log(&mut ch.tf, &self.fixed_tf_msg, stamp).map_err(fail)?;
             }
         }
         if s.k % self.steps_per_path_point == 0 || s.is_final {
             let p = tool.translation;
             self.path_points.push(Point3 { x: p.x, y: p.y, z: p.z });
-            if self.path_points.len() > 5 || s.is_final {
-                self.publish_path_segment(s.t);
+            if self.path_points.len() % 10 == 0 || s.is_final {
+                self.publish_path(s.t)?;
             }
         }
         Ok(())
@@ -412,8 +462,8 @@ impl Recorder for McapRecorder {
         meta.insert("status".into(), serde_json::to_string(&summary.status).unwrap_or_default());
         self.write_metadata("armscope.summary", meta)?;
         self.channels = None;
-        if let Some(writer) = self.writer.take() {
-            writer.close().map_err(|e| self.err(e))?;
+        if let Some(mut out) = self.out.take() {
+            out.writer.finish().map_err(|e| self.err(e))?;
         }
         Ok(())
     }
