@@ -3,8 +3,8 @@
 use crate::config::{IntegratorKind, RunConfig};
 use crate::error::Error;
 use crate::experiment::Experiment;
-use crate::recorder::{Console, LiveViewer, McapRecorder, Pacer, Recorder, RerunOptions, RerunRecorder, SummaryJson, Threaded, Trace, TutorialCsv};
-use crate::sim::simulate;
+use crate::recorder::LiveViewer;
+use crate::runner::{Outputs, run_experiment};
 use crate::summary::RunStatus;
 use clap::{Args, Parser, Subcommand};
 use std::ffi::OsString;
@@ -22,6 +22,54 @@ pub struct Cli {
 pub enum Command {
     /// Run one experiment: the tutorial's PD + gravity-compensation controller on the arm.
     Run(RunArgs),
+    /// Run many experiments from a TOML manifest, in parallel, into recordings/BATCH/.
+    Batch(BatchArgs),
+    /// Build one comparison recording (.rrd) from the .mcap files of finished runs.
+    Compare(CompareArgs),
+}
+
+#[derive(Args, Debug)]
+#[command(args_conflicts_with_subcommands = true)]
+pub struct BatchArgs {
+    #[command(subcommand)]
+    pub action: Option<BatchAction>,
+    /// The manifest.
+    #[arg(value_name = "MANIFEST", default_value = "assets/experiments/tutorial.toml")]
+    pub manifest: PathBuf,
+    /// Experiments run at once (default: the number of cores).
+    #[arg(long)]
+    pub jobs: Option<usize>,
+    /// Run only shard I of N (I from 0), e.g. a Slurm array task: --shard $SLURM_ARRAY_TASK_ID/4.
+    #[arg(long, value_name = "I/N")]
+    pub shard: Option<String>,
+    /// Output folder (default: recordings/BATCH, BATCH the manifest's name).
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// Skip the comparison recording.
+    #[arg(long)]
+    pub no_compare: bool,
+}
+
+#[derive(Subcommand, Debug)]
+pub enum BatchAction {
+    /// Join the shard summaries in DIR… into one set of tables (and the comparison recording).
+    Merge {
+        #[arg(required = true)]
+        dirs: Vec<PathBuf>,
+        /// Where to write the merged tables (default: the first DIR).
+        #[arg(long, value_name = "DIR")]
+        out: Option<PathBuf>,
+    },
+}
+
+#[derive(Args, Debug)]
+pub struct CompareArgs {
+    /// The runs' .mcap files (each run is labelled with its file name).
+    #[arg(required = true, value_name = "RUN.mcap")]
+    pub inputs: Vec<PathBuf>,
+    /// The comparison recording to write.
+    #[arg(long, value_name = "PATH", default_value = "recordings/comparison.rrd")]
+    pub out: PathBuf,
 }
 
 fn defaults() -> RunConfig {
@@ -242,18 +290,10 @@ where
 fn run_command(command: Command) -> Result<i32, Error> {
     match command {
         Command::Run(args) => run(&args),
+        Command::Batch(args) => batch(&args),
+        Command::Compare(args) => compare(&args),
     }
 }
-
-fn create_parent(path: &std::path::Path) -> Result<(), Error> {
-    match path.parent() {
-        Some(dir) if !dir.as_os_str().is_empty() => std::fs::create_dir_all(dir).map_err(|e| Error::output(dir, e)),
-        _ => Ok(()),
-    }
-}
-
-/// How long a recorder thread may wait for samples (keeps a live viewer current).
-const RECORDER_LATENCY: std::time::Duration = std::time::Duration::from_millis(20);
 
 /// Set by SIGINT (Ctrl-C): the run stops after the current step and finishes its files.
 static INTERRUPTED: AtomicBool = AtomicBool::new(false);
@@ -288,40 +328,21 @@ pub fn run(args: &RunArgs) -> Result<i32, Error> {
         args.connect.clone().map(LiveViewer::Connect)
     };
 
-    let mut recorders: Vec<Box<dyn Recorder>> = Vec::new();
-    if !args.quiet {
-        recorders.push(Box::new(Console::stdout()));
-    }
-    if rrd_path.is_some() || live.is_some() {
-        if let Some(path) = &rrd_path {
-            create_parent(path)?;
-        }
-        let mut rrd = RerunRecorder::new(RerunOptions { file: rrd_path.clone(), live, name: name.clone() });
-        // the viewer connection is made in start(); report what could not be reached right away
-        rrd.on_notice(|n| eprintln!("armscope: notice: {n}"));
-        recorders.push(Box::new(Threaded::new(rrd, RECORDER_LATENCY)));
-    }
-    if let Some(path) = &mcap_path {
-        create_parent(path)?;
-        recorders.push(Box::new(Threaded::new(McapRecorder::new(path.clone()), RECORDER_LATENCY)));
-    }
-    if let Some(factor) = args.realtime {
-        recorders.push(Box::new(Pacer::new(factor)));
-    }
-    for (path, make) in [
-        (&args.csv, (|p| Box::new(TutorialCsv::new(p)) as Box<dyn Recorder>) as fn(PathBuf) -> Box<dyn Recorder>),
-        (&args.trace, |p| Box::new(Trace::new(p))),
-        (&args.summary_json, |p| Box::new(SummaryJson::new(p))),
-    ] {
-        if let Some(path) = path {
-            create_parent(path)?;
-            recorders.push(make(path.clone()));
-        }
-    }
-    let mut refs: Vec<&mut dyn Recorder> = recorders.iter_mut().map(|r| r.as_mut() as &mut dyn Recorder).collect();
+    let outputs = Outputs {
+        name: name.clone(),
+        console: (!args.quiet).then(|| Box::new(std::io::stdout()) as Box<dyn std::io::Write + Send>),
+        rrd: rrd_path.clone(),
+        mcap: mcap_path.clone(),
+        live,
+        realtime: args.realtime,
+        csv: args.csv.clone(),
+        trace: args.trace.clone(),
+        summary_json: args.summary_json.clone(),
+        notice: Some(|n| eprintln!("armscope: notice: {n}")),
+    };
     install_interrupt_handler();
     INTERRUPTED.store(false, Ordering::SeqCst);
-    let summary = simulate(&experiment, &mut refs, Some(&INTERRUPTED))?;
+    let summary = run_experiment(&experiment, outputs, Some(&INTERRUPTED))?;
     if !args.quiet {
         let mut files = Vec::new();
         if let Some(p) = &rrd_path {
@@ -339,4 +360,71 @@ pub fn run(args: &RunArgs) -> Result<i32, Error> {
         RunStatus::Interrupted { .. } => Ok(130),
         RunStatus::Completed => Ok(0),
     }
+}
+
+/// `armscope batch`.
+pub fn batch(args: &BatchArgs) -> Result<i32, Error> {
+    use crate::batch::{BatchOptions, merge_summaries, parse_shard, write_tables};
+    let summary = match &args.action {
+        Some(BatchAction::Merge { dirs, out }) => {
+            let merged = merge_summaries(dirs)?;
+            let dir = out.clone().unwrap_or_else(|| dirs[0].clone());
+            std::fs::create_dir_all(&dir).map_err(|e| Error::output(&dir, e))?;
+            let mut files = write_tables(&dir, &merged)?;
+            let runs: Vec<crate::batch::ComparedRun> = merged
+                .experiments
+                .iter()
+                .filter(|e| e.summary.is_some())
+                .filter_map(|e| dirs.iter().map(|d| d.join(format!("{}.mcap", e.name))).find(|p| p.exists()).map(|mcap| crate::batch::ComparedRun { label: e.name.clone(), mcap }))
+                .collect();
+            if !runs.is_empty() {
+                let rrd = dir.join("comparison.rrd");
+                crate::batch::build_comparison(&runs, &rrd, &merged.batch)?;
+                files.push(rrd);
+            }
+            report_batch(&merged, &files);
+            merged
+        }
+        None => {
+            let options = BatchOptions {
+                manifest: args.manifest.clone(),
+                jobs: args.jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get())),
+                shard: args.shard.as_deref().map(parse_shard).transpose()?,
+                out: args.out.clone(),
+                compare: !args.no_compare,
+                progress: true,
+            };
+            if options.jobs == 0 {
+                return Err(Error::flag("--jobs", "must be at least 1"));
+            }
+            install_interrupt_handler();
+            INTERRUPTED.store(false, Ordering::SeqCst);
+            let (summary, files) = crate::batch::run_batch(&options, Some(&INTERRUPTED))?;
+            report_batch(&summary, &files);
+            summary
+        }
+    };
+    let failed = summary.experiments.iter().filter(|e| e.status != "completed").count();
+    Ok(if failed == 0 { 0 } else { 1 })
+}
+
+fn report_batch(summary: &crate::batch::BatchSummary, files: &[PathBuf]) {
+    print!("{}", crate::batch::BatchSummary::markdown(summary));
+    for e in summary.experiments.iter().filter(|e| e.status != "completed") {
+        eprintln!("armscope: experiment '{}' {}: {}", e.name, e.status, e.error.clone().unwrap_or_default());
+    }
+    println!("\nWritten: {}", files.iter().map(|f| f.display().to_string()).collect::<Vec<_>>().join(", "));
+}
+
+/// `armscope compare`.
+pub fn compare(args: &CompareArgs) -> Result<i32, Error> {
+    let runs: Vec<crate::batch::ComparedRun> = args
+        .inputs
+        .iter()
+        .map(|p| crate::batch::ComparedRun { label: p.file_stem().map_or("run".into(), |s| s.to_string_lossy().to_string()), mcap: p.clone() })
+        .collect();
+    crate::runner::create_parent(&args.out)?;
+    crate::batch::build_comparison(&runs, &args.out, "comparison")?;
+    println!("Comparison of {} runs: {}   open in Rerun: rerun {}", runs.len(), args.out.display(), args.out.display());
+    Ok(0)
 }

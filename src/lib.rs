@@ -3,6 +3,7 @@
 //! Data flows one way: [`config::RunConfig`] → [`model::Model`] → [`sim::simulate`] →
 //! [`sample::Sample`]s → [`recorder::Recorder`]s (console, CSV, trace, JSON, …).
 
+pub mod batch;
 pub mod cli;
 pub mod config;
 pub mod controller;
@@ -13,6 +14,7 @@ pub mod gains;
 pub mod integrator;
 pub mod model;
 pub mod recorder;
+pub mod runner;
 pub mod sample;
 pub mod sim;
 pub mod spatial;

@@ -1,9 +1,9 @@
 //! The numbers a run ends with: tracking error, saturation, limit hits, tool range.
 
 use crate::sample::Sample;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "state", rename_all = "lowercase")]
 pub enum RunStatus {
     Completed,
@@ -13,20 +13,20 @@ pub enum RunStatus {
     Diverged { joint: String, time: f64, message: String },
 }
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Range {
     pub min: f64,
     pub max: f64,
 }
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct ToolRange {
     pub x: Range,
     pub y: Range,
     pub z: Range,
 }
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Summary {
     pub status: RunStatus,
     pub joints: Vec<String>,

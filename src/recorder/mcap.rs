@@ -37,7 +37,7 @@ pub const TOPIC_COMMANDED_PATH: &str = "/tool/commanded_path";
 pub const TOPIC_ROBOT_DESCRIPTION: &str = "/robot_description";
 
 /// Per-step controller telemetry, one array entry per joint (Foxglove plots `/controller.torque[1]`).
-#[derive(Clone, Debug, Default, Serialize, JsonSchema)]
+#[derive(Clone, Debug, Default, Serialize, serde::Deserialize, JsonSchema)]
 pub struct ControllerTelemetry {
     /// Simulation time, s.
     pub time: f64,

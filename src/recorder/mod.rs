@@ -4,14 +4,14 @@
 mod console;
 mod mcap;
 mod pacer;
-mod rrd;
+pub mod rrd;
 mod summary_json;
 mod threaded;
 mod trace;
 mod tutorial_csv;
 
 pub use console::Console;
-pub use mcap::{ControllerTelemetry, McapRecorder};
+pub use mcap::{ControllerTelemetry, McapRecorder, TOPIC_CONTROLLER, TOPIC_JOINT_STATES};
 pub use pacer::Pacer;
 pub use rrd::{DEFAULT_CONNECT_URL, LiveViewer, RerunOptions, RerunRecorder};
 pub use summary_json::SummaryJson;

@@ -1,0 +1,12 @@
+//! `armscope batch`: many experiments from a manifest, in parallel, with summary tables and a
+//! comparison recording; shards for clusters and merging of their summaries.
+
+mod compare;
+mod manifest;
+mod runner;
+mod table;
+
+pub use compare::{ComparedRun, build_comparison};
+pub use manifest::{Manifest, PlannedExperiment, load_manifest, parse_shard, shard};
+pub use runner::{BatchOptions, ExperimentOutcome, run_batch};
+pub use table::{BatchSummary, merge_summaries, write_tables};

@@ -1,0 +1,149 @@
+use super::manifest::{PlannedExperiment, load_manifest, shard};
+use super::table::{BatchSummary, write_tables};
+use super::compare::{ComparedRun, build_comparison};
+use crate::cli::RunArgs;
+use crate::error::Error;
+use crate::experiment::Experiment;
+use crate::runner::{Outputs, run_experiment};
+use crate::summary::{RunStatus, Summary};
+use clap::Parser;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicBool;
+
+#[derive(Clone, Debug)]
+pub struct BatchOptions {
+    pub manifest: PathBuf,
+    /// Experiments run at once.
+    pub jobs: usize,
+    /// Run only shard I of N.
+    pub shard: Option<(usize, usize)>,
+    /// The output folder (default: recordings/BATCH).
+    pub out: Option<PathBuf>,
+    /// Build the comparison recording.
+    pub compare: bool,
+    pub progress: bool,
+}
+
+/// One experiment's result, as the tables and `batch merge` see it.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct ExperimentOutcome {
+    pub index: usize,
+    pub name: String,
+    pub args: Vec<String>,
+    /// completed, interrupted, diverged or failed.
+    pub status: String,
+    pub summary: Option<Summary>,
+    pub error: Option<String>,
+    /// The whole experiment, recordings included, s.
+    pub wall_time: f64,
+}
+
+/// `run` flags as the CLI parses them.
+#[derive(Parser)]
+#[command(name = "run", no_binary_name = false)]
+struct RunFlags {
+    #[command(flatten)]
+    args: RunArgs,
+}
+
+fn run_one(e: &PlannedExperiment, dir: &Path, stop: Option<&AtomicBool>) -> ExperimentOutcome {
+    let started = std::time::Instant::now();
+    let mut outcome = run_timed(e, dir, stop);
+    outcome.wall_time = started.elapsed().as_secs_f64();
+    outcome
+}
+
+fn run_timed(e: &PlannedExperiment, dir: &Path, stop: Option<&AtomicBool>) -> ExperimentOutcome {
+    let failed = |error: String| ExperimentOutcome { index: e.index, name: e.name.clone(), args: e.args.clone(), status: "failed".into(), summary: None, error: Some(error), wall_time: 0.0 };
+    let argv = std::iter::once("run".to_string()).chain(e.args.iter().cloned());
+    let flags = match RunFlags::try_parse_from(argv) {
+        Ok(f) => f.args,
+        Err(err) => {
+            let text = err.render().to_string();
+            return failed(text.lines().next().unwrap_or("invalid flags").trim_start_matches("error: ").to_string());
+        }
+    };
+    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| -> Result<Summary, Error> {
+        let experiment = Experiment::prepare(flags.config())?;
+        let log = dir.join(format!("{}.log", e.name));
+        let console = std::fs::File::create(&log).map_err(|err| Error::output(&log, err))?;
+        let outputs = Outputs {
+            name: e.name.clone(),
+            console: Some(Box::new(std::io::BufWriter::new(console))),
+            rrd: Some(dir.join(format!("{}.rrd", e.name))),
+            mcap: Some(dir.join(format!("{}.mcap", e.name))),
+            csv: Some(dir.join(format!("{}.csv", e.name))),
+            summary_json: Some(dir.join(format!("{}.json", e.name))),
+            ..Outputs::default()
+        };
+        run_experiment(&experiment, outputs, stop)
+    }));
+    match result {
+        Ok(Ok(summary)) => {
+            let (status, error) = match &summary.status {
+                RunStatus::Completed => ("completed", None),
+                RunStatus::Interrupted { .. } => ("interrupted", None),
+                RunStatus::Diverged { message, .. } => ("diverged", Some(message.clone())),
+            };
+            ExperimentOutcome { index: e.index, name: e.name.clone(), args: e.args.clone(), status: status.into(), summary: Some(summary), error, wall_time: 0.0 }
+        }
+        Ok(Err(err)) => failed(err.to_string()),
+        Err(panic) => failed(format!("internal error: {}", panic.downcast_ref::<String>().cloned().or_else(|| panic.downcast_ref::<&str>().map(|s| s.to_string())).unwrap_or_default())),
+    }
+}
+
+/// Run a manifest (or one shard of it). Returns the batch summary and the files written.
+pub fn run_batch(options: &BatchOptions, stop: Option<&AtomicBool>) -> Result<(BatchSummary, Vec<PathBuf>), Error> {
+    let manifest = load_manifest(&options.manifest)?;
+    let planned = match options.shard {
+        Some((i, n)) => shard(&manifest.experiments, i, n),
+        None => manifest.experiments.clone(),
+    };
+    let dir = options.out.clone().unwrap_or_else(|| PathBuf::from("recordings").join(&manifest.name));
+    std::fs::create_dir_all(&dir).map_err(|e| Error::output(&dir, e))?;
+    let jobs = options.jobs.max(1);
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(jobs).build().map_err(|e| Error::flag("--jobs", e.to_string()))?;
+    let bar = ProgressBar::new(planned.len() as u64);
+    if options.progress {
+        bar.set_style(ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:30} {pos}/{len} experiments  {msg}").unwrap_or_else(|_| ProgressStyle::default_bar()));
+        bar.enable_steady_tick(std::time::Duration::from_millis(200));
+    } else {
+        bar.set_draw_target(ProgressDrawTarget::hidden());
+    }
+    let outcomes: Vec<ExperimentOutcome> = pool.install(|| {
+        planned
+            .par_iter()
+            .map(|e| {
+                let outcome = run_one(e, &dir, stop);
+                bar.set_message(format!("{} {}", outcome.name, outcome.status));
+                bar.inc(1);
+                outcome
+            })
+            .collect()
+    });
+    bar.finish_and_clear();
+    let summary = BatchSummary {
+        batch: manifest.name.clone(),
+        manifest: manifest.path.clone(),
+        shard: options.shard.map(|(i, n)| [i, n]),
+        experiments: outcomes,
+    };
+    let mut files = write_tables(&dir, &summary)?;
+    if options.compare && options.shard.is_none() {
+        let runs: Vec<ComparedRun> = summary
+            .experiments
+            .iter()
+            .filter(|e| e.summary.is_some())
+            .map(|e| ComparedRun { label: e.name.clone(), mcap: dir.join(format!("{}.mcap", e.name)) })
+            .collect();
+        if !runs.is_empty() {
+            let out = dir.join("comparison.rrd");
+            build_comparison(&runs, &out, &summary.batch)?;
+            files.push(out);
+        }
+    }
+    Ok((summary, files))
+}

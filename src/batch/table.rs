@@ -1,0 +1,145 @@
+use super::runner::ExperimentOutcome;
+use crate::error::Error;
+use crate::summary::Summary;
+use serde::{Deserialize, Serialize};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// What a batch (or one shard of it) produced: the input of the tables and of `batch merge`.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct BatchSummary {
+    pub batch: String,
+    pub manifest: PathBuf,
+    /// `[I, N]` for one shard of N, absent for a whole batch.
+    pub shard: Option<[usize; 2]>,
+    pub experiments: Vec<ExperimentOutcome>,
+}
+
+impl BatchSummary {
+    pub fn markdown(&self) -> String {
+        markdown(self)
+    }
+}
+
+fn fmt_opt(v: Option<f64>) -> String {
+    v.map_or("n/a".into(), |x| format!("{x:.4}"))
+}
+
+fn per_joint(s: &Summary, f: impl Fn(usize) -> String) -> String {
+    (0..s.joints.len()).map(f).collect::<Vec<_>>().join(" ")
+}
+
+pub fn markdown(summary: &BatchSummary) -> String {
+    let mut md = format!("# batch `{}`\n\nMax and RMS tracking error over every step with t ≥ the settle time (2 s), saturation % of control steps, per joint J1..Jn.\n\n", summary.batch);
+    md += "| experiment | status | max err (rad) | RMS err (rad) | saturation % | tool x / y / z range (m) | wall time incl. recording (s) |\n|---|---|---|---|---|---|---|\n";
+    for e in &summary.experiments {
+        match &e.summary {
+            Some(s) => {
+                let r = &s.tool_range;
+                let _ = writeln!(
+                    md,
+                    "| {} | {} | {} | {} | {} | [{:.3}, {:.3}] / [{:.3}, {:.3}] / [{:.3}, {:.3}] | {:.3} |",
+                    e.name,
+                    e.status,
+                    per_joint(s, |j| fmt_opt(s.max_abs_error[j])),
+                    per_joint(s, |j| fmt_opt(s.rms_error[j])),
+                    per_joint(s, |j| format!("{:.1}", s.saturation_percent[j])),
+                    r.x.min,
+                    r.x.max,
+                    r.y.min,
+                    r.y.max,
+                    r.z.min,
+                    r.z.max,
+                    e.wall_time
+                );
+            }
+            None => {
+                let _ = writeln!(md, "| {} | {} | | | | | |", e.name, e.status);
+            }
+        }
+    }
+    md
+}
+
+pub fn csv(summary: &BatchSummary) -> String {
+    let n = summary.experiments.iter().filter_map(|e| e.summary.as_ref()).map(|s| s.joints.len()).max().unwrap_or(0);
+    let mut header = vec!["experiment".to_string(), "status".into()];
+    for prefix in ["max_err", "rms_err", "saturation_pct"] {
+        header.extend((1..=n).map(|j| format!("{prefix}_{j}")));
+    }
+    header.extend(["x_min", "x_max", "y_min", "y_max", "z_min", "z_max", "wall_s", "error"].map(String::from));
+    let mut out = header.join(",") + "\n";
+    for e in &summary.experiments {
+        let mut row = vec![e.name.clone(), e.status.clone()];
+        match &e.summary {
+            Some(s) => {
+                let cell = |v: Option<f64>| v.map_or(String::new(), |x| format!("{x:?}"));
+                row.extend((0..n).map(|j| cell(s.max_abs_error.get(j).copied().flatten())));
+                row.extend((0..n).map(|j| cell(s.rms_error.get(j).copied().flatten())));
+                row.extend((0..n).map(|j| cell(s.saturation_percent.get(j).copied())));
+                let r = &s.tool_range;
+                row.extend([r.x.min, r.x.max, r.y.min, r.y.max, r.z.min, r.z.max, e.wall_time].map(|x| format!("{x:?}")));
+                row.push(String::new());
+            }
+            None => {
+                row.extend(std::iter::repeat_n(String::new(), 3 * n + 7));
+                row.push(format!("\"{}\"", e.error.clone().unwrap_or_default().replace('"', "'")));
+            }
+        }
+        out += &(row.join(",") + "\n");
+    }
+    out
+}
+
+/// The file stem of the tables: `summary`, or `summary.shard-I-of-N` for a shard.
+pub fn table_stem(summary: &BatchSummary) -> String {
+    match summary.shard {
+        Some([i, n]) => format!("summary.shard-{i}-of-{n}"),
+        None => "summary".into(),
+    }
+}
+
+/// Writes DIR/STEM.md, .csv and .json; returns the paths.
+pub fn write_tables(dir: &Path, summary: &BatchSummary) -> Result<Vec<PathBuf>, Error> {
+    let stem = table_stem(summary);
+    let files = [
+        (dir.join(format!("{stem}.md")), markdown(summary)),
+        (dir.join(format!("{stem}.csv")), csv(summary)),
+        (dir.join(format!("{stem}.json")), serde_json::to_string_pretty(summary).unwrap_or_default() + "\n"),
+    ];
+    for (path, text) in &files {
+        std::fs::write(path, text).map_err(|e| Error::output(path, e))?;
+    }
+    Ok(files.into_iter().map(|(p, _)| p).collect())
+}
+
+/// Joins the shard summaries found in `dirs` into one, in manifest order; every experiment must
+/// appear exactly once.
+pub fn merge_summaries(dirs: &[PathBuf]) -> Result<BatchSummary, Error> {
+    let mut parts: Vec<BatchSummary> = Vec::new();
+    for dir in dirs {
+        let entries = std::fs::read_dir(dir).map_err(|e| Error::flag("batch merge", format!("{}: {e}", dir.display())))?;
+        for entry in entries.flatten() {
+            let name = entry.file_name().to_string_lossy().to_string();
+            if name.starts_with("summary.shard-") && name.ends_with(".json") {
+                let text = std::fs::read_to_string(entry.path()).map_err(|e| Error::output(&entry.path(), e))?;
+                let part: BatchSummary = serde_json::from_str(&text).map_err(|e| Error::flag("batch merge", format!("{}: {e}", entry.path().display())))?;
+                parts.push(part);
+            }
+        }
+    }
+    let first = parts.first().ok_or_else(|| Error::flag("batch merge", "no summary.shard-*.json in the given folders"))?.clone();
+    let total = first.shard.map_or(1, |[_, n]| n);
+    let mut shards: Vec<usize> = parts.iter().filter_map(|p| p.shard.map(|[i, _]| i)).collect();
+    shards.sort();
+    shards.dedup();
+    if shards.len() != total || parts.iter().any(|p| p.batch != first.batch) {
+        return Err(Error::flag("batch merge", format!("found shards {shards:?} of batch '{}'; expected all {total}", first.batch)));
+    }
+    let mut experiments: Vec<ExperimentOutcome> = parts.into_iter().flat_map(|p| p.experiments).collect();
+    experiments.sort_by_key(|e| e.index);
+    if let Some(dup) = experiments.windows(2).find(|w| w[0].index == w[1].index) {
+        return Err(Error::flag("batch merge", format!("experiment '{}' appears in two shards", dup[0].name)));
+    }
+    Ok(BatchSummary { batch: first.batch, manifest: first.manifest, shard: None, experiments })
+}

@@ -1,0 +1,159 @@
+//! `armscope batch`: the tutorial manifest end to end, agreement with single runs, determinism
+//! across job counts, a failing experiment, shards and their merge, the comparison recording.
+
+mod common;
+
+use common::{armscope, repo};
+use serde_json::Value;
+use std::path::Path;
+
+fn read_json(path: &Path) -> Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))).unwrap()
+}
+
+/// The summary without its wall-clock time (which differs between any two runs).
+fn numbers(summary: &Value) -> Value {
+    let mut s = summary.clone();
+    s.as_object_mut().unwrap().remove("wall_time");
+    s
+}
+
+fn experiment<'a>(batch: &'a Value, name: &str) -> &'a Value {
+    batch["experiments"].as_array().unwrap().iter().find(|e| e["name"] == name).unwrap_or_else(|| panic!("no experiment {name}"))
+}
+
+#[test]
+fn tutorial_manifest_runs_end_to_end_and_matches_single_runs() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("tutorial");
+    let manifest = repo().join("assets/experiments/tutorial.toml");
+    assert_eq!(armscope(&["batch", manifest.to_str().unwrap(), "--out", out.to_str().unwrap(), "--jobs", "2"]), 0);
+    let batch = read_json(&out.join("summary.json"));
+    let names: Vec<&str> = batch["experiments"].as_array().unwrap().iter().map(|e| e["name"].as_str().unwrap()).collect();
+    assert_eq!(names, ["default", "static", "no-ff", "no-gravity", "test-joint-1", "test-joint-2", "test-joint-3", "test-joint-4", "test-joint-5", "test-joint-6", "freq0.3", "amp20", "freq1.2"]);
+    for name in &names {
+        assert_eq!(experiment(&batch, name)["status"], "completed", "{name}");
+        for ext in ["rrd", "mcap", "csv", "json", "log"] {
+            assert!(out.join(format!("{name}.{ext}")).metadata().unwrap().len() > 0, "{name}.{ext}");
+        }
+    }
+    for table in ["summary.md", "summary.csv", "comparison.rrd"] {
+        assert!(out.join(table).exists(), "{table}");
+    }
+    let csv = std::fs::read_to_string(out.join("summary.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 14, "header + 13 experiments");
+    let md = std::fs::read_to_string(out.join("summary.md")).unwrap();
+    assert!(md.contains("| no-ff | completed |"));
+
+    // the same experiments through `armscope run` give exactly the same summaries
+    for (name, flags) in [("no-ff", vec!["--no-ff", "--duration", "10"]), ("test-joint-3", vec!["--test-joint", "3", "--duration", "5"]), ("default", vec![])] {
+        let single = dir.path().join(format!("{name}.json"));
+        let mut args = vec!["run", "--quiet", "--summary-json", single.to_str().unwrap()];
+        args.extend(flags);
+        assert_eq!(armscope(&args), 0);
+        assert_eq!(numbers(&read_json(&single)["summary"]), numbers(&experiment(&batch, name)["summary"]), "{name}");
+    }
+}
+
+const SMALL: &str = r#"
+name = "small"
+[defaults]
+duration = 0.6
+[[experiment]]
+name = "wave"
+[[experiment]]
+name = "step-{test-joint}"
+grid = { test-joint = [2, "J4"] }
+[[experiment]]
+name = "broken"
+kp = [1, 2, 3]
+[[experiment]]
+name = "continuous"
+time-step = 0
+"#;
+
+fn small_manifest(dir: &Path) -> std::path::PathBuf {
+    let path = dir.join("small.toml");
+    std::fs::write(&path, SMALL).unwrap();
+    path
+}
+
+#[test]
+fn one_failing_experiment_is_reported_and_the_others_are_identical_for_any_job_count() {
+    let dir = tempfile::tempdir().unwrap();
+    let manifest = small_manifest(dir.path());
+    let mut results = Vec::new();
+    for jobs in ["1", "2"] {
+        let out = dir.path().join(format!("jobs{jobs}"));
+        // a failed experiment makes the batch exit 1, after running all the others
+        assert_eq!(armscope(&["batch", manifest.to_str().unwrap(), "--out", out.to_str().unwrap(), "--jobs", jobs]), 1);
+        let batch = read_json(&out.join("summary.json"));
+        let broken = experiment(&batch, "broken");
+        assert_eq!(broken["status"], "failed");
+        assert!(broken["error"].as_str().unwrap().contains("--kp"), "{broken}");
+        for name in ["wave", "step-2", "step-J4", "continuous"] {
+            assert_eq!(experiment(&batch, name)["status"], "completed", "{name}");
+        }
+        results.push(out);
+    }
+    let (a, b) = (read_json(&results[0].join("summary.json")), read_json(&results[1].join("summary.json")));
+    for name in ["wave", "step-2", "step-J4", "continuous"] {
+        assert_eq!(numbers(&experiment(&a, name)["summary"]), numbers(&experiment(&b, name)["summary"]), "{name}: --jobs 1 vs 2");
+        let csv = |dir: &Path| std::fs::read(dir.join(format!("{name}.csv"))).unwrap();
+        assert_eq!(csv(&results[0]), csv(&results[1]), "{name}.csv");
+    }
+}
+
+#[test]
+fn shards_cover_the_manifest_and_merge_into_the_whole() {
+    let dir = tempfile::tempdir().unwrap();
+    let manifest = small_manifest(dir.path());
+    let whole = dir.path().join("whole");
+    armscope(&["batch", manifest.to_str().unwrap(), "--out", whole.to_str().unwrap(), "--no-compare"]);
+    let shared = dir.path().join("shards");
+    let mut seen = Vec::new();
+    for i in 0..3 {
+        armscope(&["batch", manifest.to_str().unwrap(), "--out", shared.to_str().unwrap(), "--shard", &format!("{i}/3"), "--no-compare"]);
+        let part = read_json(&shared.join(format!("summary.shard-{i}-of-3.json")));
+        seen.extend(part["experiments"].as_array().unwrap().iter().map(|e| e["index"].as_u64().unwrap()));
+    }
+    seen.sort();
+    assert_eq!(seen, [0, 1, 2, 3, 4], "every experiment in exactly one shard");
+    armscope(&["batch", "merge", shared.to_str().unwrap()]);
+    let merged = read_json(&shared.join("summary.json"));
+    let reference = read_json(&whole.join("summary.json"));
+    let names = |v: &Value| v["experiments"].as_array().unwrap().iter().map(|e| e["name"].as_str().unwrap().to_string()).collect::<Vec<_>>();
+    assert_eq!(names(&merged), names(&reference));
+    for name in names(&reference) {
+        let (m, r) = (experiment(&merged, &name), experiment(&reference, &name));
+        assert_eq!(m["status"], r["status"]);
+        if r["summary"].is_object() {
+            assert_eq!(numbers(&m["summary"]), numbers(&r["summary"]), "{name}");
+        }
+    }
+    assert!(shared.join("comparison.rrd").exists(), "merge builds the comparison recording");
+    // an incomplete set of shards is refused
+    std::fs::remove_file(shared.join("summary.shard-1-of-3.json")).unwrap();
+    assert_eq!(armscope(&["batch", "merge", shared.to_str().unwrap()]), 2);
+}
+
+#[test]
+fn compare_overlays_runs_under_their_own_prefix() {
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b) = (dir.path().join("default.mcap"), dir.path().join("no-ff.mcap"));
+    assert_eq!(armscope(&["run", "--quiet", "--duration", "0.5", "--no-rrd", "--mcap", a.to_str().unwrap()]), 0);
+    assert_eq!(armscope(&["run", "--quiet", "--duration", "0.5", "--no-ff", "--no-rrd", "--mcap", b.to_str().unwrap()]), 0);
+    let out = dir.path().join("cmp.rrd");
+    assert_eq!(armscope(&["compare", a.to_str().unwrap(), b.to_str().unwrap(), "--out", out.to_str().unwrap()]), 0);
+    let listing = std::process::Command::new("bash").arg(repo().join("../shared/viewers/rrd-query.sh")).arg(&out).output().unwrap();
+    let text = String::from_utf8_lossy(&listing.stdout);
+    for entity in ["/default/joints/J2/error", "/no-ff/joints/J2/error", "/default/joints/J5/torque", "/no-ff/joints/J5/angle"] {
+        let line = text.lines().find(|l| l.trim_start().starts_with(&format!("{entity} "))).unwrap_or_else(|| panic!("{entity} missing:\n{text}"));
+        assert!(line.contains("rows=502"), "{line}: one row per step plus the style");
+    }
+    assert!(text.contains("blueprints in file: 1"));
+    // not an armscope recording: a clear error
+    let junk = dir.path().join("junk.mcap");
+    std::fs::write(&junk, b"not an mcap").unwrap();
+    assert_eq!(armscope(&["compare", junk.to_str().unwrap(), "--out", out.to_str().unwrap()]), 2);
+}
