@@ -12,6 +12,7 @@ pub mod error;
 pub mod experiment;
 pub mod gains;
 pub mod integrator;
+pub mod meshgen;
 pub mod model;
 pub mod recorder;
 pub mod runner;

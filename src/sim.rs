@@ -80,14 +80,29 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
     Ok(summary)
 }
 
-/// A state that is not finite, or a joint faster than any real arm moves, is divergence.
+/// Divergence: a state that is not finite, a joint that swept (nearly) its whole range within one
+/// control period (a limited joint banging from limit to limit: the plant's numbers, not physics),
+/// or a joint faster than `--divergence-speed`.
 fn divergence(experiment: &Experiment, q: &[f64], v: &[f64], time: f64) -> Option<RunStatus> {
     let limit = experiment.config.divergence_speed;
-    let bad = (0..q.len()).find(|&i| !q[i].is_finite() || !v[i].is_finite() || v[i].abs() > limit)?;
-    let joint = experiment.model.joints[bad].name.clone();
+    let dt = experiment.config.dt;
+    let joints = &experiment.model.joints;
+    let sweeps = |i: usize| {
+        let range = joints[i].upper - joints[i].lower;
+        range.is_finite() && v[i].abs() * dt >= 0.9 * range
+    };
+    let bad = (0..q.len()).find(|&i| !q[i].is_finite() || !v[i].is_finite() || v[i].abs() > limit || sweeps(i))?;
+    let joint = joints[bad].name.clone();
+    let what = if !q[bad].is_finite() || !v[bad].is_finite() {
+        "is no longer finite".to_string()
+    } else if sweeps(bad) {
+        format!("swept its whole range in one {} ms control period", dt * 1e3)
+    } else {
+        format!("exceeded {limit:.0e} rad/s")
+    };
     let message = format!(
-        "simulation diverged at t = {time:.3} s: joint {joint} reached q = {:.3e}, q̇ = {:.3e} (limit {limit:.0e}); \
-         the discrete plant is unstable for this model and dt, try the continuous plant with --time-step 0",
+        "simulation diverged at t = {time:.3} s: joint {joint} {what} (q = {:.3e}, q̇ = {:.3e}); \
+         the plant is numerically unstable for this model, gains and step: try the continuous plant with --time-step 0",
         q[bad], v[bad]
     );
     Some(RunStatus::Diverged { joint, time, message })

@@ -93,6 +93,13 @@ impl Console {
             e.gains.kd
         )
         .map_err(io)?;
+        if let Some(inertia) = &e.gains.effective_inertia {
+            writeln!(self.out, "  auto-tuned gains (kp = min(effort/0.05, 0.5·(1.5/dt)²·I), kd = 1.6·√(kp·I), I = M_ii at the start pose):").map_err(io)?;
+            writeln!(self.out, "    {:<8}{:>14}{:>12}{:>12}", "joint", "I (kg·m²)", "kp", "kd").map_err(io)?;
+            for (j, joint) in m.joints.iter().enumerate() {
+                writeln!(self.out, "    {:<8}{:>14.4e}{:>12.4}{:>12.5}", joint.name, inertia[j], e.gains.kp[j], e.gains.kd[j]).map_err(io)?;
+            }
+        }
         writeln!(self.out, "  duration {} s ({} steps)", e.config.duration, e.steps).map_err(io)?;
         Ok(())
     }

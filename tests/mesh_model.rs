@@ -1,0 +1,155 @@
+//! The generated SmallRobotArm mesh model: assets in sync with their generator, transmissions,
+//! `package://` meshes, a missing mesh, auto-tuned gains, and the discrete plant's divergence.
+
+mod common;
+
+use armscope::model::load_urdf;
+use common::{armscope, repo};
+use std::process::Command;
+
+fn mesh_urdf() -> std::path::PathBuf {
+    repo().join("assets/smallrobotarm/smallrobotarm.urdf")
+}
+
+#[test]
+fn committed_assets_are_what_the_generator_writes() {
+    let dir = tempfile::tempdir().unwrap();
+    armscope::meshgen::write_smallrobotarm(dir.path()).unwrap();
+    let committed = repo().join("assets/smallrobotarm");
+    assert_eq!(std::fs::read_to_string(dir.path().join("smallrobotarm.urdf")).unwrap(), std::fs::read_to_string(committed.join("smallrobotarm.urdf")).unwrap());
+    for entry in std::fs::read_dir(dir.path().join("meshes")).unwrap() {
+        let name = entry.unwrap().file_name();
+        assert_eq!(std::fs::read(dir.path().join("meshes").join(&name)).unwrap(), std::fs::read(committed.join("meshes").join(&name)).unwrap(), "{name:?}");
+    }
+}
+
+#[test]
+fn mesh_model_has_transmissions_meshes_and_the_tutorials_proportions() {
+    let model = load_urdf(&mesh_urdf()).unwrap();
+    assert!(model.notices.iter().any(|n| n.contains("root link 'base' is not attached to 'world'")));
+    assert_eq!(model.dof(), 6);
+    let motors: Vec<(&str, &str, f64, f64)> = model.actuators.iter().map(|a| (a.name.as_str(), model.joints[a.joint].name.as_str(), a.effort, a.gear_ratio)).collect();
+    assert_eq!(motors, [("motor1", "J1", 100.0, 4.8), ("motor2", "J2", 50.0, 4.0), ("motor3", "J3", 30.0, 5.0), ("motor4", "J4", 20.0, 2.8), ("motor5", "J5", 10.0, 2.1)]);
+    assert!(!model.is_actuated(5), "J6 has no transmission");
+    let total: f64 = model.joints.iter().map(|j| j.inertia.mass).sum::<f64>() + 0.782;
+    assert!((total - 2.27).abs() < 0.01, "total mass {total}");
+    // effective inertias of the distal joints are of the tutorial's order (3e-5 and 6e-6)
+    let gains = armscope::gains::auto_tune(&model, &[0.0; 6], 0.001);
+    let inertia = gains.effective_inertia.unwrap();
+    assert!(inertia[3] > 1e-5 && inertia[3] < 6e-5, "J4 {}", inertia[3]);
+    assert!(inertia[4] > 2e-6 && inertia[4] < 1.2e-5, "J5 {}", inertia[4]);
+    // every visual is a mesh resolved from package://smallrobotarm/…
+    let meshes: Vec<_> = model.frames.iter().flat_map(|f| &f.visuals).collect();
+    assert_eq!(meshes.len(), 7);
+    for v in meshes {
+        match &v.geometry {
+            armscope::model::Geometry::Mesh { path, .. } => assert!(path.is_file() && path.starts_with(repo().join("assets/smallrobotarm/meshes")), "{}", path.display()),
+            other => panic!("not a mesh: {other:?}"),
+        }
+    }
+}
+
+#[test]
+fn relative_and_missing_mesh_paths() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir_all(dir.path().join("parts")).unwrap();
+    std::fs::copy(repo().join("assets/smallrobotarm/meshes/link4.stl"), dir.path().join("parts/arm.stl")).unwrap();
+    let urdf = |mesh: &str| {
+        format!(
+            r#"<robot name="m"><link name="world"/><link name="a"><inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>
+<visual><geometry><mesh filename="{mesh}" scale="2 2 2"/></geometry></visual></link>
+<joint name="J1" type="continuous"><parent link="world"/><child link="a"/><axis xyz="0 0 1"/></joint></robot>"#
+        )
+    };
+    let path = dir.path().join("m.urdf");
+    std::fs::write(&path, urdf("parts/arm.stl")).unwrap();
+    let model = load_urdf(&path).unwrap();
+    assert!(matches!(&model.frames[1].visuals[0].geometry, armscope::model::Geometry::Mesh { scale, .. } if *scale == [2.0; 3]));
+    std::fs::write(&path, urdf("package://m/parts/nothing.stl")).unwrap();
+    let err = load_urdf(&path).unwrap_err().to_string();
+    assert!(err.contains("m.urdf") && err.contains("link 'a'") && err.contains("mesh 'package://m/parts/nothing.stl' not found"), "{err}");
+    let out = Command::new(env!("CARGO_BIN_EXE_armscope")).args(["run", "--urdf", path.to_str().unwrap(), "--no-rrd", "--no-mcap"]).output().unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert_eq!(String::from_utf8_lossy(&out.stderr).lines().count(), 1);
+}
+
+#[test]
+fn transmissions_define_the_actuators_and_bad_ones_are_named() {
+    let model = |extra: &str| {
+        format!(
+            r#"<robot name="t"><link name="world"/><link name="a"><inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>
+<link name="b"><inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>
+<joint name="A" type="revolute"><parent link="world"/><child link="a"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="7" velocity="1"/></joint>
+<joint name="B" type="revolute"><parent link="a"/><child link="b"/><axis xyz="0 1 0"/><limit lower="-1" upper="1" effort="3" velocity="1"/></joint>
+{extra}</robot>"#
+        )
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("t.urdf");
+    std::fs::write(&path, model(r#"<transmission name="tb"><joint name="B"/><actuator name="mb"><mechanicalReduction>3.5</mechanicalReduction></actuator></transmission>"#)).unwrap();
+    let m = load_urdf(&path).unwrap();
+    assert_eq!(m.actuators.len(), 1);
+    assert_eq!((m.actuators[0].name.as_str(), m.actuators[0].joint, m.actuators[0].effort, m.actuators[0].gear_ratio), ("mb", 1, 3.0, 3.5));
+    assert_eq!(m.effort_limits(), [0.0, 3.0], "A has no motor");
+    std::fs::write(&path, model("")).unwrap();
+    assert_eq!(load_urdf(&path).unwrap().actuators.len(), 2, "no transmissions: one actuator per joint");
+    std::fs::write(&path, model(r#"<transmission name="tx"><joint name="Z"/><actuator name="m"/></transmission>"#)).unwrap();
+    let err = load_urdf(&path).unwrap_err().to_string();
+    assert!(err.contains("transmission 'tx'") && err.contains("joint 'Z'"), "{err}");
+}
+
+#[test]
+fn mesh_model_runs_on_the_continuous_plant_with_auto_tuned_gains() {
+    let dir = tempfile::tempdir().unwrap();
+    let json = dir.path().join("s.json");
+    let out = Command::new(env!("CARGO_BIN_EXE_armscope"))
+        .args(["run", "--urdf", mesh_urdf().to_str().unwrap(), "--time-step", "0", "--duration", "2", "--no-rrd", "--no-mcap", "--summary-json", json.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(stdout.contains("auto-tuned gains") && stdout.contains("I (kg·m²)"), "{stdout}");
+    let doc: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(doc["summary"]["status"]["state"], "completed");
+    assert_eq!(doc["gains"]["source"], "auto-tuned");
+    assert_eq!(doc["gains"]["effective_inertia"].as_array().unwrap().len(), 6);
+}
+
+/// The mesh model with motors that are not clipped (no transmissions, `effort="0"`): the
+/// tutorial's gain rule puts the semi-implicit discrete loop of the light wrist joints past
+/// stability (|z| ≈ 1.35 per step for one joint alone); within a few steps the joints bang from
+/// limit to limit, which the loop reports as divergence.
+#[test]
+fn discrete_plant_divergence_is_caught_named_and_the_files_are_finished() {
+    let dir = tempfile::tempdir().unwrap();
+    let (text, meshes) = armscope::meshgen::smallrobotarm();
+    let unclipped: String = text
+        .lines()
+        .filter(|l| !l.contains("transmission") && !l.contains("<type>") && !l.contains("hardwareInterface") && !l.contains("<actuator"))
+        .map(|l| if l.contains("<limit") { l.replace(|_: char| false, "").split(" effort=").next().unwrap().to_string() + " effort=\"0\" velocity=\"3\"/>" } else { l.to_string() })
+        .collect::<Vec<_>>()
+        .join("\n");
+    let pkg = dir.path().join("smallrobotarm");
+    std::fs::create_dir_all(pkg.join("meshes")).unwrap();
+    for (name, bytes) in meshes {
+        std::fs::write(pkg.join("meshes").join(name), bytes).unwrap();
+    }
+    let path = pkg.join("unclipped.urdf");
+    std::fs::write(&path, unclipped).unwrap();
+    let (rrd, mcap) = (dir.path().join("d.rrd"), dir.path().join("d.mcap"));
+    let out = Command::new(env!("CARGO_BIN_EXE_armscope"))
+        .args(["run", "--quiet", "--urdf", path.to_str().unwrap(), "--duration", "5", "--rrd", rrd.to_str().unwrap(), "--mcap", mcap.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(3), "{stderr}");
+    let line = stderr.lines().find(|l| l.contains("diverged")).expect("divergence message");
+    assert!(line.contains("joint J") && line.contains("t = ") && line.contains("--time-step 0"), "{line}");
+    // the recordings are finished up to the divergence
+    let bytes = std::fs::read(&mcap).unwrap();
+    let summary = mcap::Summary::read(&bytes).unwrap().expect("MCAP closed properly");
+    let done = mcap::read::metadata(&bytes, &summary.metadata_indexes[1]).unwrap();
+    assert!(done.metadata["status"].contains("diverged"));
+    assert!(rrd.metadata().unwrap().len() > 0);
+    let _ = armscope;
+}
