@@ -42,6 +42,8 @@ pub struct RunConfig {
     /// Step one joint (number from 1, or name) to `test_angle`.
     pub test_joint: Option<String>,
     pub test_angle: f64,
+    /// Follow this joint schedule (CSV or .npy, `t,q1..qN`).
+    pub trajectory: Option<PathBuf>,
     pub debug: bool,
     /// The link whose origin is the tool tip.
     pub tool: Option<String>,
@@ -74,6 +76,7 @@ impl Default for RunConfig {
             no_gravity: false,
             test_joint: None,
             test_angle: 0.3,
+            trajectory: None,
             debug: false,
             tool: None,
             settle_time: 2.0,

@@ -6,7 +6,7 @@ use crate::error::Error;
 use crate::gains::{Gains, TUTORIAL_KD, TUTORIAL_KP, auto_tune, is_tutorial_model};
 use crate::integrator::{ContinuousPlant, DiscretePlant, Plant, Tolerances};
 use crate::model::{Model, load_urdf};
-use crate::trajectory::{Hold, JointStep, Trajectory, Wave};
+use crate::trajectory::{Hold, JointSchedule, JointStep, Trajectory, Wave};
 use nalgebra::Vector3;
 use std::sync::Arc;
 
@@ -128,6 +128,12 @@ fn plant_spec(config: &RunConfig) -> Result<PlantSpec, Error> {
 }
 
 fn trajectory(config: &RunConfig, model: &Model) -> Result<Box<dyn Trajectory>, Error> {
+    if let Some(path) = &config.trajectory {
+        if config.hold || config.test_joint.is_some() {
+            return Err(Error::flag("--trajectory", "cannot be combined with --static or --test-joint"));
+        }
+        return Ok(Box::new(JointSchedule::load(path, model.dof())?));
+    }
     if let Some(spec) = &config.test_joint {
         if config.hold {
             return Err(Error::flag("--test-joint", "cannot be combined with --static"));

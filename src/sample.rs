@@ -23,6 +23,8 @@ pub struct Sample<'a> {
     /// The joint was stopped at a position limit in the step that led here.
     pub at_limit: &'a [bool],
     pub tool_position: Vector3<f64>,
+    /// Where the command puts the tool (forward kinematics of cmd).
+    pub tool_target: Vector3<f64>,
     /// World pose of every body (joint i moves body i), for drawing.
     pub body_pose: &'a [Pose],
 }

@@ -18,6 +18,8 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
     let n = model.dof();
     let dt = experiment.dt();
     let mut data = Data::new(model);
+    // forward kinematics of the command, for the tool's target
+    let mut command_data = Data::new(model);
     let mut plant = experiment.make_plant();
     let controller = experiment.controller();
     let info = RunInfo { experiment, plant: plant.describe(), trajectory: experiment.trajectory.describe() };
@@ -40,6 +42,7 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
         gravity_and_bias_from_kinematics(model, &mut data, &v);
         experiment.trajectory.sample(t, &mut cmd, &mut cmd_dot);
         controller.compute(&q, &v, &cmd, &cmd_dot, &data.gravity, ControlOutput { u: &mut u, saturated: &mut saturated });
+        forward_kinematics(model, &mut command_data, &cmd);
         let interrupted = stop.is_some_and(|s| s.load(Ordering::Relaxed));
         let sample = Sample {
             k,
@@ -54,6 +57,7 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
             saturated: &saturated,
             at_limit: &at_limit,
             tool_position: frame_pose(model, &data, model.tool_frame).translation,
+            tool_target: frame_pose(model, &command_data, model.tool_frame).translation,
             body_pose: &data.body_pose,
         };
         stats.record(&sample);

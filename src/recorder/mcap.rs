@@ -49,6 +49,8 @@ pub struct ControllerTelemetry {
     pub tau_g: Vec<f64>,
     /// 1 when the controller asked for more than the limit.
     pub saturated: Vec<u8>,
+    /// Distance of the tool tip from where the command puts it, m.
+    pub tool_error: f64,
 }
 
 /// The URDF text (as ROS's std_msgs/String carries it).
@@ -355,6 +357,7 @@ impl Recorder for McapRecorder {
             torque: vec![0.0; n],
             tau_g: vec![0.0; n],
             saturated: vec![0; n],
+            tool_error: 0.0,
         };
         self.scene = scene_from_model(model).map_err(|(path, err)| Error::output(&path, err))?;
 
@@ -417,6 +420,7 @@ impl Recorder for McapRecorder {
         }
         let tel = &mut self.telemetry;
         tel.time = s.t;
+        tel.tool_error = (s.tool_position - s.tool_target).norm();
         for j in 0..s.q.len() {
             tel.target[j] = s.cmd[j];
             tel.error[j] = s.cmd[j] - s.q[j];

@@ -87,6 +87,7 @@ pub struct RerunRecorder {
     times: Vec<f64>,
     joints: Vec<JointColumns>,
     tool: [Vec<f64>; 3],
+    tool_error: Vec<f64>,
     tool_points: Vec<[f32; 3]>,
     links: Vec<MovingLink>,
     trail: VecDeque<[f32; 3]>,
@@ -118,6 +119,7 @@ impl RerunRecorder {
             times: Vec::new(),
             joints: Vec::new(),
             tool: [Vec::new(), Vec::new(), Vec::new()],
+            tool_error: Vec::new(),
             tool_points: Vec::new(),
             links: Vec::new(),
             trail: VecDeque::new(),
@@ -270,6 +272,7 @@ impl RerunRecorder {
             )
             .map_err(e)?;
         }
+        rec.log_static("tool_error", &rerun::SeriesLines::new().with_names(["tool tip error |p − p_cmd| (m)"]).with_colors([rerun::Color::from_rgb(230, 60, 60)])).map_err(e)?;
         Ok(())
     }
 
@@ -318,6 +321,7 @@ impl RerunRecorder {
         for (axis, values) in ["x", "y", "z"].iter().zip(&self.tool) {
             rec.send_columns(format!("tool/{axis}"), [time()], scalars(values).map_err(|x| self.err(x))?).map_err(e)?;
         }
+        rec.send_columns("tool_error", [time()], scalars(&self.tool_error).map_err(|x| self.err(x))?).map_err(e)?;
         rec.send_columns(
             "world/tool/tip",
             [time()],
@@ -346,6 +350,7 @@ impl RerunRecorder {
         for t in &mut self.tool {
             t.clear();
         }
+        self.tool_error.clear();
         self.tool_points.clear();
         for link in &mut self.links {
             link.translations.clear();
@@ -440,8 +445,9 @@ pub fn blueprint(joint_names: &[String], prefix: &str) -> Blueprint {
     let left = Vertical::new([
         Spatial3DView::new("arm").with_origin(format!("{prefix}world")).into(),
         TimeSeriesView::new("tool position").with_origin(format!("{prefix}tool")).into(),
+        TimeSeriesView::new("tool tip error").with_origin(format!("{prefix}tool_error")).into(),
     ])
-    .with_row_shares([3.0, 1.0]);
+    .with_row_shares([4.0, 1.0, 1.0]);
     let right = Vertical::new([
         Grid::new(angle_views).with_grid_columns(columns).with_name("joint angles").into(),
         Grid::new(torque_views).with_grid_columns(columns).with_name("joint torques").into(),
@@ -566,6 +572,7 @@ impl Recorder for RerunRecorder {
         for a in 0..3 {
             self.tool[a].push(p[a]);
         }
+        self.tool_error.push((s.tool_position - s.tool_target).norm());
         let tip = [p.x as f32, p.y as f32, p.z as f32];
         self.tool_points.push(tip);
         for link in &mut self.links {

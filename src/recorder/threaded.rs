@@ -38,6 +38,7 @@ struct SampleBlock {
     saturated: Vec<bool>,
     at_limit: Vec<bool>,
     tool: Vec<Vector3<f64>>,
+    tool_target: Vec<Vector3<f64>>,
     body_pose: Vec<Pose>,
 }
 
@@ -59,6 +60,7 @@ impl SampleBlock {
             saturated: Vec::with_capacity(capacity * n),
             at_limit: Vec::with_capacity(capacity * n),
             tool: Vec::with_capacity(capacity),
+            tool_target: Vec::with_capacity(capacity),
             body_pose: Vec::with_capacity(capacity * bodies),
         }
     }
@@ -77,6 +79,7 @@ impl SampleBlock {
         self.saturated.clear();
         self.at_limit.clear();
         self.tool.clear();
+        self.tool_target.clear();
         self.body_pose.clear();
     }
 
@@ -93,6 +96,7 @@ impl SampleBlock {
         self.saturated.extend_from_slice(s.saturated);
         self.at_limit.extend_from_slice(s.at_limit);
         self.tool.push(s.tool_position);
+        self.tool_target.push(s.tool_target);
         self.body_pose.extend_from_slice(s.body_pose);
     }
 
@@ -111,6 +115,7 @@ impl SampleBlock {
             saturated: &self.saturated[a..b],
             at_limit: &self.at_limit[a..b],
             tool_position: self.tool[i],
+            tool_target: self.tool_target[i],
             body_pose: &self.body_pose[i * self.bodies..(i + 1) * self.bodies],
         }
     }

@@ -1,10 +1,12 @@
 //! Joint commands over time. A new kind of command is one new file implementing [`Trajectory`].
 
 mod hold;
+mod schedule;
 mod step;
 mod wave;
 
 pub use hold::Hold;
+pub use schedule::JointSchedule;
 pub use step::JointStep;
 pub use wave::Wave;
 
