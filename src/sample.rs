@@ -20,6 +20,9 @@ pub struct Sample<'a> {
     pub tau_g: &'a [f64],
     /// The controller asked for more than the motor's limit.
     pub saturated: &'a [bool],
+    /// Chatter: the torque flipped sign since the previous step while at least one of the two was
+    /// saturated (the signature of an unstable sampled loop, not of torque demand).
+    pub chatter: &'a [bool],
     /// The joint was stopped at a position limit in the step that led here.
     pub at_limit: &'a [bool],
     pub tool_position: Vector3<f64>,

@@ -30,6 +30,7 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
     let (mut q, mut v) = experiment.initial_state();
     let (mut cmd, mut cmd_dot, mut u) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
     let mut saturated = vec![false; n];
+    let (mut chatter, mut previous_u, mut previous_saturated) = (vec![false; n], vec![0.0; n], vec![false; n]);
     let mut at_limit = vec![false; n];
     let joint_names: Vec<String> = model.joints.iter().map(|j| j.name.clone()).collect();
     let mut stats = SummaryBuilder::new(joint_names, controller.effort.clone(), dt, experiment.config.settle_time);
@@ -42,6 +43,11 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
         gravity_and_bias_from_kinematics(model, &mut data, &v);
         experiment.trajectory.sample(t, &mut cmd, &mut cmd_dot);
         controller.compute(&q, &v, &cmd, &cmd_dot, &data.gravity, ControlOutput { u: &mut u, saturated: &mut saturated });
+        for i in 0..n {
+            chatter[i] = k > 0 && u[i] * previous_u[i] < 0.0 && (saturated[i] || previous_saturated[i]);
+            previous_u[i] = u[i];
+            previous_saturated[i] = saturated[i];
+        }
         forward_kinematics(model, &mut command_data, &cmd);
         let interrupted = stop.is_some_and(|s| s.load(Ordering::Relaxed));
         let sample = Sample {
@@ -55,6 +61,7 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
             u: &u,
             tau_g: &data.gravity,
             saturated: &saturated,
+            chatter: &chatter,
             at_limit: &at_limit,
             tool_position: frame_pose(model, &data, model.tool_frame).translation,
             tool_target: frame_pose(model, &command_data, model.tool_frame).translation,

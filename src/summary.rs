@@ -42,6 +42,9 @@ pub struct Summary {
     pub rms_error: Vec<Option<f64>>,
     /// Share of control steps where the controller asked for more than the limit, %.
     pub saturation_percent: Vec<f64>,
+    /// Share of steps whose torque flipped sign from the previous step with one of the two
+    /// saturated, %. Close to the saturation share: the saturation is numerical chatter.
+    pub chatter_percent: Vec<f64>,
     pub peak_abs_torque: Vec<f64>,
     pub effort_limit: Vec<f64>,
     /// Steps at which the joint was stopped at a position limit.
@@ -60,6 +63,7 @@ pub struct SummaryBuilder {
     sum_sq_err: Vec<f64>,
     window_samples: u64,
     saturated_steps: Vec<u64>,
+    chatter_steps: Vec<u64>,
     control_steps: u64,
     peak_torque: Vec<f64>,
     effort: Vec<f64>,
@@ -81,6 +85,7 @@ impl SummaryBuilder {
             sum_sq_err: vec![0.0; n],
             window_samples: 0,
             saturated_steps: vec![0; n],
+            chatter_steps: vec![0; n],
             control_steps: 0,
             peak_torque: vec![0.0; n],
             effort,
@@ -105,6 +110,7 @@ impl SummaryBuilder {
             self.control_steps += 1;
             for i in 0..n {
                 self.saturated_steps[i] += s.saturated[i] as u64;
+                self.chatter_steps[i] += s.chatter[i] as u64;
                 self.peak_torque[i] = self.peak_torque[i].max(s.u[i].abs());
             }
         }
@@ -139,11 +145,37 @@ impl SummaryBuilder {
                 .iter()
                 .map(|&c| if self.control_steps == 0 { 0.0 } else { 100.0 * c as f64 / self.control_steps as f64 })
                 .collect(),
+            chatter_percent: self
+                .chatter_steps
+                .iter()
+                .map(|&c| if self.control_steps == 0 { 0.0 } else { 100.0 * c as f64 / self.control_steps as f64 })
+                .collect(),
             peak_abs_torque: self.peak_torque.clone(),
             effort_limit: self.effort.clone(),
             limit_hits: self.limit_hits.clone(),
             tool_range: ToolRange { x: range(0), y: range(1), z: range(2) },
             wall_time,
         }
+    }
+}
+
+impl Summary {
+    /// In words, per joint that saturates noticeably: real torque demand or numerical chatter.
+    pub fn saturation_verdicts(&self) -> Vec<String> {
+        let mut out = Vec::new();
+        for (j, name) in self.joints.iter().enumerate() {
+            let (sat, chat) = (self.saturation_percent[j], self.chatter_percent[j]);
+            if sat < 2.0 {
+                continue;
+            }
+            if chat >= 0.5 * sat {
+                out.push(format!(
+                    "{name}: saturated {sat:.0}% of steps, and the torque flips sign on {chat:.0}% — mostly numerical chatter (the sampled loop is unstable), not torque demand; `armscope analyze` finds stable gains"
+                ));
+            } else {
+                out.push(format!("{name}: saturated {sat:.0}% of steps with little chatter ({chat:.0}%) — real torque demand beyond the motor's limit"));
+            }
+        }
+        out
     }
 }

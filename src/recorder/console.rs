@@ -146,6 +146,7 @@ pub fn write_summary(out: &mut dyn Write, s: &Summary) -> std::io::Result<()> {
     )?;
     writeln!(out, "{}", row("RMS error (rad)", s.rms_error.iter().map(opt).collect()))?;
     writeln!(out, "{}", row("saturation (%)", s.saturation_percent.iter().map(|p| format!("{p:.1}")).collect()))?;
+    writeln!(out, "{}", row("chatter (%)", s.chatter_percent.iter().map(|p| format!("{p:.1}")).collect()))?;
     writeln!(out, "{}", row("peak |u| (N·m)", s.peak_abs_torque.iter().map(|p| format!("{p:.3}")).collect()))?;
     writeln!(out, "{}", row("effort limit (N·m)", s.effort_limit.iter().map(|p| format!("{p}")).collect()))?;
     writeln!(out, "{}", row("limit hits (steps)", s.limit_hits.iter().map(|p| format!("{p}")).collect()))?;
@@ -155,5 +156,8 @@ pub fn write_summary(out: &mut dyn Write, s: &Summary) -> std::io::Result<()> {
         "  tool range: x [{:.3}, {:.3}]  y [{:.3}, {:.3}]  z [{:.3}, {:.3}] m",
         r.x.min, r.x.max, r.y.min, r.y.max, r.z.min, r.z.max
     )?;
+    for verdict in s.saturation_verdicts() {
+        writeln!(out, "  {verdict}")?;
+    }
     out.flush()
 }

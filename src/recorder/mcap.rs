@@ -49,6 +49,8 @@ pub struct ControllerTelemetry {
     pub tau_g: Vec<f64>,
     /// 1 when the controller asked for more than the limit.
     pub saturated: Vec<u8>,
+    /// 1 when the torque flipped sign since the last step with one of the two saturated (chatter).
+    pub chatter: Vec<u8>,
     /// Distance of the tool tip from where the command puts it, m.
     pub tool_error: f64,
 }
@@ -357,6 +359,7 @@ impl Recorder for McapRecorder {
             torque: vec![0.0; n],
             tau_g: vec![0.0; n],
             saturated: vec![0; n],
+            chatter: vec![0; n],
             tool_error: 0.0,
         };
         self.scene = scene_from_model(model).map_err(|(path, err)| Error::output(&path, err))?;
@@ -427,6 +430,7 @@ impl Recorder for McapRecorder {
             tel.torque[j] = s.u[j];
             tel.tau_g[j] = s.tau_g[j];
             tel.saturated[j] = s.saturated[j] as u8;
+            tel.chatter[j] = s.chatter[j] as u8;
         }
         let tool = self.frame_world[self.tool_frame];
         let path = &self.path;

@@ -44,6 +44,7 @@ struct JointColumns {
     torque: Vec<f64>,
     gravity_torque: Vec<f64>,
     saturated: Vec<f64>,
+    chatter: Vec<f64>,
     saturated_times: Vec<f64>,
     saturated_torque: Vec<f64>,
 }
@@ -58,13 +59,14 @@ impl JointColumns {
             torque: v(),
             gravity_torque: v(),
             saturated: v(),
+            chatter: v(),
             saturated_times: Vec::new(),
             saturated_torque: Vec::new(),
         }
     }
 
     fn clear(&mut self) {
-        for c in [&mut self.angle, &mut self.target, &mut self.error, &mut self.torque, &mut self.gravity_torque, &mut self.saturated, &mut self.saturated_times, &mut self.saturated_torque] {
+        for c in [&mut self.angle, &mut self.target, &mut self.error, &mut self.torque, &mut self.gravity_torque, &mut self.saturated, &mut self.chatter, &mut self.saturated_times, &mut self.saturated_torque] {
             c.clear();
         }
     }
@@ -252,6 +254,7 @@ impl RerunRecorder {
             rec.log_static(format!("{base}/torque"), &line(&format!("{name} torque (N·m)"), c, 1.5)).map_err(e)?;
             rec.log_static(format!("{base}/gravity_torque"), &line(&format!("{name} τ_g (N·m)"), rerun::Color::from_rgb(90, 170, 90), 1.0)).map_err(e)?;
             rec.log_static(format!("{base}/saturated"), &line(&format!("{name} saturated (0/1)"), rerun::Color::from_rgb(220, 50, 50), 1.0)).map_err(e)?;
+            rec.log_static(format!("{base}/chatter"), &line(&format!("{name} chatter (0/1)"), rerun::Color::from_rgb(240, 160, 40), 1.0)).map_err(e)?;
             for side in ["upper", "lower"] {
                 rec.log_static(format!("{base}/torque_limit/{side}"), &line(&format!("{name} ±effort"), rerun::Color::from_rgb(220, 50, 50), 1.0)).map_err(e)?;
             }
@@ -294,6 +297,7 @@ impl RerunRecorder {
                 ("torque", &c.torque),
                 ("gravity_torque", &c.gravity_torque),
                 ("saturated", &c.saturated),
+                ("chatter", &c.chatter),
             ] {
                 rec.send_columns(format!("{base}/{leaf}"), [time()], scalars(values).map_err(|x| self.err(x))?).map_err(e)?;
             }
@@ -563,6 +567,7 @@ impl Recorder for RerunRecorder {
             c.torque.push(s.u[j]);
             c.gravity_torque.push(s.tau_g[j]);
             c.saturated.push(if s.saturated[j] { 1.0 } else { 0.0 });
+            c.chatter.push(if s.chatter[j] { 1.0 } else { 0.0 });
             if s.saturated[j] {
                 c.saturated_times.push(s.t);
                 c.saturated_torque.push(s.u[j]);

@@ -36,6 +36,7 @@ struct SampleBlock {
     u: Vec<f64>,
     tau_g: Vec<f64>,
     saturated: Vec<bool>,
+    chatter: Vec<bool>,
     at_limit: Vec<bool>,
     tool: Vec<Vector3<f64>>,
     tool_target: Vec<Vector3<f64>>,
@@ -58,6 +59,7 @@ impl SampleBlock {
             u: f(),
             tau_g: f(),
             saturated: Vec::with_capacity(capacity * n),
+            chatter: Vec::with_capacity(capacity * n),
             at_limit: Vec::with_capacity(capacity * n),
             tool: Vec::with_capacity(capacity),
             tool_target: Vec::with_capacity(capacity),
@@ -77,6 +79,7 @@ impl SampleBlock {
             v.clear();
         }
         self.saturated.clear();
+        self.chatter.clear();
         self.at_limit.clear();
         self.tool.clear();
         self.tool_target.clear();
@@ -94,6 +97,7 @@ impl SampleBlock {
         self.u.extend_from_slice(s.u);
         self.tau_g.extend_from_slice(s.tau_g);
         self.saturated.extend_from_slice(s.saturated);
+        self.chatter.extend_from_slice(s.chatter);
         self.at_limit.extend_from_slice(s.at_limit);
         self.tool.push(s.tool_position);
         self.tool_target.push(s.tool_target);
@@ -113,6 +117,7 @@ impl SampleBlock {
             u: &self.u[a..b],
             tau_g: &self.tau_g[a..b],
             saturated: &self.saturated[a..b],
+            chatter: &self.chatter[a..b],
             at_limit: &self.at_limit[a..b],
             tool_position: self.tool[i],
             tool_target: self.tool_target[i],

@@ -1,0 +1,168 @@
+//! Stability of the sampled closed loop: the controller at period h holding its torque, the plant
+//! advancing the state, linearized about a pose held still (cmd = q*, v = 0, saturation ignored).
+//!
+//! Discrete plant (Drake's update): with δq, v the state and G = ∂τ_g/∂q,
+//!   v₁ = (M + hD)⁻¹ [ (M − h·Kd) v₀ + h(−Kp + (1 − ff)·G) δq₀ ],   δq₁ = δq₀ + h v₁.
+//! Continuous plant: ẋ = [[0, I], [M⁻¹G, −M⁻¹D]] x + [[0], [M⁻¹]] u with u = −(Kp + ff·G) δq − Kd v held
+//! over h, discretized exactly (matrix exponential).
+
+use crate::dynamics::{Data, crba, gravity_forces};
+use crate::model::Model;
+use nalgebra::{DMatrix, DVector};
+use serde::Serialize;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum LoopPlant {
+    Discrete,
+    Continuous,
+}
+
+/// Everything the linearization needs at one pose.
+pub struct Linearization {
+    pub mass: DMatrix<f64>,
+    pub gravity_stiffness: DMatrix<f64>,
+    pub damping: DVector<f64>,
+}
+
+impl Linearization {
+    pub fn at(model: &Model, q: &[f64]) -> Self {
+        let n = model.dof();
+        let mut data = Data::new(model);
+        let mass = crba(model, &mut data, q).clone();
+        let eps = 1e-6;
+        let mut gravity_stiffness = DMatrix::zeros(n, n);
+        let mut qp = q.to_vec();
+        for j in 0..n {
+            qp[j] = q[j] + eps;
+            let plus = gravity_forces(model, &mut data, &qp).to_vec();
+            qp[j] = q[j] - eps;
+            let minus = gravity_forces(model, &mut data, &qp).to_vec();
+            qp[j] = q[j];
+            for i in 0..n {
+                gravity_stiffness[(i, j)] = (plus[i] - minus[i]) / (2.0 * eps);
+            }
+        }
+        Self { mass, gravity_stiffness, damping: DVector::from_iterator(n, model.joints.iter().map(|j| j.damping)) }
+    }
+
+    /// The one-period transition matrix of the closed loop (state δq, v).
+    pub fn closed_loop(&self, kp: &[f64], kd: &[f64], h: f64, feed_forward: bool, plant: LoopPlant) -> DMatrix<f64> {
+        let n = kp.len();
+        let (m, g) = (&self.mass, &self.gravity_stiffness);
+        let kp_m = DMatrix::from_diagonal(&DVector::from_column_slice(kp));
+        let kd_m = DMatrix::from_diagonal(&DVector::from_column_slice(kd));
+        let d_m = DMatrix::from_diagonal(&self.damping);
+        let ff = if feed_forward { 1.0 } else { 0.0 };
+        let mut a = DMatrix::zeros(2 * n, 2 * n);
+        match plant {
+            LoopPlant::Discrete => {
+                let lhs = m + &d_m * h;
+                let inv = lhs.try_inverse().expect("M + hD is positive definite");
+                let b_q = &inv * ((-&kp_m + g * (1.0 - ff)) * h);
+                let b_v = &inv * (m - &kd_m * h);
+                a.view_mut((0, 0), (n, n)).copy_from(&(DMatrix::identity(n, n) + &b_q * h));
+                a.view_mut((0, n), (n, n)).copy_from(&(&b_v * h));
+                a.view_mut((n, 0), (n, n)).copy_from(&b_q);
+                a.view_mut((n, n), (n, n)).copy_from(&b_v);
+            }
+            LoopPlant::Continuous => {
+                let m_inv = m.clone().try_inverse().expect("M is positive definite");
+                // augmented [[A, B], [0, 0]] so that exp(·h) = [[Φ, Γ], [0, I]]
+                let mut aug = DMatrix::zeros(3 * n, 3 * n);
+                aug.view_mut((0, n), (n, n)).copy_from(&DMatrix::identity(n, n));
+                aug.view_mut((n, 0), (n, n)).copy_from(&(&m_inv * g));
+                aug.view_mut((n, n), (n, n)).copy_from(&(-(&m_inv * &d_m)));
+                aug.view_mut((n, 2 * n), (n, n)).copy_from(&m_inv);
+                let e = (aug * h).exp();
+                let phi = e.view((0, 0), (2 * n, 2 * n)).into_owned();
+                let gamma = e.view((0, 2 * n), (2 * n, n)).into_owned();
+                let mut k = DMatrix::zeros(n, 2 * n);
+                k.view_mut((0, 0), (n, n)).copy_from(&(-(kp_m + g * ff)));
+                k.view_mut((0, n), (n, n)).copy_from(&(-kd_m));
+                a = phi + gamma * k;
+            }
+        }
+        a
+    }
+}
+
+/// The largest eigenvalue magnitude, and per joint its share of the dominant mode.
+pub fn spectral_radius(a: &DMatrix<f64>) -> (f64, Vec<f64>) {
+    let n = a.nrows() / 2;
+    let eig = a.clone().complex_eigenvalues();
+    let (mut rho, mut dominant) = (0.0, nalgebra::Complex::new(0.0, 0.0));
+    for z in eig.iter() {
+        if z.norm() > rho {
+            rho = z.norm();
+            dominant = *z;
+        }
+    }
+    // the dominant mode's shape: null vector of (A − λI) by inverse iteration (complex)
+    let c = a.map(|x| nalgebra::Complex::new(x, 0.0)) - DMatrix::<nalgebra::Complex<f64>>::identity(2 * n, 2 * n) * (dominant * nalgebra::Complex::new(1.0 + 1e-9, 0.0));
+    let mut v = DVector::from_element(2 * n, nalgebra::Complex::new(1.0, 0.0));
+    if let Some(lu) = Some(c.lu()) {
+        for _ in 0..4 {
+            if let Some(next) = lu.solve(&v) {
+                let norm = next.norm();
+                if norm > 0.0 && norm.is_finite() {
+                    v = next / nalgebra::Complex::new(norm, 0.0);
+                }
+            }
+        }
+    }
+    let weights: Vec<f64> = (0..n).map(|j| v[j].norm_sqr() + v[n + j].norm_sqr() / (1.0 + v[n + j].norm_sqr())).collect();
+    let total: f64 = weights.iter().sum::<f64>().max(f64::MIN_POSITIVE);
+    (rho, weights.iter().map(|w| w / total).collect())
+}
+
+/// The largest control period ≤ `h_max` for which the loop is stable (bisection after a
+/// logarithmic scan from 1 µs), or None when even 1 µs is unstable.
+pub fn largest_stable_period(lin: &Linearization, kp: &[f64], kd: &[f64], h_max: f64, ff: bool, plant: LoopPlant) -> Option<f64> {
+    let stable = |h: f64| spectral_radius(&lin.closed_loop(kp, kd, h, ff, plant)).0 < 1.0;
+    let mut h = 1e-6;
+    if !stable(h) {
+        return None;
+    }
+    if stable(h_max) {
+        return Some(h_max);
+    }
+    let mut hi = h;
+    while hi < h_max && stable(hi) {
+        h = hi;
+        hi = (hi * 1.25).min(h_max);
+    }
+    let mut lo = h;
+    for _ in 0..40 {
+        let mid = 0.5 * (lo + hi);
+        if stable(mid) { lo = mid } else { hi = mid }
+    }
+    Some(lo)
+}
+
+/// Derivative gains that make the loop stable at `h` with the given kp: per joint, the kd
+/// (scaled from the given one by factors from 1/1000 to 4) that most lowers the spectral radius,
+/// in repeated sweeps. Returns the gains and the radius they reach.
+pub fn stabilizing_kd(lin: &Linearization, kp: &[f64], kd: &[f64], h: f64, ff: bool, plant: LoopPlant) -> (Vec<f64>, f64) {
+    let mut best = kd.to_vec();
+    let mut rho = spectral_radius(&lin.closed_loop(kp, &best, h, ff, plant)).0;
+    let factors: Vec<f64> = (0..=40).map(|i| 10f64.powf(-3.0 + 3.6 * i as f64 / 40.0)).collect();
+    for _sweep in 0..4 {
+        for j in 0..kd.len() {
+            if kd[j] == 0.0 && kp[j] == 0.0 {
+                continue;
+            }
+            let base = if kd[j] > 0.0 { kd[j] } else { 1e-3 };
+            for f in &factors {
+                let mut trial = best.clone();
+                trial[j] = base * f;
+                let r = spectral_radius(&lin.closed_loop(kp, &trial, h, ff, plant)).0;
+                if r < rho - 1e-12 {
+                    rho = r;
+                    best = trial;
+                }
+            }
+        }
+    }
+    (best, rho)
+}

@@ -1,0 +1,87 @@
+//! Telling torque demand from numerical chatter: the chatter statistic against Drake's reference
+//! run, and `armscope analyze` against the reference README (spectral radius ≈ 3.58 at q = 0 with
+//! the tutorial's gains at 1 kHz; stable at 10 kHz), with its suggested gains run for real.
+
+mod common;
+
+use common::{armscope, read_csv_gz, reference};
+use serde_json::Value;
+use std::process::Command;
+
+const EFFORT: [f64; 6] = [8.0, 12.0, 8.0, 5.0, 3.0, 1.5];
+
+/// Chatter % computed from a per-step table of torques, by the definition in the summary.
+fn chatter_percent(u: &[Vec<f64>]) -> Vec<f64> {
+    let steps = u.len();
+    (0..6)
+        .map(|j| {
+            let flips = (1..steps)
+                .filter(|&k| u[k][j] * u[k - 1][j] < 0.0 && (u[k][j].abs() == EFFORT[j] || u[k - 1][j].abs() == EFFORT[j]))
+                .count();
+            100.0 * flips as f64 / steps as f64
+        })
+        .collect()
+}
+
+#[test]
+fn chatter_on_the_reference_default_run_is_at_least_90_percent_on_j2_to_j5_and_zero_on_j1() {
+    let table = read_csv_gz(&reference("steps/default_10s_clean.csv.gz"));
+    let u: Vec<Vec<f64>> = table.rows.iter().filter(|r| r[table.col("u1")].is_finite()).map(|r| (1..=6).map(|j| r[table.col(&format!("u{j}"))]).collect()).collect();
+    let reference_chatter = chatter_percent(&u);
+    assert!(reference_chatter[0] < 0.5, "J1 {reference_chatter:?}");
+    for j in 1..5 {
+        assert!(reference_chatter[j] >= 90.0, "J{} {reference_chatter:?}", j + 1);
+    }
+    // armscope's own statistic on the same run agrees with the one computed from Drake's torques
+    let dir = tempfile::tempdir().unwrap();
+    let json = dir.path().join("s.json");
+    assert_eq!(armscope(&["run", "--quiet", "--duration", "10", "--summary-json", json.to_str().unwrap()]), 0);
+    let doc: Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    for j in 0..6 {
+        let ours = doc["summary"]["chatter_percent"][j].as_f64().unwrap();
+        assert!((ours - reference_chatter[j]).abs() < 0.5, "J{}: {ours} vs Drake's {}", j + 1, reference_chatter[j]);
+    }
+    // and the console says what it is
+    let out = Command::new(env!("CARGO_BIN_EXE_armscope")).args(["run", "--duration", "4", "--no-rrd", "--no-mcap"]).current_dir(common::repo()).output().unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("chatter (%)"), "{text}");
+    assert!(text.contains("J3: saturated") && text.contains("mostly numerical chatter"), "{text}");
+}
+
+fn analyze(args: &[&str]) -> Value {
+    let out = Command::new(env!("CARGO_BIN_EXE_armscope")).arg("analyze").args(args).arg("--json").current_dir(common::repo()).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+#[test]
+fn analyze_reports_the_reference_spectral_radius_and_stability() {
+    let at_1khz = analyze(&[]);
+    let rho = at_1khz["spectral_radius"].as_f64().unwrap();
+    assert!((rho - 3.58).abs() <= 0.05, "spectral radius {rho}");
+    assert_eq!(at_1khz["stable"], false);
+    // the wrist joints drive it
+    let p = &at_1khz["participation"];
+    assert!(p["J5"].as_f64().unwrap() + p["J4"].as_f64().unwrap() > 0.5, "{p}");
+    let largest = at_1khz["largest_stable_dt"].as_f64().unwrap();
+    assert!(largest > 1e-4 && largest < 1e-3, "largest stable dt {largest}");
+    let at_10khz = analyze(&["--dt", "0.0001"]);
+    assert_eq!(at_10khz["stable"], true, "{at_10khz}");
+    assert!(at_10khz["spectral_radius"].as_f64().unwrap() < 1.0);
+}
+
+#[test]
+fn analyze_suggested_gains_run_without_chatter() {
+    let doc = analyze(&[]);
+    assert!(doc["stable_kd_spectral_radius"].as_f64().unwrap() < 1.0);
+    let kd: Vec<String> = doc["stable_kd"].as_array().unwrap().iter().map(|k| format!("{}", k.as_f64().unwrap())).collect();
+    let dir = tempfile::tempdir().unwrap();
+    let json = dir.path().join("s.json");
+    let kd = kd.join(",");
+    assert_eq!(armscope(&["run", "--quiet", "--duration", "10", "--kd", &kd, "--summary-json", json.to_str().unwrap()]), 0);
+    let s: Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    for j in 0..6 {
+        let chatter = s["summary"]["chatter_percent"][j].as_f64().unwrap();
+        assert!(chatter < 0.1, "J{} chatter {chatter}% with kd {kd}", j + 1);
+    }
+}
