@@ -87,12 +87,17 @@ impl Linearization {
     }
 }
 
-/// The largest eigenvalue magnitude, and per joint its share of the dominant mode.
+/// The largest eigenvalue magnitude, and per joint its share of the dominant mode. Eigenvalues at
+/// z = 1 are left out: they are the neutral rigid-body modes of joints without motor or damping
+/// (a free joint drifts, it does not blow up); they show as a defective pair split by ~√ε.
 pub fn spectral_radius(a: &DMatrix<f64>) -> (f64, Vec<f64>) {
     let n = a.nrows() / 2;
     let eig = a.clone().complex_eigenvalues();
     let (mut rho, mut dominant) = (0.0, nalgebra::Complex::new(0.0, 0.0));
     for z in eig.iter() {
+        if (z - nalgebra::Complex::new(1.0, 0.0)).norm() < 1e-6 {
+            continue;
+        }
         if z.norm() > rho {
             rho = z.norm();
             dominant = *z;
