@@ -467,12 +467,7 @@ pub fn batch(args: &BatchArgs) -> Result<i32, Error> {
             let dir = out.clone().unwrap_or_else(|| dirs[0].clone());
             std::fs::create_dir_all(&dir).map_err(|e| Error::output(&dir, e))?;
             let mut files = write_tables(&dir, &merged)?;
-            let runs: Vec<crate::batch::ComparedRun> = merged
-                .experiments
-                .iter()
-                .filter(|e| e.summary.is_some())
-                .filter_map(|e| dirs.iter().map(|d| d.join(format!("{}.mcap", e.name))).find(|p| p.exists()).map(|mcap| crate::batch::ComparedRun { label: e.name.clone(), mcap }))
-                .collect();
+            let runs = crate::batch::compared_runs(&merged, dirs);
             if !runs.is_empty() {
                 let rrd = dir.join("comparison.rrd");
                 crate::batch::build_comparison(&runs, &rrd, &merged.batch)?;
@@ -597,10 +592,7 @@ pub fn analyze(args: &AnalyzeArgs) -> Result<i32, Error> {
     if pose.len() != n || pose.iter().any(|x| !x.is_finite()) {
         return Err(Error::flag("--pose", format!("expected {n} finite angles, one per joint")));
     }
-    // the controller's effective gains: zero on joints without a motor
-    let controller = experiment.controller();
-    let kp: Vec<f64> = (0..n).map(|j| if controller.actuated[j] { controller.kp[j] } else { 0.0 }).collect();
-    let kd: Vec<f64> = (0..n).map(|j| if controller.actuated[j] { controller.kd[j] } else { 0.0 }).collect();
+    let (kp, kd) = experiment.controller().effective_gains();
     let ff = !args.no_ff;
     let lin = Linearization::at(model, &pose);
     let h = args.dt;
@@ -674,11 +666,11 @@ pub fn envelope(args: &EnvelopeArgs) -> Result<i32, Error> {
     let model = with_payload(crate::model::load_urdf(&args.urdf)?, args.payload);
     let mut config = RunConfig { urdf: args.urdf.clone(), dt: args.dt, kp: args.kp.clone(), kd: args.kd.clone(), ..RunConfig::default() };
     let probe = Experiment::with_model(config.clone(), model.clone())?;
-    let controller = probe.controller();
+    let (kp, kd) = probe.controller().effective_gains();
     let lin = Linearization::at(&model, &vec![0.0; model.dof()]);
-    let (rho, _) = spectral_radius(&lin.closed_loop(&controller.kp, &controller.kd, args.dt, true, LoopPlant::Discrete));
+    let (rho, _) = spectral_radius(&lin.closed_loop(&kp, &kd, args.dt, true, LoopPlant::Discrete));
     if args.kd.is_none() && rho >= 1.0 {
-        let (kd, stable) = stabilizing_kd(&lin, &controller.kp, &controller.kd, args.dt, true, LoopPlant::Discrete);
+        let (kd, stable) = stabilizing_kd(&lin, &kp, &kd, args.dt, true, LoopPlant::Discrete);
         println!("gains {} are unstable at dt = {} ms (spectral radius {rho:.2}); using kd = {kd:.4?} (spectral radius {stable:.3})", probe.gains.source, args.dt * 1e3);
         config.kd = Some(kd);
     } else if rho >= 1.0 {

@@ -22,6 +22,12 @@ pub struct ControlOutput<'a> {
 }
 
 impl PdGravityController {
+    /// The gains as the loop sees them: zero on joints without a motor.
+    pub fn effective_gains(&self) -> (Vec<f64>, Vec<f64>) {
+        let keep = |g: &[f64]| g.iter().zip(&self.actuated).map(|(g, &a)| if a { *g } else { 0.0 }).collect();
+        (keep(&self.kp), keep(&self.kd))
+    }
+
     #[allow(clippy::too_many_arguments)]
     pub fn compute(&self, q: &[f64], v: &[f64], cmd: &[f64], cmd_dot: &[f64], tau_g: &[f64], out: ControlOutput) {
         for i in 0..q.len() {

@@ -91,6 +91,23 @@ impl Experiment {
     pub fn dt(&self) -> f64 {
         self.config.dt
     }
+
+    /// Where the command puts the tool over the run (forward kinematics of the command), sampled
+    /// every `interval` seconds: the shape the recordings draw as the commanded path.
+    pub fn commanded_tool_path(&self, interval: f64) -> Vec<Vector3<f64>> {
+        let model = &*self.model;
+        let n = model.dof();
+        let mut data = crate::dynamics::Data::new(model);
+        let (mut cmd, mut cmd_dot) = (vec![0.0; n], vec![0.0; n]);
+        let samples = (self.config.duration / interval).ceil() as usize;
+        (0..=samples)
+            .map(|i| {
+                self.trajectory.sample((i as f64 * interval).min(self.config.duration), &mut cmd, &mut cmd_dot);
+                crate::dynamics::forward_kinematics(model, &mut data, &cmd);
+                crate::dynamics::frame_pose(model, &data, model.tool_frame).translation
+            })
+            .collect()
+    }
 }
 
 fn plant_spec(config: &RunConfig) -> Result<PlantSpec, Error> {

@@ -22,7 +22,12 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
     let mut command_data = Data::new(model);
     let mut plant = experiment.make_plant();
     let controller = experiment.controller();
-    let info = RunInfo { experiment, plant: plant.describe(), trajectory: experiment.trajectory.describe() };
+    let info = RunInfo {
+        experiment,
+        plant: plant.describe(),
+        trajectory: experiment.trajectory.describe(),
+        commanded_tool_path: if recorders.is_empty() { Vec::new() } else { experiment.commanded_tool_path(0.01) },
+    };
     for r in recorders.iter_mut() {
         r.start(&info)?;
     }

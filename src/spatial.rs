@@ -49,6 +49,12 @@ impl Pose {
         self.translation + self.rotation * p
     }
 
+    /// The rotation as a unit quaternion [x, y, z, w].
+    pub fn quaternion_xyzw(&self) -> [f64; 4] {
+        let q = nalgebra::UnitQuaternion::from_rotation_matrix(&nalgebra::Rotation3::from_matrix_unchecked(self.rotation));
+        [q.i, q.j, q.k, q.w]
+    }
+
     pub fn inverse(&self) -> Pose {
         let rt = self.rotation.transpose();
         Pose { rotation: rt, translation: -(rt * self.translation) }

@@ -6,7 +6,6 @@
 //! file directly (the SDK's sink machinery costs more per message than the encoding itself).
 
 use super::{Recorder, RunInfo};
-use crate::dynamics::{Data, forward_kinematics, frame_pose};
 use crate::error::Error;
 use crate::model::{Geometry, Model};
 use crate::sample::Sample;
@@ -18,7 +17,6 @@ use foxglove::messages::{
 };
 use foxglove::Encode;
 use mcap::records::MessageHeader;
-use nalgebra::{Rotation3, UnitQuaternion};
 use schemars::JsonSchema;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -219,8 +217,8 @@ fn vec3(v: &nalgebra::Vector3<f64>) -> Vector3 {
 }
 
 fn quaternion(pose: &Pose) -> Quaternion {
-    let q = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(pose.rotation));
-    Quaternion { x: q.i, y: q.j, z: q.k, w: q.w }
+    let [x, y, z, w] = pose.quaternion_xyzw();
+    Quaternion { x, y, z, w }
 }
 
 fn fox_pose(pose: &Pose) -> foxglove::messages::Pose {
@@ -371,18 +369,7 @@ impl Recorder for McapRecorder {
             let (out, ch) = (self.out.as_mut().unwrap(), self.channels.as_mut().unwrap());
             out.log(&mut ch.robot_description, &RobotDescription { data: model.urdf_text.clone() }, t0).map_err(fail)?;
         }
-        // the commanded tool path, from forward kinematics of the command
-        let mut data = Data::new(model);
-        let (mut cmd, mut cmd_dot) = (vec![0.0; n], vec![0.0; n]);
-        let samples = (e.config.duration / 0.01).ceil() as usize;
-        let points: Vec<Point3> = (0..=samples)
-            .map(|i| {
-                e.trajectory.sample((i as f64 * 0.01).min(e.config.duration), &mut cmd, &mut cmd_dot);
-                forward_kinematics(model, &mut data, &cmd);
-                let p = frame_pose(model, &data, model.tool_frame).translation;
-                Point3 { x: p.x, y: p.y, z: p.z }
-            })
-            .collect();
+        let points: Vec<Point3> = run.commanded_tool_path.iter().map(|p| Point3 { x: p.x, y: p.y, z: p.z }).collect();
         let commanded = SceneEntity {
             timestamp: Some(self.timestamp(0.0)),
             frame_id: "world".into(),

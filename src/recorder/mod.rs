@@ -30,6 +30,8 @@ pub struct RunInfo<'a> {
     /// One line each, for humans and for the recordings' configuration.
     pub plant: String,
     pub trajectory: String,
+    /// The commanded tool path, every 10 ms (computed once for all recorders).
+    pub commanded_tool_path: Vec<nalgebra::Vector3<f64>>,
 }
 
 pub trait Recorder {

@@ -394,8 +394,7 @@ fn transform(pose: &Pose) -> rerun::Transform3D {
 }
 
 fn quaternion(pose: &Pose) -> rerun::Quaternion {
-    let q = nalgebra::UnitQuaternion::from_rotation_matrix(&nalgebra::Rotation3::from_matrix_unchecked(pose.rotation));
-    rerun::Quaternion::from_xyzw([q.i as f32, q.j as f32, q.k as f32, q.w as f32])
+    rerun::Quaternion::from_xyzw(pose.quaternion_xyzw().map(|x| x as f32))
 }
 
 fn mat3(pose: &Pose) -> rerun::components::TransformMat3x3 {
@@ -493,24 +492,6 @@ pub fn summary_markdown(summary: &Summary) -> String {
     format!("# summary\n\n```\n{}\n```\n\n```json\n{}\n```\n", String::from_utf8_lossy(&text).trim(), serde_json::to_string_pretty(summary).unwrap_or_default())
 }
 
-/// The tool positions the command asks for (forward kinematics of the command), every 10 ms.
-fn commanded_path(run: &RunInfo) -> Vec<[f32; 3]> {
-    let e = run.experiment;
-    let model = &*e.model;
-    let n = model.dof();
-    let mut data = Data::new(model);
-    let (mut cmd, mut cmd_dot) = (vec![0.0; n], vec![0.0; n]);
-    let samples = (e.config.duration / 0.01).ceil() as usize;
-    (0..=samples)
-        .map(|i| {
-            e.trajectory.sample((i as f64 * 0.01).min(e.config.duration), &mut cmd, &mut cmd_dot);
-            forward_kinematics(model, &mut data, &cmd);
-            let p = frame_pose(model, &data, model.tool_frame).translation;
-            [p.x as f32, p.y as f32, p.z as f32]
-        })
-        .collect()
-}
-
 impl Recorder for RerunRecorder {
     fn start(&mut self, run: &RunInfo) -> Result<(), Error> {
         let e = run.experiment;
@@ -539,9 +520,10 @@ impl Recorder for RerunRecorder {
         self.log_static_scene(&rec, model, &data)?;
         self.log_series_styles(&rec)?;
         rec.log_static("config", &rerun::TextDocument::from_markdown(config_markdown(run))).map_err(|x| self.err(x))?;
-        let commanded = commanded_path(run);
+        let commanded: Vec<[f32; 3]> = run.commanded_tool_path.iter().map(|p| [p.x as f32, p.y as f32, p.z as f32]).collect();
         let spread = commanded.iter().any(|p| (0..3).any(|a| (p[a] - commanded[0][a]).abs() > 1e-4));
-        if spread {
+        let commanded = if spread { commanded } else { Vec::new() };
+        if !commanded.is_empty() {
             rec.log_static(
                 "world/tool/commanded_path",
                 &rerun::LineStrips3D::new([commanded]).with_colors([rerun::Color::from_rgb(120, 120, 120)]).with_radii([0.0015]),
