@@ -269,3 +269,16 @@ fn a_run_prints_where_its_recordings_are_and_how_to_open_them() {
     assert_eq!(code, 0);
     assert!(out.contains(&format!("open in Rerun: rerun {}", rrd.display())), "{out}");
 }
+
+#[test]
+fn realtime_paces_simulated_time_to_the_wall_clock() {
+    // 1.5 s of simulation at 3× real time cannot finish in less than 0.5 s (it takes ~40 ms unpaced)
+    let started = std::time::Instant::now();
+    let (code, _, err) = armscope(&["run", "--quiet", "--duration", "1.5", "--realtime", "3", "--no-rrd", "--no-mcap"]);
+    assert_eq!(code, 0, "{err}");
+    let wall = started.elapsed().as_secs_f64();
+    assert!(wall >= 0.5, "paced run took {wall} s");
+    let (code, _, err) = armscope(&["run", "--quiet", "--realtime", "0", "--no-rrd", "--no-mcap"]);
+    assert_eq!(code, 2);
+    assert!(err.contains("--realtime"), "{err}");
+}
