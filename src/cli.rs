@@ -82,6 +82,14 @@ pub struct AnalyzeArgs {
     /// The pose to linearize at, one angle per joint (default: all 0, the start pose).
     #[arg(long, value_delimiter = ',', num_args = 1, allow_negative_numbers = true)]
     pub pose: Option<Vec<f64>>,
+    /// Also linearize at 12 poses along one period of the default wave (--freq/--amp-deg as `run`),
+    /// and suggest kd that is stable at all of them (inertia changes with pose).
+    #[arg(long)]
+    pub along_command: bool,
+    #[arg(long, default_value_t = 0.5, allow_negative_numbers = true)]
+    pub freq: f64,
+    #[arg(long, default_value_t = 30.0, allow_negative_numbers = true)]
+    pub amp_deg: f64,
     /// The plant in the loop.
     #[arg(long, value_enum, default_value = "discrete")]
     pub plant: crate::analysis::LoopPlant,
@@ -599,7 +607,26 @@ pub fn analyze(args: &AnalyzeArgs) -> Result<i32, Error> {
     let (rho, participation) = spectral_radius(&lin.closed_loop(&kp, &kd, h, ff, args.plant));
     let stable = rho < 1.0;
     let largest_dt = largest_stable_period(&lin, &kp, &kd, h, ff, args.plant);
-    let (stable_kd, stable_rho) = stabilizing_kd(&lin, &kp, &kd, h, ff, args.plant);
+    let poses: Vec<Vec<f64>> = if args.along_command {
+        let wave = crate::trajectory::Wave { amplitude_rad: args.amp_deg.to_radians(), omega: args.freq };
+        let period = 2.0 * std::f64::consts::PI / args.freq.abs().max(1e-6);
+        let (mut q, mut qd) = (vec![0.0; n], vec![0.0; n]);
+        std::iter::once(pose.clone())
+            .chain((0..12).map(|i| {
+                crate::trajectory::Trajectory::sample(&wave, period * i as f64 / 12.0, &mut q, &mut qd);
+                q.clone()
+            }))
+            .collect()
+    } else {
+        vec![pose.clone()]
+    };
+    let lins: Vec<Linearization> = poses.iter().map(|p| Linearization::at(model, p)).collect();
+    let worst = crate::analysis::worst_radius(&lins, &kp, &kd, h, ff, args.plant);
+    let (stable_kd, stable_rho) = if args.along_command {
+        crate::analysis::stabilizing_kd_over(&lins, &kp, &kd, h, ff, args.plant)
+    } else {
+        stabilizing_kd(&lin, &kp, &kd, h, ff, args.plant)
+    };
     let names: Vec<String> = model.joints.iter().map(|j| j.name.clone()).collect();
     let mut drivers: Vec<(String, f64)> = names.iter().cloned().zip(participation.iter().copied()).collect();
     drivers.sort_by(|a, b| b.1.total_cmp(&a.1));
@@ -620,6 +647,7 @@ pub fn analyze(args: &AnalyzeArgs) -> Result<i32, Error> {
             "model": model.name, "urdf": args.urdf, "pose": pose, "dt": h, "plant": args.plant, "feed_forward": ff,
             "kp": kp, "kd": kd, "gains": experiment.gains.source,
             "spectral_radius": rho, "stable": stable,
+            "poses": poses.len(), "worst_spectral_radius_over_poses": worst,
             "participation": names.iter().zip(&participation).map(|(n, p)| (n.clone(), *p)).collect::<std::collections::BTreeMap<_, _>>(),
             "largest_stable_dt": largest_dt,
             "stable_kd": if stable_rho < 1.0 { Some(&stable_kd) } else { None },
@@ -636,6 +664,9 @@ pub fn analyze(args: &AnalyzeArgs) -> Result<i32, Error> {
     } else {
         println!("  spectral radius {rho:.3}: UNSTABLE (a small disturbance grows {rho:.2}× per control step, until the torque limits clip it into chatter)");
         println!("  driven by: {}", drivers.iter().filter(|d| d.1 > 0.02).map(|(n, p)| format!("{n} {:.0}%", 100.0 * p)).collect::<Vec<_>>().join(", "));
+    }
+    if args.along_command {
+        println!("  worst spectral radius over {} poses along the wave: {worst:.3}", poses.len());
     }
     match largest_dt {
         Some(d) if d >= h => println!("  these gains are stable at this dt"),

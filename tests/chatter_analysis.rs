@@ -85,3 +85,20 @@ fn analyze_suggested_gains_run_without_chatter() {
         assert!(chatter < 0.1, "J{} chatter {chatter}% with kd {kd}", j + 1);
     }
 }
+
+#[test]
+fn gains_stable_along_the_wave_run_the_whole_wave_without_chatter() {
+    let doc = analyze(&["--along-command"]);
+    assert_eq!(doc["poses"], 13);
+    assert!(doc["worst_spectral_radius_over_poses"].as_f64().unwrap() >= doc["spectral_radius"].as_f64().unwrap());
+    assert!(doc["stable_kd_spectral_radius"].as_f64().unwrap() < 1.0);
+    let kd = doc["stable_kd"].as_array().unwrap().iter().map(|k| format!("{}", k.as_f64().unwrap())).collect::<Vec<_>>().join(",");
+    let dir = tempfile::tempdir().unwrap();
+    let json = dir.path().join("s.json");
+    assert_eq!(armscope(&["run", "--quiet", "--duration", "20", "--kd", &kd, "--summary-json", json.to_str().unwrap()]), 0);
+    let s: Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    for j in 0..6 {
+        assert!(s["summary"]["chatter_percent"][j].as_f64().unwrap() < 0.1, "J{}", j + 1);
+        assert!(s["summary"]["max_abs_error"][j].as_f64().unwrap() < 1e-3, "J{} tracks", j + 1);
+    }
+}
