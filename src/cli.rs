@@ -402,7 +402,8 @@ fn run_command(command: Command) -> Result<i32, Error> {
 /// Set by SIGINT (Ctrl-C): the run stops after the current step and finishes its files.
 static INTERRUPTED: AtomicBool = AtomicBool::new(false);
 
-fn install_interrupt_handler() {
+/// Ctrl-C sets a flag the simulation loop checks every step (the files are then finished).
+pub fn install_interrupt_handler() {
     static INSTALLED: std::sync::Once = std::sync::Once::new();
     INSTALLED.call_once(|| {
         // a second handler cannot be installed (e.g. by an embedding program): then Ctrl-C just kills

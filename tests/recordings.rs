@@ -223,13 +223,18 @@ fn an_interrupted_run_leaves_both_files_readable_up_to_that_point() {
         .args(["run", "--quiet", "--duration", "30", "--realtime", "1", "--rrd", rrd.to_str().unwrap(), "--mcap", mcap.to_str().unwrap()])
         .spawn()
         .unwrap();
-    std::thread::sleep(std::time::Duration::from_millis(1500));
+    // interrupt once the recording is under way (the MCAP has its first chunk or the header at least)
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(20);
+    while mcap.metadata().map_or(true, |m| m.len() == 0) && std::time::Instant::now() < deadline {
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    std::thread::sleep(std::time::Duration::from_millis(1000));
     assert!(Command::new("kill").args(["-INT", &child.id().to_string()]).status().unwrap().success());
     let status = child.wait().unwrap();
     assert_eq!(status.code(), Some(130), "interrupted runs exit with 130");
     let topics = mcap_messages(&mcap);
     let n = topics["/controller"].len();
-    assert!(n > 500 && n < 10_000, "{n} steps recorded before the interrupt");
+    assert!(n > 100 && n < 20_000, "{n} steps recorded before the interrupt");
     let bytes = std::fs::read(&mcap).unwrap();
     let summary = mcap::Summary::read(&bytes).unwrap().expect("the MCAP was closed properly");
     let done = mcap::read::metadata(&bytes, &summary.metadata_indexes[1]).unwrap();
