@@ -153,3 +153,25 @@ fn discrete_plant_divergence_is_caught_named_and_the_files_are_finished() {
     assert!(rrd.metadata().unwrap().len() > 0);
     let _ = armscope;
 }
+
+/// The mesh model as specified (clipped motors) on the discrete plant: the energy audit catches the
+/// numerically unstable plant within milliseconds; the same model on the continuous plant runs on.
+#[test]
+fn mesh_model_on_the_discrete_plant_is_caught_as_divergent() {
+    let dir = tempfile::tempdir().unwrap();
+    let (rrd, mcap) = (dir.path().join("m.rrd"), dir.path().join("m.mcap"));
+    let out = Command::new(env!("CARGO_BIN_EXE_armscope"))
+        .args(["run", "--quiet", "--urdf", mesh_urdf().to_str().unwrap(), "--duration", "10", "--rrd", rrd.to_str().unwrap(), "--mcap", mcap.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(3), "{stderr}");
+    let line = stderr.lines().find(|l| l.contains("diverged")).expect("divergence message");
+    assert!(line.contains("created") && line.contains("J of energy") && line.contains("joint J") && line.contains("--time-step 0"), "{line}");
+    let t: f64 = line.split("t = ").nth(1).unwrap().split(' ').next().unwrap().parse().unwrap();
+    assert!(t < 0.1, "caught at t = {t}");
+    let bytes = std::fs::read(&mcap).unwrap();
+    let summary = mcap::Summary::read(&bytes).unwrap().expect("MCAP closed properly");
+    assert!(mcap::read::metadata(&bytes, &summary.metadata_indexes[1]).unwrap().metadata["status"].contains("diverged"));
+    assert!(rrd.metadata().unwrap().len() > 0);
+}
