@@ -149,27 +149,7 @@ pub fn largest_stable_period(lin: &Linearization, kp: &[f64], kd: &[f64], h_max:
 /// (scaled from the given one by factors from 1/1000 to 4) that most lowers the spectral radius,
 /// in repeated sweeps. Returns the gains and the radius they reach.
 pub fn stabilizing_kd(lin: &Linearization, kp: &[f64], kd: &[f64], h: f64, ff: bool, plant: LoopPlant) -> (Vec<f64>, f64) {
-    let mut best = kd.to_vec();
-    let mut rho = spectral_radius(&lin.closed_loop(kp, &best, h, ff, plant)).0;
-    let factors: Vec<f64> = (0..=40).map(|i| 10f64.powf(-3.0 + 3.6 * i as f64 / 40.0)).collect();
-    for _sweep in 0..4 {
-        for j in 0..kd.len() {
-            if kd[j] == 0.0 && kp[j] == 0.0 {
-                continue;
-            }
-            let base = if kd[j] > 0.0 { kd[j] } else { 1e-3 };
-            for f in &factors {
-                let mut trial = best.clone();
-                trial[j] = base * f;
-                let r = spectral_radius(&lin.closed_loop(kp, &trial, h, ff, plant)).0;
-                if r < rho - 1e-12 {
-                    rho = r;
-                    best = trial;
-                }
-            }
-        }
-    }
-    (best, rho)
+    stabilizing_kd_over(std::slice::from_ref(lin), kp, kd, h, ff, plant)
 }
 
 /// The worst spectral radius over several linearizations (poses).

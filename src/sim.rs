@@ -83,15 +83,17 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
             }
             break;
         }
-        let potential = audit.as_ref().map(|a| a.potential_energy(model, &data));
-        let v_before = audit.as_mut().map(|a| a.remember(&v));
+        let potential = audit.as_mut().map(|a| {
+            a.remember(&v);
+            a.potential_energy(model, &data)
+        });
         plant.advance(model, &mut data, &u, &mut q, &mut v);
         at_limit.copy_from_slice(plant.limit_active());
         if let Some(diverged) = divergence(experiment, &q, &v, t + dt) {
             status = diverged;
             break;
         }
-        if let (Some(a), Some(pe), Some(())) = (audit.as_mut(), potential, v_before) {
+        if let (Some(a), Some(pe)) = (audit.as_mut(), potential) {
             // the discrete step left M(q_k) in data.mass_matrix
             if let Some(diverged) = a.step(model, &data, pe, &u, &v, t + dt) {
                 status = diverged;
