@@ -1,5 +1,6 @@
 //! Recordings read back by readers independent of the code that wrote them: the `.mcap` through
-//! the mcap crate (JSON through serde_json, protobuf through the official Foxglove types), the
+//! the mcap crate (Foxglove's schemas through the official Foxglove types, armscope's own through
+//! prost-reflect and the schema embedded in the file, as Foxglove decodes it), the
 //! `.rrd` through the Python rerun-sdk 0.36.3 of `../shared/viewers` (installed by its setup.sh),
 //! compared value by value with the run's own per-step trace.
 
@@ -68,7 +69,7 @@ fn mcap_has_the_channels_schemas_and_per_step_messages_and_equals_the_trace() {
     let expect = [
         ("/tf", "foxglove.FrameTransforms", "protobuf", Some(steps)),
         ("/joint_states", "foxglove.JointStates", "protobuf", Some(steps)),
-        ("/controller", "armscope::recorder::mcap::ControllerTelemetry", "json", Some(steps)),
+        ("/controller", "armscope.ControllerTelemetry", "protobuf", Some(steps)),
         ("/tool/pose", "foxglove.PoseInFrame", "protobuf", Some(steps)),
         ("/robot/geometry", "foxglove.SceneUpdate", "protobuf", None),
         ("/tool/path", "foxglove.SceneUpdate", "protobuf", None),
@@ -91,18 +92,24 @@ fn mcap_has_the_channels_schemas_and_per_step_messages_and_equals_the_trace() {
     for (k, m) in controller.iter().enumerate() {
         assert_eq!(m.0 - t0, k as u64 * 1_000_000, "log time of step {k}");
     }
-    // decoded values equal the trace
+    // decoded through the schema the file carries (as Foxglove does), the values equal the trace
+    let bytes = std::fs::read(&run.mcap).unwrap();
+    let schema = mcap::MessageStream::new(&bytes).unwrap().map(|m| m.unwrap()).find(|m| m.channel.topic == "/controller").unwrap().channel.schema.clone().unwrap();
+    assert_eq!(schema.encoding, "protobuf");
+    let pool = prost_reflect::DescriptorPool::decode(&schema.data[..]).expect("a FileDescriptorSet");
+    let descriptor = pool.get_message_by_name(&schema.name).expect("the schema names its message");
     for (k, m) in controller.iter().enumerate() {
-        let v: serde_json::Value = serde_json::from_slice(&m.3).unwrap();
-        assert_eq!(v["time"].as_f64().unwrap(), run.trace.rows[k][0]);
+        let v = prost_reflect::DynamicMessage::decode(descriptor.clone(), &m.3[..]).unwrap();
+        let list = |field: &str| v.get_field_by_name(field).unwrap().as_list().unwrap().to_vec();
+        assert_eq!(v.get_field_by_name("time").unwrap().as_f64().unwrap(), run.trace.rows[k][0]);
         for j in 0..6 {
-            let get = |field: &str| v[field][j].as_f64().unwrap();
+            let get = |field: &str| list(field)[j].as_f64().unwrap();
             assert_eq!(get("target"), col(&run.trace, "cmd", j)[k], "target J{} step {k}", j + 1);
             assert_eq!(get("torque"), col(&run.trace, "u", j)[k]);
             assert_eq!(get("tau_g"), col(&run.trace, "tau_g", j)[k]);
             assert_eq!(get("error"), col(&run.trace, "cmd", j)[k] - col(&run.trace, "q", j)[k]);
             let effort = [8.0, 12.0, 8.0, 5.0, 3.0, 1.5][j];
-            assert_eq!(get("saturated") == 1.0, col(&run.trace, "u", j)[k].abs() == effort);
+            assert_eq!(list("saturated")[j].as_u32().unwrap() == 1, col(&run.trace, "u", j)[k].abs() == effort);
         }
     }
     for (k, m) in topics["/joint_states"].iter().enumerate() {
@@ -153,7 +160,8 @@ fn mcap_has_the_channels_schemas_and_per_step_messages_and_equals_the_trace() {
     assert!(done.metadata["summary"].contains("\"saturation_percent\""));
 }
 
-fn rrd_series(rrd: &Path, entity: &str) -> Vec<(f64, f64)> {
+/// One entity's scalar rows: (time, the row's values, one per instance).
+fn rrd_series(rrd: &Path, entity: &str) -> Vec<(f64, Vec<f64>)> {
     let out = tempfile::NamedTempFile::new().unwrap();
     let status = Command::new("bash")
         .arg(kit("rrd-query.sh"))
@@ -161,7 +169,7 @@ fn rrd_series(rrd: &Path, entity: &str) -> Vec<(f64, f64)> {
         .output()
         .unwrap();
     assert!(status.status.success(), "rrd-query {entity}: {}", String::from_utf8_lossy(&status.stderr));
-    read_csv(out.path()).rows.iter().map(|r| (r[0], r[1])).collect()
+    read_csv(out.path()).rows.into_iter().map(|r| (r[0], r[1..].to_vec())).collect()
 }
 
 #[test]
@@ -173,26 +181,26 @@ fn rrd_holds_every_joint_series_with_one_row_per_step_equal_to_the_trace() {
         let name = format!("J{}", j + 1);
         let (q, cmd, u, tau_g) = (col(&run.trace, "q", j), col(&run.trace, "cmd", j), col(&run.trace, "u", j), col(&run.trace, "tau_g", j));
         let effort = [8.0, 12.0, 8.0, 5.0, 3.0, 1.5][j];
-        let expected: [(&str, Vec<f64>); 6] = [
-            ("angle", q.clone()),
-            ("target", cmd.clone()),
-            ("error", cmd.iter().zip(&q).map(|(c, q)| c - q).collect()),
-            ("torque", u.clone()),
-            ("gravity_torque", tau_g),
-            ("saturated", u.iter().map(|u| if u.abs() == effort { 1.0 } else { 0.0 }).collect()),
+        let saturated = |k: usize| if u[k].abs() == effort { 1.0 } else { 0.0 };
+        // each entity: its series per step, in instance order
+        let expected: [(&str, Box<dyn Fn(usize) -> Vec<f64>>); 3] = [
+            ("position", Box::new(|k| vec![q[k], cmd[k]])),
+            ("torque", Box::new(|k| vec![u[k], tau_g[k]])),
+            ("status", Box::new(|k| vec![cmd[k] - q[k], saturated(k)])),
         ];
         for (leaf, want) in expected {
             let got = rrd_series(&run.rrd, &format!("/joints/{name}/{leaf}"));
             assert_eq!(got.len(), steps, "{name}/{leaf}: one row per step");
-            for (k, (time, value)) in got.iter().enumerate() {
+            for (k, (time, values)) in got.iter().enumerate() {
                 assert!((time - t[k]).abs() < 1e-9, "{name}/{leaf} time {time} vs {}", t[k]);
-                assert_eq!(*value, want[k], "{name}/{leaf} at step {k}");
+                let want = want(k);
+                assert_eq!(values[..want.len()], want[..], "{name}/{leaf} at step {k}");
             }
         }
     }
-    for axis in ["x", "y", "z"] {
-        let got = rrd_series(&run.rrd, &format!("/tool/{axis}"));
-        assert_eq!(got.iter().map(|r| r.1).collect::<Vec<_>>(), run.trace.column(axis), "tool {axis}");
+    let tool = rrd_series(&run.rrd, "/tool/position");
+    for (a, axis) in ["x", "y", "z"].iter().enumerate() {
+        assert_eq!(tool.iter().map(|r| r.1[a]).collect::<Vec<_>>(), run.trace.column(axis), "tool {axis}");
     }
 }
 
@@ -202,7 +210,7 @@ fn rrd_has_the_3d_scene_configuration_summary_and_blueprint_and_passes_rerun_ver
     let out = Command::new("bash").arg(kit("rrd-query.sh")).args([run.rrd.to_str().unwrap(), "--json"]).output().unwrap();
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let text = String::from_utf8_lossy(&out.stdout);
-    for entity in ["/config", "/summary", "/world/robot/upper_arm_link", "/world/robot/upper_arm_link/visual_0", "/world/tool/tip", "/world/tool/trail", "/world/tool/commanded_path", "/world/tool/path"] {
+    for entity in ["/config", "/summary", "/world/robot/upper_arm_link", "/world/robot/upper_arm_link/visual_0", "/world/robot/tool_link/tip", "/world/tool/trail", "/world/tool/commanded_path", "/world/tool/path"] {
         assert!(text.contains(&format!("\"{entity}\"")), "entity {entity} missing from the recording");
     }
     let listing = Command::new("bash").arg(kit("rrd-query.sh")).arg(run.rrd.to_str().unwrap()).output().unwrap();
@@ -239,7 +247,7 @@ fn an_interrupted_run_leaves_both_files_readable_up_to_that_point() {
     let summary = mcap::Summary::read(&bytes).unwrap().expect("the MCAP was closed properly");
     let done = mcap::read::metadata(&bytes, &summary.metadata_indexes[1]).unwrap();
     assert!(done.metadata["status"].contains("interrupted"));
-    let rows = rrd_series(&rrd, "/joints/J2/angle");
+    let rows = rrd_series(&rrd, "/joints/J2/position");
     assert_eq!(rows.len(), n, "the .rrd holds the same steps as the .mcap");
     let verify = Command::new(viewers_home().join("bin/rerun")).args(["rrd", "verify", rrd.to_str().unwrap()]).output().unwrap();
     assert!(verify.status.success(), "{}", String::from_utf8_lossy(&verify.stderr));
@@ -263,7 +271,7 @@ fn no_viewer_listening_is_reported_and_the_files_are_still_written() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(0), "{err}");
     assert!(err.contains("could not start the Rerun viewer") && err.contains("install"), "{err}");
-    assert_eq!(rrd_series(&rrd, "/joints/J1/angle").len(), 201);
+    assert_eq!(rrd_series(&rrd, "/joints/J1/position").len(), 201);
 }
 
 #[test]

@@ -36,7 +36,10 @@ fn read_run(run: &ComparedRun) -> Result<RunSeries, Error> {
         let message = message.map_err(|e| fail(e.to_string()))?;
         match message.channel.topic.as_str() {
             TOPIC_CONTROLLER => {
-                let t: ControllerTelemetry = serde_json::from_slice(&message.data).map_err(|e| fail(e.to_string()))?;
+                if message.channel.message_encoding != "protobuf" {
+                    return Err(fail(format!("{TOPIC_CONTROLLER} is {}-encoded: recorded by an older armscope, record it again", message.channel.message_encoding)));
+                }
+                let t = ControllerTelemetry::decode(&message.data[..]).map_err(|e| fail(e.to_string()))?;
                 if series.error.is_empty() {
                     series.error = vec![Vec::new(); t.error.len()];
                     series.torque = vec![Vec::new(); t.torque.len()];

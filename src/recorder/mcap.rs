@@ -5,11 +5,12 @@
 //! The foxglove SDK provides the well-known schemas and their encoders; the mcap crate writes the
 //! file directly (the SDK's sink machinery costs more per message than the encoding itself).
 
+use super::telemetry::ControllerTelemetry;
 use super::{Recorder, RunInfo};
 use crate::error::Error;
-use crate::model::{Geometry, Model};
+use crate::model::{Geometry, JointKind, Model};
 use crate::sample::Sample;
-use crate::spatial::Pose;
+use crate::spatial::{Pose, rotation_about_axis};
 use crate::summary::Summary;
 use foxglove::messages::{
     Color, CubePrimitive, CylinderPrimitive, FrameTransform, FrameTransforms, JointState, JointStates, LinePrimitive, ModelPrimitive,
@@ -33,25 +34,6 @@ pub const TOPIC_TOOL_POSE: &str = "/tool/pose";
 pub const TOPIC_TOOL_PATH: &str = "/tool/path";
 pub const TOPIC_COMMANDED_PATH: &str = "/tool/commanded_path";
 pub const TOPIC_ROBOT_DESCRIPTION: &str = "/robot_description";
-
-/// Per-step controller telemetry, one array entry per joint (Foxglove plots `/controller.torque[1]`).
-#[derive(Clone, Debug, Default, Serialize, serde::Deserialize, JsonSchema)]
-pub struct ControllerTelemetry {
-    /// Simulation time, s.
-    pub time: f64,
-    pub target: Vec<f64>,
-    pub error: Vec<f64>,
-    /// Applied (clipped) torque, N·m.
-    pub torque: Vec<f64>,
-    /// Generalized gravity force τ_g, N·m.
-    pub tau_g: Vec<f64>,
-    /// 1 when the controller asked for more than the limit.
-    pub saturated: Vec<u8>,
-    /// 1 when the torque flipped sign since the last step with one of the two saturated (chatter).
-    pub chatter: Vec<u8>,
-    /// Distance of the tool tip from where the command puts it, m.
-    pub tool_error: f64,
-}
 
 /// The URDF text (as ROS's std_msgs/String carries it).
 #[derive(Clone, Debug, Serialize, JsonSchema)]
@@ -107,18 +89,17 @@ pub struct McapRecorder {
     out: Option<Out>,
     channels: Option<Channels>,
     start_ns: u64,
-    /// (parent frame, child frame) per transform; parent `None` is "world" for a root not named so.
-    tf_pairs: Vec<(Option<usize>, usize)>,
-    frame_world: Vec<Pose>,
-    frame_body: Vec<(Option<usize>, Pose)>,
-    tool_frame: usize,
+    /// One per moving joint, in the order of `tf_msg.transforms`.
+    joint_tfs: Vec<JointTransform>,
+    /// The tool link's body and its pose in that body.
+    tool_frame: (Option<usize>, Pose),
     tf_msg: FrameTransforms,
-    /// The transforms of fixed joints (sent with the geometry, once a simulated second).
+    /// The transforms of fixed joints (constant; sent with the geometry, once a simulated second).
     fixed_tf_msg: FrameTransforms,
-    fixed_tf_pairs: Vec<(Option<usize>, usize)>,
     joints_msg: JointStates,
     telemetry: ControllerTelemetry,
     scene: SceneUpdate,
+    model: Option<std::sync::Arc<Model>>,
     dt: f64,
     steps_per_path_point: usize,
     path_points: Vec<Point3>,
@@ -132,16 +113,14 @@ impl McapRecorder {
             out: None,
             channels: None,
             start_ns: 0,
-            tf_pairs: Vec::new(),
-            frame_world: Vec::new(),
-            frame_body: Vec::new(),
-            tool_frame: 0,
+            joint_tfs: Vec::new(),
+            tool_frame: (None, Pose::identity()),
             tf_msg: FrameTransforms::default(),
             fixed_tf_msg: FrameTransforms::default(),
-            fixed_tf_pairs: Vec::new(),
             joints_msg: JointStates::default(),
             telemetry: ControllerTelemetry::default(),
             scene: SceneUpdate::default(),
+            model: None,
             dt: 0.001,
             steps_per_path_point: 20,
             path_points: Vec::new(),
@@ -190,17 +169,30 @@ impl McapRecorder {
     }
 }
 
-/// Each child link's pose in its parent link's frame.
-fn fill_transforms(msg: &mut FrameTransforms, pairs: &[(Option<usize>, usize)], frame_world: &[Pose], ts: Option<Timestamp>) {
-    for (m, &(parent, child)) in msg.transforms.iter_mut().zip(pairs) {
-        let relative = match parent {
-            Some(p) => frame_world[p].inverse().compose(&frame_world[child]),
-            None => frame_world[child],
+/// A moving joint's child link in its parent link: `before` ∘ motion(q) ∘ `after`, where `before`
+/// takes the parent link to the joint frame and `after` the joint's body to the child link.
+/// Built from the URDF's own origins rather than from world poses, so what the URDF has exactly
+/// (zero offsets, an axis along z) stays exact: protobuf then leaves the zeros out, a third of /tf.
+struct JointTransform {
+    joint: usize,
+    before: Pose,
+    after: Pose,
+}
+
+impl JointTransform {
+    fn pose(&self, model_joint: &crate::model::Joint, q: f64) -> Pose {
+        let motion = match model_joint.kind {
+            JointKind::Revolute | JointKind::Continuous => Pose::new(rotation_about_axis(&model_joint.axis, q), nalgebra::Vector3::zeros()),
+            JointKind::Prismatic => Pose::new(nalgebra::Matrix3::identity(), model_joint.axis * q),
         };
-        m.timestamp = ts;
-        m.translation = Some(vec3(&relative.translation));
-        m.rotation = Some(quaternion(&relative));
+        self.before.compose(&motion).compose(&self.after)
     }
+}
+
+fn set_transform(m: &mut FrameTransform, pose: &Pose, ts: Option<Timestamp>) {
+    m.timestamp = ts;
+    m.translation = Some(vec3(&pose.translation));
+    m.rotation = Some(quaternion(pose));
 }
 
 fn color(c: [f32; 4]) -> Color {
@@ -327,23 +319,35 @@ impl Recorder for McapRecorder {
         self.steps_per_path_point = ((0.05 / self.dt).round() as usize).max(1);
 
         // transforms: every link from its parent link; "world" → root when the root is not "world"
-        self.frame_body = model.frames.iter().map(|f| (f.body, f.placement)).collect();
-        self.frame_world = vec![Pose::identity(); model.frames.len()];
-        self.tool_frame = model.tool_frame;
+        let tool = &model.frames[model.tool_frame];
+        self.tool_frame = (tool.body, tool.placement);
         let pairs = model.frames.iter().enumerate().filter(|(_, f)| f.parent_frame.is_some() || f.name != "world");
-        // a link moves relative to its parent when its joint is a moving joint
+        // a link moves relative to its parent when its joint is a moving joint (the child's body's joint)
         let (moving, fixed): (Vec<_>, Vec<_>) = pairs.partition(|(_, f)| f.parent_frame.is_some_and(|p| model.frames[p].body != f.body));
-        self.tf_pairs = moving.iter().map(|(i, f)| (f.parent_frame, *i)).collect();
-        self.fixed_tf_pairs = fixed.iter().map(|(i, f)| (f.parent_frame, *i)).collect();
         let name_of = |f: Option<usize>| f.map_or("world".to_string(), |i| model.frames[i].name.clone());
-        let message = |pairs: &[(Option<usize>, usize)]| FrameTransforms {
-            transforms: pairs
+        let transform = |p: Option<usize>, c: usize| FrameTransform { timestamp: None, parent_frame_id: name_of(p), child_frame_id: name_of(Some(c)), translation: None, rotation: None };
+        self.tf_msg = FrameTransforms { transforms: moving.iter().map(|(c, f)| transform(f.parent_frame, *c)).collect() };
+        self.joint_tfs = moving
+            .iter()
+            .map(|(_, f)| {
+                let joint = f.body.expect("a moving link has a body");
+                let parent_in_body = f.parent_frame.map_or(Pose::identity(), |p| model.frames[p].placement);
+                JointTransform { joint, before: parent_in_body.inverse().compose(&model.joints[joint].placement), after: f.placement }
+            })
+            .collect();
+        // links on the same body (or on the world) keep their relative pose: P_parent⁻¹ ∘ P_child
+        self.fixed_tf_msg = FrameTransforms {
+            transforms: fixed
                 .iter()
-                .map(|&(p, c)| FrameTransform { timestamp: None, parent_frame_id: name_of(p), child_frame_id: name_of(Some(c)), translation: None, rotation: None })
+                .map(|(c, f)| {
+                    let mut m = transform(f.parent_frame, *c);
+                    let parent = f.parent_frame.map_or(Pose::identity(), |p| model.frames[p].placement);
+                    set_transform(&mut m, &parent.inverse().compose(&f.placement), None);
+                    m
+                })
                 .collect(),
         };
-        self.tf_msg = message(&self.tf_pairs);
-        self.fixed_tf_msg = message(&self.fixed_tf_pairs);
+        self.model = Some(run.experiment.model.clone());
         let names: Vec<String> = model.joints.iter().map(|j| j.name.clone()).collect();
         self.joints_msg = JointStates {
             timestamp: None,
@@ -393,15 +397,12 @@ impl Recorder for McapRecorder {
     }
 
     fn record(&mut self, s: &Sample) -> Result<(), Error> {
-        for (i, (body, placement)) in self.frame_body.iter().enumerate() {
-            self.frame_world[i] = match body {
-                Some(b) => s.body_pose[*b].compose(placement),
-                None => *placement,
-            };
-        }
         let stamp = self.stamp(s.t);
         let ts = Some(self.timestamp(s.t));
-        fill_transforms(&mut self.tf_msg, &self.tf_pairs, &self.frame_world, ts);
+        let model = self.model.as_ref().expect("started");
+        for (m, tf) in self.tf_msg.transforms.iter_mut().zip(&self.joint_tfs) {
+            set_transform(m, &tf.pose(&model.joints[tf.joint], s.q[tf.joint]), ts);
+        }
         self.joints_msg.timestamp = ts;
         for (j, state) in self.joints_msg.joints.iter_mut().enumerate() {
             state.position = Some(s.q[j]);
@@ -416,10 +417,13 @@ impl Recorder for McapRecorder {
             tel.error[j] = s.cmd[j] - s.q[j];
             tel.torque[j] = s.u[j];
             tel.tau_g[j] = s.tau_g[j];
-            tel.saturated[j] = s.saturated[j] as u8;
-            tel.chatter[j] = s.chatter[j] as u8;
+            tel.saturated[j] = s.saturated[j] as u32;
+            tel.chatter[j] = s.chatter[j] as u32;
         }
-        let tool = self.frame_world[self.tool_frame];
+        let tool = match self.tool_frame {
+            (Some(body), placement) => s.body_pose[body].compose(&placement),
+            (None, placement) => placement,
+        };
         let path = &self.path;
         let fail = |e: String| Error::output(path, e);
         let (out, ch) = (self.out.as_mut().expect("started"), self.channels.as_mut().expect("started"));
@@ -435,8 +439,10 @@ impl Recorder for McapRecorder {
                 entity.timestamp = ts;
             }
             out.log(&mut ch.scene, &self.scene, stamp).map_err(fail)?;
-            if !self.fixed_tf_pairs.is_empty() {
-                fill_transforms(&mut self.fixed_tf_msg, &self.fixed_tf_pairs, &self.frame_world, ts);
+            if !self.fixed_tf_msg.transforms.is_empty() {
+                for m in &mut self.fixed_tf_msg.transforms {
+                    m.timestamp = ts;
+                }
                 out.log(&mut ch.tf, &self.fixed_tf_msg, stamp).map_err(fail)?;
             }
         }

@@ -6,12 +6,14 @@ mod mcap;
 mod pacer;
 pub mod rrd;
 mod summary_json;
+pub mod telemetry;
 mod threaded;
 mod trace;
 mod tutorial_csv;
 
 pub use console::Console;
-pub use mcap::{ControllerTelemetry, McapRecorder, TOPIC_CONTROLLER, TOPIC_JOINT_STATES};
+pub use mcap::{McapRecorder, TOPIC_CONTROLLER, TOPIC_JOINT_STATES};
+pub use telemetry::ControllerTelemetry;
 pub use pacer::Pacer;
 pub use rrd::{DEFAULT_CONNECT_URL, LiveViewer, RerunOptions, RerunRecorder};
 pub use summary_json::SummaryJson;

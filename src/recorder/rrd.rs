@@ -37,36 +37,33 @@ pub struct RerunOptions {
     pub name: String,
 }
 
+/// One joint's per-step series. Series plotted together share an entity as instances of one row:
+/// Rerun's cost is mostly per row, so this saves a third of it, and each of the blueprint's
+/// per-joint views shows whole entities (clean legends).
 struct JointColumns {
-    angle: Vec<f64>,
-    target: Vec<f64>,
-    error: Vec<f64>,
+    /// `joints/<joint>/position`: [angle, target] per step.
+    position: Vec<f64>,
+    /// `joints/<joint>/torque`: [applied torque, gravity torque τ_g] per step.
     torque: Vec<f64>,
-    gravity_torque: Vec<f64>,
-    saturated: Vec<f64>,
-    chatter: Vec<f64>,
+    /// `joints/<joint>/status`: [tracking error, saturated 0/1, chatter 0/1] per step.
+    status: Vec<f64>,
     saturated_times: Vec<f64>,
     saturated_torque: Vec<f64>,
 }
 
 impl JointColumns {
     fn with_capacity(n: usize) -> Self {
-        let v = || Vec::with_capacity(n);
         Self {
-            angle: v(),
-            target: v(),
-            error: v(),
-            torque: v(),
-            gravity_torque: v(),
-            saturated: v(),
-            chatter: v(),
+            position: Vec::with_capacity(2 * n),
+            torque: Vec::with_capacity(2 * n),
+            status: Vec::with_capacity(3 * n),
             saturated_times: Vec::new(),
             saturated_torque: Vec::new(),
         }
     }
 
     fn clear(&mut self) {
-        for c in [&mut self.angle, &mut self.target, &mut self.error, &mut self.torque, &mut self.gravity_torque, &mut self.saturated, &mut self.chatter, &mut self.saturated_times, &mut self.saturated_torque] {
+        for c in [&mut self.position, &mut self.torque, &mut self.status, &mut self.saturated_times, &mut self.saturated_torque] {
             c.clear();
         }
     }
@@ -88,11 +85,14 @@ pub struct RerunRecorder {
     effort: Vec<f64>,
     times: Vec<f64>,
     joints: Vec<JointColumns>,
-    tool: [Vec<f64>; 3],
+    /// [x, y, z] per step.
+    tool: Vec<f64>,
     tool_error: Vec<f64>,
-    tool_points: Vec<[f32; 3]>,
     links: Vec<MovingLink>,
     trail: VecDeque<[f32; 3]>,
+    /// The trail as it was at each of its updates in this block (sent with the block).
+    trail_times: Vec<f64>,
+    trail_strips: Vec<Vec<[f32; 3]>>,
     path: Vec<[f32; 3]>,
     block_steps: usize,
     steps_per_trail_point: usize,
@@ -104,8 +104,9 @@ pub struct RerunRecorder {
     notice_sink: Option<Box<dyn Fn(&str) + Send>>,
 }
 
-/// Steps per block in a file-only recording: ~1 s of simulation per chunk.
-const FILE_BLOCK_STEPS: usize = 1000;
+/// Steps per block in a file-only recording: ~4 s of simulation per chunk (fewer, larger chunks
+/// cost less to encode; Rerun's store keeps chunks of up to 4096 rows).
+const FILE_BLOCK_STEPS: usize = 4096;
 /// A live viewer gets a block at least this often.
 const LIVE_FLUSH: Duration = Duration::from_millis(40);
 const TRAIL_SECONDS: f64 = 2.0;
@@ -120,11 +121,12 @@ impl RerunRecorder {
             effort: Vec::new(),
             times: Vec::new(),
             joints: Vec::new(),
-            tool: [Vec::new(), Vec::new(), Vec::new()],
+            tool: Vec::new(),
             tool_error: Vec::new(),
-            tool_points: Vec::new(),
             links: Vec::new(),
             trail: VecDeque::new(),
+            trail_times: Vec::new(),
+            trail_strips: Vec::new(),
             path: Vec::new(),
             block_steps: FILE_BLOCK_STEPS,
             steps_per_trail_point: 20,
@@ -244,19 +246,25 @@ impl RerunRecorder {
 
     fn log_series_styles(&self, rec: &RecordingStream) -> Result<(), Error> {
         let e = |err: rerun::RecordingStreamError| self.err(err);
+        let grey = rerun::Color::from_rgb(140, 140, 140);
+        let red = rerun::Color::from_rgb(220, 50, 50);
         for (j, name) in self.joint_names.iter().enumerate() {
             let base = format!("joints/{name}");
             let c = joint_color(j);
-            let line = |label: &str, color: rerun::Color, width: f32| rerun::SeriesLines::new().with_names([label]).with_colors([color]).with_widths([width]);
-            rec.log_static(format!("{base}/angle"), &line(&format!("{name} angle (rad)"), c, 2.0)).map_err(e)?;
-            rec.log_static(format!("{base}/target"), &line(&format!("{name} target (rad)"), rerun::Color::from_rgb(140, 140, 140), 1.0)).map_err(e)?;
-            rec.log_static(format!("{base}/error"), &line(&format!("{name} error (rad)"), c, 1.5)).map_err(e)?;
-            rec.log_static(format!("{base}/torque"), &line(&format!("{name} torque (N·m)"), c, 1.5)).map_err(e)?;
-            rec.log_static(format!("{base}/gravity_torque"), &line(&format!("{name} τ_g (N·m)"), rerun::Color::from_rgb(90, 170, 90), 1.0)).map_err(e)?;
-            rec.log_static(format!("{base}/saturated"), &line(&format!("{name} saturated (0/1)"), rerun::Color::from_rgb(220, 50, 50), 1.0)).map_err(e)?;
-            rec.log_static(format!("{base}/chatter"), &line(&format!("{name} chatter (0/1)"), rerun::Color::from_rgb(240, 160, 40), 1.0)).map_err(e)?;
-            for side in ["upper", "lower"] {
-                rec.log_static(format!("{base}/torque_limit/{side}"), &line(&format!("{name} ±effort"), rerun::Color::from_rgb(220, 50, 50), 1.0)).map_err(e)?;
+            let lines = |names: &[String], colors: &[rerun::Color], widths: &[f32]| {
+                rerun::SeriesLines::new().with_names(names.iter().cloned()).with_colors(colors.iter().copied()).with_widths(widths.iter().copied())
+            };
+            let styles = [
+                ("position", lines(&[format!("{name} angle (rad)"), format!("{name} target (rad)")], &[c, grey], &[2.0, 1.0])),
+                ("torque", lines(&[format!("{name} torque (N·m)"), format!("{name} τ_g (N·m)")], &[c, rerun::Color::from_rgb(90, 170, 90)], &[1.5, 1.0])),
+                (
+                    "status",
+                    lines(&[format!("{name} error (rad)"), format!("{name} saturated (0/1)"), format!("{name} chatter (0/1)")], &[c, red, rerun::Color::from_rgb(240, 160, 40)], &[1.5, 1.0, 1.0]),
+                ),
+                ("torque_limit", lines(&[format!("{name} +effort"), format!("{name} −effort")], &[red, red], &[1.0, 1.0])),
+            ];
+            for (leaf, style) in styles {
+                rec.log_static(format!("{base}/{leaf}"), &style).map_err(e)?;
             }
             rec.log_static(
                 format!("{base}/saturated_torque"),
@@ -268,13 +276,13 @@ impl RerunRecorder {
             )
             .map_err(e)?;
         }
-        for (axis, color) in ["x", "y", "z"].iter().zip([(220, 60, 60), (60, 170, 60), (60, 90, 220)]) {
-            rec.log_static(
-                format!("tool/{axis}"),
-                &rerun::SeriesLines::new().with_names([format!("tool {axis} (m)")]).with_colors([rerun::Color::from_rgb(color.0, color.1, color.2)]),
-            )
-            .map_err(e)?;
-        }
+        rec.log_static(
+            "tool/position",
+            &rerun::SeriesLines::new()
+                .with_names(["tool x (m)", "tool y (m)", "tool z (m)"])
+                .with_colors([rerun::Color::from_rgb(220, 60, 60), rerun::Color::from_rgb(60, 170, 60), rerun::Color::from_rgb(60, 90, 220)]),
+        )
+        .map_err(e)?;
         rec.log_static("tool_error", &rerun::SeriesLines::new().with_names(["tool tip error |p − p_cmd| (m)"]).with_colors([rerun::Color::from_rgb(230, 60, 60)])).map_err(e)?;
         Ok(())
     }
@@ -285,60 +293,51 @@ impl RerunRecorder {
             return Ok(());
         }
         let e = |err: rerun::RecordingStreamError| self.err(err);
-        let time = || TimeColumn::new_duration_secs(TIMELINE, self.times.iter().copied());
-        let scalars = |values: &[f64]| rerun::Scalars::new(values.iter().copied()).columns_of_unit_batches();
+        let time = TimeColumn::new_duration_secs(TIMELINE, self.times.iter().copied());
+        let steps = self.times.len();
+        // `width` values per row
+        let scalars = |values: &[f64], width: usize| rerun::Scalars::new(values.iter().copied()).columns(std::iter::repeat_n(width, values.len() / width));
         for (j, name) in self.joint_names.iter().enumerate() {
             let c = &self.joints[j];
             let base = format!("joints/{name}");
-            for (leaf, values) in [
-                ("angle", &c.angle),
-                ("target", &c.target),
-                ("error", &c.error),
-                ("torque", &c.torque),
-                ("gravity_torque", &c.gravity_torque),
-                ("saturated", &c.saturated),
-                ("chatter", &c.chatter),
-            ] {
-                rec.send_columns(format!("{base}/{leaf}"), [time()], scalars(values).map_err(|x| self.err(x))?).map_err(e)?;
+            for (leaf, values, width) in [("position", &c.position, 2), ("torque", &c.torque, 2), ("status", &c.status, 3)] {
+                debug_assert_eq!(values.len(), width * steps);
+                rec.send_columns(format!("{base}/{leaf}"), [time.clone()], scalars(values, width).map_err(|x| self.err(x))?).map_err(e)?;
             }
             if !c.saturated_times.is_empty() {
                 rec.send_columns(
                     format!("{base}/saturated_torque"),
                     [TimeColumn::new_duration_secs(TIMELINE, c.saturated_times.iter().copied())],
-                    scalars(&c.saturated_torque).map_err(|x| self.err(x))?,
+                    scalars(&c.saturated_torque, 1).map_err(|x| self.err(x))?,
                 )
                 .map_err(e)?;
             }
             // the limits as lines spanning the block: two points each
-            let ends = [self.times[0], *self.times.last().unwrap()];
-            for (side, value) in [("upper", self.effort[j]), ("lower", -self.effort[j])] {
-                if value.is_finite() {
-                    rec.send_columns(
-                        format!("{base}/torque_limit/{side}"),
-                        [TimeColumn::new_duration_secs(TIMELINE, ends)],
-                        scalars(&[value, value]).map_err(|x| self.err(x))?,
-                    )
-                    .map_err(e)?;
-                }
+            let effort = self.effort[j];
+            if effort.is_finite() {
+                let ends = [self.times[0], self.times[steps - 1]];
+                rec.send_columns(
+                    format!("{base}/torque_limit"),
+                    [TimeColumn::new_duration_secs(TIMELINE, ends)],
+                    scalars(&[effort, -effort, effort, -effort], 2).map_err(|x| self.err(x))?,
+                )
+                .map_err(e)?;
             }
         }
-        for (axis, values) in ["x", "y", "z"].iter().zip(&self.tool) {
-            rec.send_columns(format!("tool/{axis}"), [time()], scalars(values).map_err(|x| self.err(x))?).map_err(e)?;
+        rec.send_columns("tool/position", [time.clone()], scalars(&self.tool, 3).map_err(|x| self.err(x))?).map_err(e)?;
+        rec.send_columns("tool_error", [time.clone()], scalars(&self.tool_error, 1).map_err(|x| self.err(x))?).map_err(e)?;
+        if !self.trail_times.is_empty() {
+            rec.send_columns(
+                "world/tool/trail",
+                [TimeColumn::new_duration_secs(TIMELINE, self.trail_times.iter().copied())],
+                rerun::LineStrips3D::update_fields().with_strips(self.trail_strips.iter().cloned()).columns_of_unit_batches().map_err(|x| self.err(x))?,
+            )
+            .map_err(e)?;
         }
-        rec.send_columns("tool_error", [time()], scalars(&self.tool_error).map_err(|x| self.err(x))?).map_err(e)?;
-        rec.send_columns(
-            "world/tool/tip",
-            [time()],
-            rerun::Points3D::update_fields()
-                .with_positions(self.tool_points.iter().copied())
-                .columns_of_unit_batches()
-                .map_err(|x| self.err(x))?,
-        )
-        .map_err(e)?;
         for link in &self.links {
             rec.send_columns(
                 link.entity.as_str(),
-                [time()],
+                [time.clone()],
                 rerun::Transform3D::update_fields()
                     .with_many_translation(link.translations.iter().copied())
                     .with_many_quaternion(link.rotations.iter().copied())
@@ -351,11 +350,10 @@ impl RerunRecorder {
         for j in &mut self.joints {
             j.clear();
         }
-        for t in &mut self.tool {
-            t.clear();
-        }
+        self.tool.clear();
         self.tool_error.clear();
-        self.tool_points.clear();
+        self.trail_times.clear();
+        self.trail_strips.clear();
         for link in &mut self.links {
             link.translations.clear();
             link.rotations.clear();
@@ -435,13 +433,13 @@ pub fn blueprint(joint_names: &[String], prefix: &str) -> Blueprint {
     let angle_views = joint_names.iter().map(|j| {
         TimeSeriesView::new(format!("{j} angle vs target"))
             .with_origin(format!("{prefix}joints/{j}"))
-            .with_contents(["$origin/angle", "$origin/target"])
+            .with_contents(["$origin/position"])
             .into()
     });
     let torque_views = joint_names.iter().map(|j| {
         TimeSeriesView::new(format!("{j} torque vs ±limit"))
             .with_origin(format!("{prefix}joints/{j}"))
-            .with_contents(["$origin/torque", "$origin/torque_limit/**", "$origin/saturated_torque"])
+            .with_contents(["$origin/torque", "$origin/torque_limit", "$origin/saturated_torque"])
             .into()
     });
     let columns = joint_names.len().div_ceil(2).clamp(1, 4) as u32;
@@ -503,7 +501,7 @@ impl Recorder for RerunRecorder {
         let cap = self.block_steps + 1;
         self.times = Vec::with_capacity(cap);
         self.joints = (0..model.dof()).map(|_| JointColumns::with_capacity(cap)).collect();
-        self.tool = [Vec::with_capacity(cap), Vec::with_capacity(cap), Vec::with_capacity(cap)];
+        self.tool = Vec::with_capacity(3 * cap);
         self.links = model
             .frames
             .iter()
@@ -530,11 +528,14 @@ impl Recorder for RerunRecorder {
             )
             .map_err(|x| self.err(x))?;
         }
+        // the tip is the tool link's origin: a static point under its entity moves with it
         rec.log_static(
-            "world/tool/tip",
-            &rerun::Points3D::update_fields().with_radii([0.006]).with_colors([rerun::Color::from_rgb(230, 40, 40)]),
+            format!("{}/tip", link_entity(&model.frames[model.tool_frame].name)),
+            &rerun::Points3D::new([[0.0f32, 0.0, 0.0]]).with_radii([0.006]).with_colors([rerun::Color::from_rgb(230, 40, 40)]),
         )
         .map_err(|x| self.err(x))?;
+        rec.log_static("world/tool/trail", &rerun::LineStrips3D::update_fields().with_colors([rerun::Color::from_rgb(230, 60, 60)]).with_radii([0.002]))
+            .map_err(|x| self.err(x))?;
         self.rec = Some(rec);
         self.last_flush = Instant::now();
         Ok(())
@@ -543,25 +544,19 @@ impl Recorder for RerunRecorder {
     fn record(&mut self, s: &Sample) -> Result<(), Error> {
         self.times.push(s.t);
         for (j, c) in self.joints.iter_mut().enumerate() {
-            c.angle.push(s.q[j]);
-            c.target.push(s.cmd[j]);
-            c.error.push(s.cmd[j] - s.q[j]);
-            c.torque.push(s.u[j]);
-            c.gravity_torque.push(s.tau_g[j]);
-            c.saturated.push(if s.saturated[j] { 1.0 } else { 0.0 });
-            c.chatter.push(if s.chatter[j] { 1.0 } else { 0.0 });
+            let flag = |b: bool| if b { 1.0 } else { 0.0 };
+            c.position.extend_from_slice(&[s.q[j], s.cmd[j]]);
+            c.torque.extend_from_slice(&[s.u[j], s.tau_g[j]]);
+            c.status.extend_from_slice(&[s.cmd[j] - s.q[j], flag(s.saturated[j]), flag(s.chatter[j])]);
             if s.saturated[j] {
                 c.saturated_times.push(s.t);
                 c.saturated_torque.push(s.u[j]);
             }
         }
         let p = s.tool_position;
-        for a in 0..3 {
-            self.tool[a].push(p[a]);
-        }
+        self.tool.extend_from_slice(&[p.x, p.y, p.z]);
         self.tool_error.push((s.tool_position - s.tool_target).norm());
         let tip = [p.x as f32, p.y as f32, p.z as f32];
-        self.tool_points.push(tip);
         for link in &mut self.links {
             let pose = s.body_pose[link.body].compose(&link.placement);
             let t = pose.translation;
@@ -576,11 +571,8 @@ impl Recorder for RerunRecorder {
                 self.trail.pop_front();
             }
             self.path.push(tip);
-            if let Some(rec) = &self.rec {
-                rec.set_duration_secs(TIMELINE, s.t);
-                rec.log("world/tool/trail", &rerun::LineStrips3D::new([self.trail.iter().copied().collect::<Vec<_>>()]).with_colors([rerun::Color::from_rgb(230, 60, 60)]).with_radii([0.002]))
-                    .map_err(|x| self.err(x))?;
-            }
+            self.trail_times.push(s.t);
+            self.trail_strips.push(self.trail.iter().copied().collect());
         }
         let due = self.times.len() >= self.block_steps || (self.live && self.last_flush.elapsed() >= LIVE_FLUSH) || s.is_final;
         if due {

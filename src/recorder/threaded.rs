@@ -183,7 +183,9 @@ impl<R: Recorder + Send + 'static> Recorder for Threaded<R> {
         let (back_tx, back_rx) = sync_channel::<SampleBlock>(4);
         self.tx = Some(tx);
         self.recycled = Some(back_rx);
-        self.worker = Some(std::thread::spawn(move || {
+        // named after the recorder, so profiles and debuggers tell the threads apart
+        let name = std::any::type_name::<R>().rsplit("::").next().unwrap_or("recorder").to_string();
+        let worker = std::thread::Builder::new().name(name).spawn(move || {
             for block in rx {
                 for i in 0..block.len() {
                     if let Err(e) = inner.record(&block.sample(i)) {
@@ -193,7 +195,8 @@ impl<R: Recorder + Send + 'static> Recorder for Threaded<R> {
                 let _ = back_tx.try_send(block);
             }
             (inner, Ok(()))
-        }));
+        });
+        self.worker = Some(worker.map_err(|e| Error::output(std::path::Path::new("recorder thread"), e))?);
         self.last_send = Instant::now();
         Ok(())
     }

@@ -11,6 +11,10 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use std::path::Path;
 use std::time::Duration;
 
+// as the armscope binary (src/main.rs)
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 fn run(experiment: &Experiment, dir: &Path, rrd: bool, mcap: bool) -> usize {
     let mut recorders: Vec<Box<dyn Recorder>> = Vec::new();
     if rrd {
