@@ -5,6 +5,7 @@ mod console;
 mod mcap;
 mod pacer;
 pub mod rrd;
+mod rrd_file;
 mod summary_json;
 pub mod telemetry;
 mod threaded;

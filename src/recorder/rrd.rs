@@ -2,6 +2,7 @@
 //! 3D, the tool's trail and paths, the run's configuration and summary, and a blueprint. Columns
 //! are buffered and sent with `send_columns` in blocks (per-step `log` calls cost ~170 µs here).
 
+use super::rrd_file::RrdFile;
 use super::{Recorder, RunInfo};
 use crate::dynamics::{Data, forward_kinematics, frame_pose};
 use crate::error::Error;
@@ -81,6 +82,8 @@ struct MovingLink {
 pub struct RerunRecorder {
     options: RerunOptions,
     rec: Option<RecordingStream>,
+    /// The `.rrd`, closed by `finish` once the stream is flushed.
+    file: Option<RrdFile>,
     joint_names: Vec<String>,
     effort: Vec<f64>,
     times: Vec<f64>,
@@ -117,6 +120,7 @@ impl RerunRecorder {
         Self {
             options,
             rec: None,
+            file: None,
             joint_names: Vec::new(),
             effort: Vec::new(),
             times: Vec::new(),
@@ -149,10 +153,12 @@ impl RerunRecorder {
     }
 
     fn open_stream(&mut self) -> Result<RecordingStream, Error> {
-        use rerun::sink::{FileSink, GrpcSink, LogSink};
+        use rerun::sink::{GrpcSink, LogSink};
         let mut sinks: Vec<Box<dyn LogSink>> = Vec::new();
         if let Some(path) = &self.options.file {
-            sinks.push(Box::new(FileSink::new(path.clone()).map_err(|e| Error::output(path, e))?));
+            let file = RrdFile::create(path).map_err(|e| Error::output(path, e))?;
+            sinks.push(file.sink());
+            self.file = Some(file);
         }
         match &self.options.live {
             None => {}
@@ -591,6 +597,9 @@ impl Recorder for RerunRecorder {
         rec.log_static("summary", &rerun::TextDocument::from_markdown(summary_markdown(summary))).map_err(|x| self.err(x))?;
         rec.flush_blocking().map_err(|x| self.err(x))?;
         drop(rec);
+        if let Some(file) = self.file.take() {
+            file.close().map_err(|e| Error::output(file.path(), e))?;
+        }
         Ok(())
     }
 }
