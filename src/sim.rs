@@ -1,6 +1,6 @@
 //! The simulation loop: controller and plant at the control rate, every sample to every recorder.
 
-use crate::dynamics::{Data, forward_kinematics, frame_pose, gravity_and_bias_from_kinematics};
+use crate::dynamics::{Data, body_poses, forward_kinematics, frame_pose, frame_pose_in, gravity_and_bias_from_kinematics};
 use crate::error::Error;
 use crate::experiment::Experiment;
 use crate::controller::ControlOutput;
@@ -19,7 +19,8 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
     let dt = experiment.dt();
     let mut data = Data::new(model);
     // forward kinematics of the command, for the tool's target
-    let mut command_data = Data::new(model);
+    // where the command puts the arm (poses only), for the tool's target
+    let mut command_poses = vec![crate::spatial::Pose::identity(); n];
     let mut plant = experiment.make_plant();
     let controller = experiment.controller();
     let info = RunInfo {
@@ -54,7 +55,7 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
             previous_u[i] = u[i];
             previous_saturated[i] = saturated[i];
         }
-        forward_kinematics(model, &mut command_data, &cmd);
+        body_poses(model, &cmd, &mut command_poses);
         let interrupted = stop.is_some_and(|s| s.load(Ordering::Relaxed));
         let sample = Sample {
             k,
@@ -70,7 +71,7 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
             chatter: &chatter,
             at_limit: &at_limit,
             tool_position: frame_pose(model, &data, model.tool_frame).translation,
-            tool_target: frame_pose(model, &command_data, model.tool_frame).translation,
+            tool_target: frame_pose_in(model, &command_poses, model.tool_frame).translation,
             body_pose: &data.body_pose,
         };
         stats.record(&sample);

@@ -2,11 +2,11 @@
 //! continuous, prismatic and fixed joints, arbitrary origins), not only the box model:
 //! ABA = M⁻¹(τ + τ_g − C q̇) with M from CRBA and τ_g, C q̇ from RNEA; RNEA(q, q̇, ABA(τ)) = τ;
 //! ½ q̇ᵀ M q̇ equals the bodies' kinetic energy; the Jacobian equals the derivative of forward
-//! kinematics.
+//! kinematics; the poses-only kinematics equals the full one.
 
 mod common;
 
-use armscope::dynamics::{Data, aba, bias_forces, crba, forward_kinematics, frame_jacobian, frame_pose, gravity_forces, rnea};
+use armscope::dynamics::{Data, aba, bias_forces, body_poses, crba, forward_kinematics, frame_jacobian, frame_pose, frame_pose_in, gravity_forces, rnea};
 use armscope::model::load_urdf_str;
 use common::random_tree::{tree, urdf};
 use nalgebra::{DMatrix, DVector};
@@ -73,6 +73,19 @@ proptest! {
         rnea(&model, &mut data, &q, &v, &vec![0.0; v.len()]);
         let from_bodies: f64 = (0..model.dof()).map(|i| 0.5 * data.velocity[i].dot(&(data.body_inertia[i] * data.velocity[i]))).sum();
         prop_assert!((from_m - from_bodies).abs() <= 1e-10 * from_m.abs().max(1.0));
+    }
+
+    #[test]
+    fn poses_only_kinematics_equals_forward_kinematics((text, (q, _v, _tau)) in case()) {
+        let model = load_urdf_str(&text, Path::new("random.urdf")).unwrap();
+        let mut data = Data::new(&model);
+        forward_kinematics(&model, &mut data, &q);
+        let mut poses = vec![armscope::spatial::Pose::identity(); model.dof()];
+        body_poses(&model, &q, &mut poses);
+        for f in 0..model.frames.len() {
+            let (a, b) = (frame_pose(&model, &data, f), frame_pose_in(&model, &poses, f));
+            prop_assert!(a.translation == b.translation && a.rotation == b.rotation, "frame {f}");
+        }
     }
 
     #[test]

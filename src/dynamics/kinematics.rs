@@ -1,25 +1,29 @@
 use super::Data;
-use crate::model::{JointKind, Model};
+use crate::model::{Joint, JointKind, Model};
 use crate::spatial::{Pose, rotation_about_axis, spatial};
 use nalgebra::{Matrix3, Vector3};
+
+/// Body `joint`'s world pose from its parent's, and its joint axis in world coordinates.
+#[inline]
+fn body_pose(joint: &Joint, parent: &Pose, q: f64) -> (Pose, Vector3<f64>) {
+    let joint_frame = parent.compose(&joint.placement);
+    let axis_world: Vector3<f64> = joint_frame.rotation * joint.axis;
+    let pose = match joint.kind {
+        JointKind::Revolute | JointKind::Continuous => {
+            // rotating about the axis commutes with the axis itself, so R·Rot(a,q) = Rot(R a, q)·R
+            Pose::new(rotation_about_axis(&axis_world, q) * joint_frame.rotation, joint_frame.translation)
+        }
+        JointKind::Prismatic => Pose::new(joint_frame.rotation, joint_frame.translation + axis_world * q),
+    };
+    (pose, axis_world)
+}
 
 /// Body poses, joint motion subspaces and body inertias in world coordinates at `q`.
 pub fn forward_kinematics(model: &Model, data: &mut Data, q: &[f64]) {
     debug_assert_eq!(q.len(), model.dof());
     for (i, joint) in model.joints.iter().enumerate() {
-        let parent = match joint.parent {
-            Some(p) => data.body_pose[p],
-            None => Pose::identity(),
-        };
-        let joint_frame = parent.compose(&joint.placement);
-        let axis_world: Vector3<f64> = joint_frame.rotation * joint.axis;
-        let pose = match joint.kind {
-            JointKind::Revolute | JointKind::Continuous => {
-                // rotating about the axis commutes with the axis itself, so R·Rot(a,q) = Rot(R a, q)·R
-                Pose::new(rotation_about_axis(&axis_world, q[i]) * joint_frame.rotation, joint_frame.translation)
-            }
-            JointKind::Prismatic => Pose::new(joint_frame.rotation, joint_frame.translation + axis_world * q[i]),
-        };
+        let parent = joint.parent.map_or(Pose::identity(), |p| data.body_pose[p]);
+        let (pose, axis_world) = body_pose(joint, &parent, q[i]);
         data.motion_subspace[i] = match joint.kind {
             JointKind::Revolute | JointKind::Continuous => spatial(axis_world, pose.translation.cross(&axis_world)),
             JointKind::Prismatic => spatial(Vector3::zeros(), axis_world),
@@ -35,6 +39,15 @@ pub fn forward_kinematics(model: &Model, data: &mut Data, q: &[f64]) {
     }
 }
 
+/// Only the body poses at `q` (no motion subspaces or inertias): where a command puts the arm.
+pub fn body_poses(model: &Model, q: &[f64], poses: &mut [Pose]) {
+    debug_assert_eq!(q.len(), model.dof());
+    for (i, joint) in model.joints.iter().enumerate() {
+        let parent = joint.parent.map_or(Pose::identity(), |p| poses[p]);
+        poses[i] = body_pose(joint, &parent, q[i]).0;
+    }
+}
+
 #[inline]
 fn rotate_inertia(r: &Matrix3<f64>, inertia: &Matrix3<f64>) -> Matrix3<f64> {
     r * inertia * r.transpose()
@@ -42,9 +55,14 @@ fn rotate_inertia(r: &Matrix3<f64>, inertia: &Matrix3<f64>) -> Matrix3<f64> {
 
 /// World pose of a frame (URDF link), from the body poses of the last `forward_kinematics`.
 pub fn frame_pose(model: &Model, data: &Data, frame: usize) -> Pose {
+    frame_pose_in(model, &data.body_pose, frame)
+}
+
+/// World pose of a frame (URDF link) given the world poses of the bodies.
+pub fn frame_pose_in(model: &Model, body_poses: &[Pose], frame: usize) -> Pose {
     let f = &model.frames[frame];
     match f.body {
-        Some(b) => data.body_pose[b].compose(&f.placement),
+        Some(b) => body_poses[b].compose(&f.placement),
         None => f.placement,
     }
 }

@@ -19,5 +19,5 @@ pub use cholesky::{cholesky_in_place, cholesky_solve_in_place};
 pub use crba::{crba, crba_from_kinematics};
 pub use data::Data;
 pub use jacobian::frame_jacobian;
-pub use kinematics::{forward_kinematics, frame_pose};
+pub use kinematics::{body_poses, forward_kinematics, frame_pose, frame_pose_in};
 pub use rnea::{bias_forces, gravity_and_bias_from_kinematics, gravity_forces, gravity_from_kinematics, rnea, rnea_from_kinematics};
