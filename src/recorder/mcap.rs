@@ -25,6 +25,8 @@ use std::fs::File;
 use std::io::BufWriter;
 use std::path::PathBuf;
 use std::marker::PhantomData;
+use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
+use std::thread::JoinHandle;
 
 pub const TOPIC_TF: &str = "/tf";
 pub const TOPIC_SCENE: &str = "/robot/geometry";
@@ -48,28 +50,110 @@ struct Topic<T> {
     _message: PhantomData<T>,
 }
 
-/// The MCAP file and a reusable encoding buffer.
+type McapWriter = mcap::Writer<BufWriter<File>>;
+
+/// Encoded messages on their way to the writer thread: payloads back to back, and per message its
+/// header and where its payload ends.
+#[derive(Default)]
+struct Batch {
+    bytes: Vec<u8>,
+    messages: Vec<(MessageHeader, usize)>,
+}
+
+/// Messages per batch: ~250 control steps.
+const BATCH_MESSAGES: usize = 1000;
+
+/// The MCAP file, written on a thread of its own: this (recorder) thread encodes the messages,
+/// the writer thread frames and compresses them (zstd, the larger half of the work), so the two
+/// halves run on both cores instead of one.
 struct Out {
-    writer: mcap::Writer<BufWriter<File>>,
-    buf: Vec<u8>,
+    /// The writer while schemas, channels and metadata are added (before `spawn`, after `close`).
+    writer: Option<McapWriter>,
+    batch: Batch,
+    tx: Option<SyncSender<Batch>>,
+    recycled: Option<Receiver<Batch>>,
+    worker: Option<JoinHandle<(McapWriter, Result<(), String>)>>,
 }
 
 impl Out {
+    fn new(writer: McapWriter) -> Self {
+        Self { writer: Some(writer), batch: Batch::default(), tx: None, recycled: None, worker: None }
+    }
+
+    fn writer(&mut self) -> &mut McapWriter {
+        self.writer.as_mut().expect("the writer is here before spawn and after close")
+    }
+
     fn channel<T: Encode>(&mut self, topic: &str, metadata: BTreeMap<String, String>) -> mcap::McapResult<Topic<T>> {
         let schema_id = match T::get_schema() {
-            Some(s) => self.writer.add_schema(&s.name, &s.encoding, &s.data)?,
+            Some(s) => self.writer().add_schema(&s.name, &s.encoding, &s.data)?,
             None => 0,
         };
-        let id = self.writer.add_channel(schema_id, topic, &T::get_message_encoding(), &metadata)?;
+        let id = self.writer().add_channel(schema_id, topic, &T::get_message_encoding(), &metadata)?;
         Ok(Topic { id, sequence: 0, _message: PhantomData })
     }
 
     fn log<T: Encode>(&mut self, topic: &mut Topic<T>, msg: &T, time_ns: u64) -> Result<(), String> {
-        self.buf.clear();
-        msg.encode(&mut self.buf).map_err(|e| e.to_string())?;
+        msg.encode(&mut self.batch.bytes).map_err(|e| e.to_string())?;
         let header = MessageHeader { channel_id: topic.id, sequence: topic.sequence, log_time: time_ns, publish_time: time_ns };
         topic.sequence += 1;
-        self.writer.write_to_known_channel(&header, &self.buf).map_err(|e| e.to_string())
+        self.batch.messages.push((header, self.batch.bytes.len()));
+        if self.batch.messages.len() >= BATCH_MESSAGES { self.send() } else { Ok(()) }
+    }
+
+    /// Moves the writer to its thread; messages logged from now on are written there.
+    fn spawn(&mut self) -> Result<(), String> {
+        let mut writer = self.writer.take().expect("spawned once");
+        let (tx, rx) = sync_channel::<Batch>(4);
+        let (back_tx, back_rx) = sync_channel::<Batch>(4);
+        let worker = std::thread::Builder::new().name("McapWriter".into()).spawn(move || {
+            for mut batch in rx {
+                let mut start = 0;
+                for (header, end) in &batch.messages {
+                    if let Err(e) = writer.write_to_known_channel(header, &batch.bytes[start..*end]) {
+                        return (writer, Err(e.to_string()));
+                    }
+                    start = *end;
+                }
+                batch.bytes.clear();
+                batch.messages.clear();
+                let _ = back_tx.try_send(batch);
+            }
+            (writer, Ok(()))
+        });
+        self.worker = Some(worker.map_err(|e| e.to_string())?);
+        self.tx = Some(tx);
+        self.recycled = Some(back_rx);
+        Ok(())
+    }
+
+    fn send(&mut self) -> Result<(), String> {
+        let Some(tx) = &self.tx else { return Ok(()) };
+        let fresh = self.recycled.as_ref().and_then(|r| r.try_recv().ok()).unwrap_or_default();
+        let full = std::mem::replace(&mut self.batch, fresh);
+        if tx.send(full).is_err() {
+            // the writer stopped on an error: report it
+            return self.join();
+        }
+        Ok(())
+    }
+
+    /// Writes what is left and takes the writer back.
+    fn join(&mut self) -> Result<(), String> {
+        self.tx = None;
+        match self.worker.take() {
+            Some(worker) => {
+                let (writer, result) = worker.join().map_err(|_| "the MCAP writer thread panicked".to_string())?;
+                self.writer = Some(writer);
+                result
+            }
+            None => Ok(()),
+        }
+    }
+
+    fn close(&mut self) -> Result<(), String> {
+        self.send()?;
+        self.join()
     }
 }
 
@@ -155,7 +239,7 @@ impl McapRecorder {
     fn write_metadata(&mut self, name: &str, entries: BTreeMap<String, String>) -> Result<(), Error> {
         let record = mcap::records::Metadata { name: name.into(), metadata: entries };
         match self.out.as_mut() {
-            Some(out) => out.writer.write_metadata(&record).map_err(|e| Error::output(&self.path, e)),
+            Some(out) => out.writer().write_metadata(&record).map_err(|e| Error::output(&self.path, e)),
             None => Ok(()),
         }
     }
@@ -303,7 +387,7 @@ impl Recorder for McapRecorder {
             .compression_threads(0)
             .library(format!("armscope {} (foxglove-sdk schemas, mcap-rust)", env!("CARGO_PKG_VERSION")));
         let writer = options.create(BufWriter::new(file)).map_err(|err| self.err(err))?;
-        let mut out = Out { writer, buf: Vec::with_capacity(4096) };
+        let mut out = Out::new(writer);
         let none = BTreeMap::new;
         // joint order and limits are constant: channel metadata, not repeated in every message
         let mut controller_meta = BTreeMap::new();
@@ -404,7 +488,8 @@ impl Recorder for McapRecorder {
         meta.insert("command".into(), run.trajectory.clone());
         meta.insert("start_time_unix_ns".into(), self.start_ns.to_string());
         meta.insert("timestamps".into(), "log time = start_time_unix_ns + simulation time (s) × 1e9".into());
-        self.write_metadata("armscope.config", meta)
+        self.write_metadata("armscope.config", meta)?;
+        self.out.as_mut().expect("started").spawn().map_err(|e| Error::output(&self.path, e))
     }
 
     fn record(&mut self, s: &Sample) -> Result<(), Error> {
@@ -472,10 +557,13 @@ impl Recorder for McapRecorder {
         let mut meta = BTreeMap::new();
         meta.insert("summary".into(), serde_json::to_string(summary).unwrap_or_default());
         meta.insert("status".into(), serde_json::to_string(&summary.status).unwrap_or_default());
+        if let Some(out) = self.out.as_mut() {
+            out.close().map_err(|e| Error::output(&self.path, e))?;
+        }
         self.write_metadata("armscope.summary", meta)?;
         self.channels = None;
         if let Some(mut out) = self.out.take() {
-            out.writer.finish().map_err(|e| self.err(e))?;
+            out.writer().finish().map_err(|e| self.err(e))?;
         }
         Ok(())
     }
