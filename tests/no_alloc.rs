@@ -1,5 +1,6 @@
 //! A control step (kinematics, τ_g and C·q̇, controller, plant) allocates nothing, for the discrete
-//! and the continuous plant. Counted with a global allocator that tallies every allocation.
+//! and the continuous plant. Counted with a global allocator that tallies every allocation made on
+//! the test's own thread (the test harness's threads allocate when they like).
 
 mod common;
 
@@ -8,14 +9,23 @@ use armscope::controller::ControlOutput;
 use armscope::dynamics::{Data, forward_kinematics, frame_pose, gravity_and_bias_from_kinematics};
 use armscope::experiment::Experiment;
 use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::cell::Cell;
 
 struct Counting;
-static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
+
+thread_local! {
+    /// Allocations on this thread (a const-initialized Cell: reading it does not allocate).
+    static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
+}
+
+fn allocations() -> usize {
+    ALLOCATIONS.with(|a| a.get())
+}
 
 unsafe impl GlobalAlloc for Counting {
     unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
+        // try_with: the thread-local may already be gone while a thread shuts down
+        let _ = ALLOCATIONS.try_with(|a| a.set(a.get() + 1));
         unsafe { System.alloc(layout) }
     }
     unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
@@ -44,11 +54,11 @@ fn allocations_in_steps(config: RunConfig) -> usize {
         plant.advance(model, &mut data, &u, q, v);
     };
     step(0, &mut q, &mut v); // warm-up: nothing lazy left
-    let before = ALLOCATIONS.load(Ordering::SeqCst);
+    let before = allocations();
     for k in 1..500 {
         step(k, &mut q, &mut v);
     }
-    ALLOCATIONS.load(Ordering::SeqCst) - before
+    allocations() - before
 }
 
 #[test]

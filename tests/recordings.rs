@@ -151,6 +151,8 @@ fn mcap_has_the_channels_schemas_and_per_step_messages_and_equals_the_trace() {
     let summary = mcap::Summary::read(&bytes).unwrap().expect("summary section");
     assert!(!summary.chunk_indexes.is_empty());
     assert!(summary.chunk_indexes.iter().all(|c| c.compression == "zstd"));
+    // Foxglove refuses to preload a file with a chunk that has no message index
+    assert!(summary.chunk_indexes.iter().all(|c| !c.message_index_offsets.is_empty()), "a chunk without message indexes");
     let names: Vec<String> = summary.metadata_indexes.iter().map(|m| m.name.clone()).collect();
     assert_eq!(names, ["armscope.config", "armscope.summary"]);
     let config = mcap::read::metadata(&bytes, &summary.metadata_indexes[0]).unwrap();

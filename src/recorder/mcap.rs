@@ -387,7 +387,22 @@ impl Recorder for McapRecorder {
             .compression_threads(0)
             .library(format!("armscope {} (foxglove-sdk schemas, mcap-rust)", env!("CARGO_PKG_VERSION")));
         let writer = options.create(BufWriter::new(file)).map_err(|err| self.err(err))?;
-        let mut out = Out::new(writer);
+        self.out = Some(Out::new(writer));
+        let now = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).unwrap_or_default();
+        self.start_ns = now.as_nanos() as u64;
+        // the configuration first: written later, it would close a chunk holding only schemas and
+        // channels, a chunk without message indexes, which Foxglove refuses to preload
+        let mut meta = BTreeMap::new();
+        meta.insert("model".into(), model.name.clone());
+        meta.insert("urdf".into(), model.source.display().to_string());
+        meta.insert("config".into(), serde_json::to_string(&e.config).unwrap_or_default());
+        meta.insert("gains".into(), serde_json::to_string(&e.gains).unwrap_or_default());
+        meta.insert("plant".into(), run.plant.clone());
+        meta.insert("command".into(), run.trajectory.clone());
+        meta.insert("start_time_unix_ns".into(), self.start_ns.to_string());
+        meta.insert("timestamps".into(), "log time = start_time_unix_ns + simulation time (s) × 1e9".into());
+        self.write_metadata("armscope.config", meta)?;
+        let mut out = self.out.take().expect("just created");
         let none = BTreeMap::new;
         // joint order and limits are constant: channel metadata, not repeated in every message
         let mut controller_meta = BTreeMap::new();
@@ -408,8 +423,6 @@ impl Recorder for McapRecorder {
         .map_err(|err| self.err(err))?;
         self.channels = Some(channels);
         self.out = Some(out);
-        let now = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).unwrap_or_default();
-        self.start_ns = now.as_nanos() as u64;
         self.dt = e.config.dt;
         self.steps_per_path_point = ((0.05 / self.dt).round() as usize).max(1);
 
@@ -479,16 +492,6 @@ impl Recorder for McapRecorder {
         let (out, ch) = (self.out.as_mut().unwrap(), self.channels.as_mut().unwrap());
         out.log(&mut ch.commanded_path, &SceneUpdate { deletions: vec![], entities: vec![commanded] }, t0).map_err(fail)?;
 
-        let mut meta = BTreeMap::new();
-        meta.insert("model".into(), model.name.clone());
-        meta.insert("urdf".into(), model.source.display().to_string());
-        meta.insert("config".into(), serde_json::to_string(&e.config).unwrap_or_default());
-        meta.insert("gains".into(), serde_json::to_string(&e.gains).unwrap_or_default());
-        meta.insert("plant".into(), run.plant.clone());
-        meta.insert("command".into(), run.trajectory.clone());
-        meta.insert("start_time_unix_ns".into(), self.start_ns.to_string());
-        meta.insert("timestamps".into(), "log time = start_time_unix_ns + simulation time (s) × 1e9".into());
-        self.write_metadata("armscope.config", meta)?;
         self.out.as_mut().expect("started").spawn().map_err(|e| Error::output(&self.path, e))
     }
 
