@@ -385,6 +385,9 @@ impl Recorder for McapRecorder {
             .compression(Some(mcap::Compression::Zstd))
             .compression_level(zstd_level(ZSTD_LEVEL))
             .compression_threads(0)
+            // within zstd's window at this level, so no block takes its slower "external
+            // dictionary" path (−5 % of the writer's work at the same size)
+            .chunk_size(Some(512 * 1024))
             .library(format!("armscope {} (foxglove-sdk schemas, mcap-rust)", env!("CARGO_PKG_VERSION")));
         let writer = options.create(BufWriter::new(file)).map_err(|err| self.err(err))?;
         self.out = Some(Out::new(writer));
