@@ -70,7 +70,8 @@ fn mcap_has_the_channels_schemas_and_per_step_messages_and_equals_the_trace() {
         ("/tf", "foxglove.FrameTransforms", "protobuf", Some(steps)),
         ("/joint_states", "foxglove.JointStates", "protobuf", Some(steps)),
         ("/controller", "armscope.ControllerTelemetry", "protobuf", Some(steps)),
-        ("/tool/pose", "foxglove.PoseInFrame", "protobuf", Some(steps)),
+        // the pose at the display rate of the path, 50 Hz: every 20th step and the last
+        ("/tool/pose", "foxglove.PoseInFrame", "protobuf", Some(steps.div_ceil(20))),
         ("/robot/geometry", "foxglove.SceneUpdate", "protobuf", None),
         ("/tool/path", "foxglove.SceneUpdate", "protobuf", None),
         ("/tool/commanded_path", "foxglove.SceneUpdate", "protobuf", Some(1)),
@@ -102,6 +103,8 @@ fn mcap_has_the_channels_schemas_and_per_step_messages_and_equals_the_trace() {
         let v = prost_reflect::DynamicMessage::decode(descriptor.clone(), &m.3[..]).unwrap();
         let list = |field: &str| v.get_field_by_name(field).unwrap().as_list().unwrap().to_vec();
         assert_eq!(v.get_field_by_name("time").unwrap().as_f64().unwrap(), run.trace.rows[k][0]);
+        let tool: Vec<f64> = list("tool_position").iter().map(|x| x.as_f64().unwrap()).collect();
+        assert_eq!(tool, ["x", "y", "z"].map(|a| run.trace.rows[k][run.trace.col(a)]), "tool position step {k}");
         for j in 0..6 {
             let get = |field: &str| list(field)[j].as_f64().unwrap();
             assert_eq!(get("target"), col(&run.trace, "cmd", j)[k], "target J{} step {k}", j + 1);
@@ -121,7 +124,9 @@ fn mcap_has_the_channels_schemas_and_per_step_messages_and_equals_the_trace() {
             assert_eq!(state.effort, Some(col(&run.trace, "u", j)[k]));
         }
     }
-    for (k, m) in topics["/tool/pose"].iter().enumerate() {
+    for (i, m) in topics["/tool/pose"].iter().enumerate() {
+        let k = ((m.0 - t0) / 1_000_000) as usize;
+        assert!(k % 20 == 0 || k == steps - 1, "pose {i} at step {k}");
         let p = PoseInFrame::decode(&m.3[..]).unwrap().pose.unwrap().position.unwrap();
         for (got, name) in [(p.x, "x"), (p.y, "y"), (p.z, "z")] {
             assert_eq!(got, run.trace.rows[k][run.trace.col(name)], "tool {name} step {k}");

@@ -38,6 +38,9 @@ pub struct ControllerTelemetry {
     /// Distance of the tool tip from where the command puts it, m.
     #[prost(double, tag = "8")]
     pub tool_error: f64,
+    /// Tool tip position [x, y, z] in the world frame, m.
+    #[prost(double, repeated, tag = "9")]
+    pub tool_position: Vec<f64>,
 }
 
 /// The schema as MCAP's protobuf profile wants it: a serialized FileDescriptorSet. Kept next to
@@ -62,6 +65,7 @@ pub fn file_descriptor_set() -> Vec<u8> {
             field("saturated", 6, true, Type::Uint32),
             field("chatter", 7, true, Type::Uint32),
             field("tool_error", 8, false, Type::Double),
+            field("tool_position", 9, true, Type::Double),
         ],
         ..Default::default()
     };
