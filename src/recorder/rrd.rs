@@ -298,59 +298,40 @@ impl RerunRecorder {
         if self.times.is_empty() {
             return Ok(());
         }
-        let e = |err: rerun::RecordingStreamError| self.err(err);
         let time = TimeColumn::new_duration_secs(TIMELINE, self.times.iter().copied());
         let steps = self.times.len();
+        let send = |entity: &str, time: TimeColumn, columns: Result<Vec<rerun::SerializedComponentColumn>, rerun::SerializationError>| -> Result<(), Error> {
+            send_in_order(&rec, entity, time, columns.map_err(|x| self.err(x))?).map_err(|x| self.err(x))
+        };
         // `width` values per row
-        let scalars = |values: &[f64], width: usize| rerun::Scalars::new(values.iter().copied()).columns(std::iter::repeat_n(width, values.len() / width));
+        let scalars = |values: &[f64], width: usize| rerun::Scalars::new(values.iter().copied()).columns(std::iter::repeat_n(width, values.len() / width)).map(Iterator::collect);
         for (j, name) in self.joint_names.iter().enumerate() {
             let c = &self.joints[j];
             let base = format!("joints/{name}");
             for (leaf, values, width) in [("position", &c.position, 2), ("torque", &c.torque, 2), ("status", &c.status, 3)] {
                 debug_assert_eq!(values.len(), width * steps);
-                rec.send_columns(format!("{base}/{leaf}"), [time.clone()], scalars(values, width).map_err(|x| self.err(x))?).map_err(e)?;
+                send(&format!("{base}/{leaf}"), time.clone(), scalars(values, width))?;
             }
             if !c.saturated_times.is_empty() {
-                rec.send_columns(
-                    format!("{base}/saturated_torque"),
-                    [TimeColumn::new_duration_secs(TIMELINE, c.saturated_times.iter().copied())],
-                    scalars(&c.saturated_torque, 1).map_err(|x| self.err(x))?,
-                )
-                .map_err(e)?;
+                let times = TimeColumn::new_duration_secs(TIMELINE, c.saturated_times.iter().copied());
+                send(&format!("{base}/saturated_torque"), times, scalars(&c.saturated_torque, 1))?;
             }
             // the limits as lines spanning the block: two points each
             let effort = self.effort[j];
             if effort.is_finite() {
-                let ends = [self.times[0], self.times[steps - 1]];
-                rec.send_columns(
-                    format!("{base}/torque_limit"),
-                    [TimeColumn::new_duration_secs(TIMELINE, ends)],
-                    scalars(&[effort, -effort, effort, -effort], 2).map_err(|x| self.err(x))?,
-                )
-                .map_err(e)?;
+                let ends = TimeColumn::new_duration_secs(TIMELINE, [self.times[0], self.times[steps - 1]]);
+                send(&format!("{base}/torque_limit"), ends, scalars(&[effort, -effort, effort, -effort], 2))?;
             }
         }
-        rec.send_columns("tool/position", [time.clone()], scalars(&self.tool, 3).map_err(|x| self.err(x))?).map_err(e)?;
-        rec.send_columns("tool_error", [time.clone()], scalars(&self.tool_error, 1).map_err(|x| self.err(x))?).map_err(e)?;
+        send("tool/position", time.clone(), scalars(&self.tool, 3))?;
+        send("tool_error", time.clone(), scalars(&self.tool_error, 1))?;
         if !self.trail_times.is_empty() {
-            rec.send_columns(
-                "world/tool/trail",
-                [TimeColumn::new_duration_secs(TIMELINE, self.trail_times.iter().copied())],
-                rerun::LineStrips3D::update_fields().with_strips(self.trail_strips.iter().cloned()).columns_of_unit_batches().map_err(|x| self.err(x))?,
-            )
-            .map_err(e)?;
+            let times = TimeColumn::new_duration_secs(TIMELINE, self.trail_times.iter().copied());
+            send("world/tool/trail", times, rerun::LineStrips3D::update_fields().with_strips(self.trail_strips.iter().cloned()).columns_of_unit_batches().map(Iterator::collect))?;
         }
         for link in &self.links {
-            rec.send_columns(
-                link.entity.as_str(),
-                [time.clone()],
-                rerun::Transform3D::update_fields()
-                    .with_many_translation(link.translations.iter().copied())
-                    .with_many_quaternion(link.rotations.iter().copied())
-                    .columns_of_unit_batches()
-                    .map_err(|x| self.err(x))?,
-            )
-            .map_err(e)?;
+            let poses = rerun::Transform3D::update_fields().with_many_translation(link.translations.iter().copied()).with_many_quaternion(link.rotations.iter().copied());
+            send(link.entity.as_str(), time.clone(), poses.columns_of_unit_batches().map(Iterator::collect))?;
         }
         self.times.clear();
         for j in &mut self.joints {
@@ -370,6 +351,24 @@ impl RerunRecorder {
         self.last_flush = Instant::now();
         Ok(())
     }
+}
+
+/// `send_columns` for rows already in time order. Rerun's own first reorders every chunk by time
+/// (a sort and a shuffle of each column, a fifth of this recorder's work); a block's rows are in
+/// order, so here they keep it and get consecutive row ids.
+fn send_in_order(
+    rec: &RecordingStream,
+    entity: &str,
+    time: TimeColumn,
+    columns: impl IntoIterator<Item = rerun::SerializedComponentColumn>,
+) -> Result<(), rerun::log::ChunkError> {
+    use rerun::log::{Chunk, ChunkId, RowId};
+    let rows = time.num_rows();
+    let row_ids: Vec<RowId> = std::iter::successors(Some(RowId::new()), |id| Some(id.next())).take(rows).collect();
+    let components: rerun::log::ChunkComponents = columns.into_iter().map(|c| (c.descriptor, c.list_array)).collect();
+    let timelines = std::iter::once((*time.timeline().name(), time)).collect();
+    rec.send_chunk(Chunk::from_native_row_ids(ChunkId::new(), entity.into(), Some(true), &row_ids, timelines, components)?);
+    Ok(())
 }
 
 fn viewer_reachable(url: &str) -> Result<rerun::external::re_uri::ProxyUri, String> {
