@@ -3,7 +3,8 @@
 //! Timestamps are simulation time offset by the wall-clock start of the run (in the metadata).
 //!
 //! The foxglove SDK provides the well-known schemas and their encoders; the mcap crate writes the
-//! file directly (the SDK's sink machinery costs more per message than the encoding itself).
+//! file directly (the SDK's sink machinery costs more per message than the encoding itself), on a
+//! thread of its own (see `Out`).
 
 use super::telemetry::ControllerTelemetry;
 use super::{Recorder, RunInfo};
@@ -539,7 +540,7 @@ impl Recorder for McapRecorder {
         out.log(&mut ch.joint_states, &self.joints_msg, stamp).map_err(fail)?;
         out.log(&mut ch.controller, &self.telemetry, stamp).map_err(fail)?;
         // the tool pose at a display rate, 50 Hz (every step's tool position is in /controller)
-        if s.k % self.steps_per_pose == 0 || s.is_final {
+        if s.k.is_multiple_of(self.steps_per_pose) || s.is_final {
             out.log(&mut ch.tool_pose, &PoseInFrame { timestamp: ts, frame_id: "world".into(), pose: Some(fox_pose(&tool)) }, stamp).map_err(fail)?;
         }
         // geometry once a simulated second, so a viewer that seeks always has it
@@ -557,10 +558,10 @@ impl Recorder for McapRecorder {
                 out.log(&mut ch.tf, &self.fixed_tf_msg, stamp).map_err(fail)?;
             }
         }
-        if s.k % self.steps_per_path_point == 0 || s.is_final {
+        if s.k.is_multiple_of(self.steps_per_path_point) || s.is_final {
             let p = tool.translation;
             self.path_points.push(Point3 { x: p.x, y: p.y, z: p.z });
-            if self.path_points.len() % 10 == 0 || s.is_final {
+            if self.path_points.len().is_multiple_of(10) || s.is_final {
                 self.publish_path(s.t)?;
             }
         }

@@ -1,6 +1,7 @@
 //! Rerun recorder: every joint series at the control rate on the `sim_time` timeline, the arm in
 //! 3D, the tool's trail and paths, the run's configuration and summary, and a blueprint. Columns
-//! are buffered and sent with `send_columns` in blocks (per-step `log` calls cost ~170 µs here).
+//! are buffered and sent as one chunk per entity and block (per-step `log` calls cost ~170 µs
+//! here; a block of 4096 steps costs ~2.5 µs per step), to the `.rrd` and/or a live viewer.
 
 use super::rrd_file::RrdFile;
 use super::{Recorder, RunInfo};
@@ -569,7 +570,7 @@ impl Recorder for RerunRecorder {
             link.rotations.push(quaternion(&pose));
         }
         self.last_t = s.t;
-        if s.k % self.steps_per_trail_point == 0 {
+        if s.k.is_multiple_of(self.steps_per_trail_point) {
             self.trail.push_back(tip);
             let keep = (TRAIL_SECONDS * TRAIL_RATE_HZ) as usize;
             while self.trail.len() > keep {

@@ -204,7 +204,7 @@ impl<R: Recorder + Send + 'static> Recorder for Threaded<R> {
     fn record(&mut self, s: &Sample) -> Result<(), Error> {
         self.block.push(s);
         // the clock is read every 16 samples only: at 1 kHz that is still every 16 ms of simulation
-        let late = || self.block.len() % 16 == 0 && self.last_send.elapsed() >= self.max_latency;
+        let late = || self.block.len().is_multiple_of(16) && self.last_send.elapsed() >= self.max_latency;
         if self.block.len() >= self.block_samples || s.is_final || late() {
             self.send_block()?;
         }
