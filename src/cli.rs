@@ -326,7 +326,7 @@ pub fn default_run_name(config: &RunConfig) -> String {
     if parts.is_empty() {
         parts.push("default".into());
     }
-    parts.join("_").chars().map(|c| if c.is_ascii_alphanumeric() || "-_.".contains(c) { c } else { '-' }).collect()
+    crate::runner::file_safe(&parts.join("_"))
 }
 
 impl RunArgs {
@@ -476,12 +476,7 @@ pub fn batch(args: &BatchArgs) -> Result<i32, Error> {
             let dir = out.clone().unwrap_or_else(|| dirs[0].clone());
             std::fs::create_dir_all(&dir).map_err(|e| Error::output(&dir, e))?;
             let mut files = write_tables(&dir, &merged)?;
-            let runs = crate::batch::compared_runs(&merged, dirs);
-            if !runs.is_empty() {
-                let rrd = dir.join("comparison.rrd");
-                crate::batch::build_comparison(&runs, &rrd, &merged.batch)?;
-                files.push(rrd);
-            }
+            files.extend(crate::batch::write_comparison(&merged, dirs, &dir)?);
             report_batch(&merged, &files);
             merged
         }

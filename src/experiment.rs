@@ -97,14 +97,14 @@ impl Experiment {
     pub fn commanded_tool_path(&self, interval: f64) -> Vec<Vector3<f64>> {
         let model = &*self.model;
         let n = model.dof();
-        let mut data = crate::dynamics::Data::new(model);
+        let mut poses = vec![crate::spatial::Pose::identity(); n];
         let (mut cmd, mut cmd_dot) = (vec![0.0; n], vec![0.0; n]);
         let samples = (self.config.duration / interval).ceil() as usize;
         (0..=samples)
             .map(|i| {
                 self.trajectory.sample((i as f64 * interval).min(self.config.duration), &mut cmd, &mut cmd_dot);
-                crate::dynamics::forward_kinematics(model, &mut data, &cmd);
-                crate::dynamics::frame_pose(model, &data, model.tool_frame).translation
+                crate::dynamics::body_poses(model, &cmd, &mut poses);
+                crate::dynamics::frame_pose_in(model, &poses, model.tool_frame).translation
             })
             .collect()
     }

@@ -31,6 +31,12 @@ pub struct Outputs {
     pub notice: Option<fn(&str)>,
 }
 
+/// `text` with every character that is not ASCII alphanumeric or `-_.` made a `-`: usable as a
+/// file name and as an entity path part.
+pub fn file_safe(text: &str) -> String {
+    text.chars().map(|c| if c.is_ascii_alphanumeric() || "-_.".contains(c) { c } else { '-' }).collect()
+}
+
 pub fn create_parent(path: &Path) -> Result<(), Error> {
     match path.parent() {
         Some(dir) if !dir.as_os_str().is_empty() => std::fs::create_dir_all(dir).map_err(|e| Error::output(dir, e)),

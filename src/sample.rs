@@ -31,3 +31,15 @@ pub struct Sample<'a> {
     /// World pose of every body (joint i moves body i), for drawing.
     pub body_pose: &'a [Pose],
 }
+
+impl Sample<'_> {
+    /// Joint `j`'s tracking error, target − position.
+    pub fn tracking_error(&self, j: usize) -> f64 {
+        self.cmd[j] - self.q[j]
+    }
+
+    /// How far the tool tip is from where the command puts it, m.
+    pub fn tool_error(&self) -> f64 {
+        (self.tool_position - self.tool_target).norm()
+    }
+}

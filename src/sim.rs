@@ -18,7 +18,6 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
     let n = model.dof();
     let dt = experiment.dt();
     let mut data = Data::new(model);
-    // forward kinematics of the command, for the tool's target
     // where the command puts the arm (poses only), for the tool's target
     let mut command_poses = vec![crate::spatial::Pose::identity(); n];
     let mut plant = experiment.make_plant();

@@ -101,7 +101,7 @@ impl SummaryBuilder {
         if s.k >= self.first_window_step {
             self.window_samples += 1;
             for i in 0..n {
-                let e = (s.cmd[i] - s.q[i]).abs();
+                let e = s.tracking_error(i).abs();
                 self.max_err[i] = self.max_err[i].max(e);
                 self.sum_sq_err[i] += e * e;
             }

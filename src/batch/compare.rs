@@ -69,13 +69,8 @@ fn read_run(run: &ComparedRun) -> Result<RunSeries, Error> {
     Ok(series)
 }
 
-/// A label usable as an entity path part.
-fn slug(label: &str) -> String {
-    label.chars().map(|c| if c.is_ascii_alphanumeric() || "-_.".contains(c) { c } else { '-' }).collect()
-}
-
 pub fn build_comparison(runs: &[ComparedRun], out: &Path, name: &str) -> Result<(), Error> {
-    let all: Vec<(String, RunSeries)> = runs.iter().map(|r| read_run(r).map(|s| (slug(&r.label), s))).collect::<Result<_, _>>()?;
+    let all: Vec<(String, RunSeries)> = runs.iter().map(|r| read_run(r).map(|s| (crate::runner::file_safe(&r.label), s))).collect::<Result<_, _>>()?;
     let joints = all[0].1.joints.clone();
     let rec = rerun::RecordingStreamBuilder::new("armscope-compare").recording_name(name).save(out).map_err(|e| Error::output(out, e))?;
     let e = |err: rerun::RecordingStreamError| Error::output(out, err);

@@ -8,5 +8,5 @@ mod table;
 
 pub use compare::{ComparedRun, build_comparison};
 pub use manifest::{Manifest, PlannedExperiment, load_manifest, parse_shard, shard};
-pub use runner::{BatchOptions, ExperimentOutcome, compared_runs, run_batch};
+pub use runner::{BatchOptions, ExperimentOutcome, run_batch, write_comparison};
 pub use table::{BatchSummary, merge_summaries, write_tables};

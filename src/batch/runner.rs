@@ -2,18 +2,6 @@ use super::manifest::{PlannedExperiment, load_manifest, shard};
 use super::table::{BatchSummary, write_tables};
 use super::compare::{ComparedRun, build_comparison};
 
-/// The experiments that finished, with the first of `dirs` that holds their .mcap.
-pub fn compared_runs(summary: &BatchSummary, dirs: &[PathBuf]) -> Vec<ComparedRun> {
-    summary
-        .experiments
-        .iter()
-        .filter(|e| e.summary.is_some())
-        .filter_map(|e| {
-            let mcap = dirs.iter().map(|d| d.join(format!("{}.mcap", e.name))).find(|p| p.exists())?;
-            Some(ComparedRun { label: e.name.clone(), mcap })
-        })
-        .collect()
-}
 use crate::cli::RunArgs;
 use crate::error::Error;
 use crate::experiment::Experiment;
@@ -146,12 +134,27 @@ pub fn run_batch(options: &BatchOptions, stop: Option<&AtomicBool>) -> Result<(B
     };
     let mut files = write_tables(&dir, &summary)?;
     if options.compare && options.shard.is_none() {
-        let runs = compared_runs(&summary, std::slice::from_ref(&dir));
-        if !runs.is_empty() {
-            let out = dir.join("comparison.rrd");
-            build_comparison(&runs, &out, &summary.batch)?;
-            files.push(out);
-        }
+        files.extend(write_comparison(&summary, std::slice::from_ref(&dir), &dir)?);
     }
     Ok((summary, files))
+}
+
+/// `out_dir/comparison.rrd` from the experiments that finished, each from the first of `dirs`
+/// that holds its .mcap. None when there is nothing to compare.
+pub fn write_comparison(summary: &BatchSummary, dirs: &[PathBuf], out_dir: &Path) -> Result<Option<PathBuf>, Error> {
+    let runs: Vec<ComparedRun> = summary
+        .experiments
+        .iter()
+        .filter(|e| e.summary.is_some())
+        .filter_map(|e| {
+            let mcap = dirs.iter().map(|d| d.join(format!("{}.mcap", e.name))).find(|p| p.exists())?;
+            Some(ComparedRun { label: e.name.clone(), mcap })
+        })
+        .collect();
+    if runs.is_empty() {
+        return Ok(None);
+    }
+    let out = out_dir.join("comparison.rrd");
+    build_comparison(&runs, &out, &summary.batch)?;
+    Ok(Some(out))
 }

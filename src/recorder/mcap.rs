@@ -7,10 +7,12 @@
 //! thread of its own (see `Out`).
 
 use super::telemetry::ControllerTelemetry;
+use super::worker::BatchWorker;
 use super::{Recorder, RunInfo};
 use crate::error::Error;
 use crate::model::{Geometry, JointKind, Model};
 use crate::sample::Sample;
+use crate::dynamics::frame_pose_in;
 use crate::spatial::{Pose, rotation_about_axis};
 use crate::summary::Summary;
 use foxglove::messages::{
@@ -26,8 +28,6 @@ use std::fs::File;
 use std::io::BufWriter;
 use std::path::PathBuf;
 use std::marker::PhantomData;
-use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
-use std::thread::JoinHandle;
 
 pub const TOPIC_TF: &str = "/tf";
 pub const TOPIC_SCENE: &str = "/robot/geometry";
@@ -71,14 +71,12 @@ struct Out {
     /// The writer while schemas, channels and metadata are added (before `spawn`, after `close`).
     writer: Option<McapWriter>,
     batch: Batch,
-    tx: Option<SyncSender<Batch>>,
-    recycled: Option<Receiver<Batch>>,
-    worker: Option<JoinHandle<(McapWriter, Result<(), String>)>>,
+    worker: Option<BatchWorker<McapWriter, Batch, String>>,
 }
 
 impl Out {
     fn new(writer: McapWriter) -> Self {
-        Self { writer: Some(writer), batch: Batch::default(), tx: None, recycled: None, worker: None }
+        Self { writer: Some(writer), batch: Batch::default(), worker: None }
     }
 
     fn writer(&mut self) -> &mut McapWriter {
@@ -94,6 +92,10 @@ impl Out {
         Ok(Topic { id, sequence: 0, _message: PhantomData })
     }
 
+    fn write_metadata(&mut self, name: &str, metadata: BTreeMap<String, String>) -> mcap::McapResult<()> {
+        self.writer().write_metadata(&mcap::records::Metadata { name: name.into(), metadata })
+    }
+
     fn log<T: Encode>(&mut self, topic: &mut Topic<T>, msg: &T, time_ns: u64) -> Result<(), String> {
         msg.encode(&mut self.batch.bytes).map_err(|e| e.to_string())?;
         let header = MessageHeader { channel_id: topic.id, sequence: topic.sequence, log_time: time_ns, publish_time: time_ns };
@@ -104,35 +106,28 @@ impl Out {
 
     /// Moves the writer to its thread; messages logged from now on are written there.
     fn spawn(&mut self) -> Result<(), String> {
-        let mut writer = self.writer.take().expect("spawned once");
-        let (tx, rx) = sync_channel::<Batch>(4);
-        let (back_tx, back_rx) = sync_channel::<Batch>(4);
-        let worker = std::thread::Builder::new().name("McapWriter".into()).spawn(move || {
-            for mut batch in rx {
-                let mut start = 0;
-                for (header, end) in &batch.messages {
-                    if let Err(e) = writer.write_to_known_channel(header, &batch.bytes[start..*end]) {
-                        return (writer, Err(e.to_string()));
-                    }
-                    start = *end;
-                }
-                batch.bytes.clear();
-                batch.messages.clear();
-                let _ = back_tx.try_send(batch);
+        let writer = self.writer.take().expect("spawned once");
+        let worker = BatchWorker::spawn("McapWriter", writer, |writer: &mut McapWriter, batch: &Batch| {
+            let mut start = 0;
+            for (header, end) in &batch.messages {
+                writer.write_to_known_channel(header, &batch.bytes[start..*end]).map_err(|e| e.to_string())?;
+                start = *end;
             }
-            (writer, Ok(()))
+            Ok(())
         });
         self.worker = Some(worker.map_err(|e| e.to_string())?);
-        self.tx = Some(tx);
-        self.recycled = Some(back_rx);
         Ok(())
     }
 
     fn send(&mut self) -> Result<(), String> {
-        let Some(tx) = &self.tx else { return Ok(()) };
-        let fresh = self.recycled.as_ref().and_then(|r| r.try_recv().ok()).unwrap_or_default();
+        let Some(worker) = &self.worker else { return Ok(()) };
+        let fresh = worker.recycled().map_or_else(Batch::default, |mut b| {
+            b.bytes.clear();
+            b.messages.clear();
+            b
+        });
         let full = std::mem::replace(&mut self.batch, fresh);
-        if tx.send(full).is_err() {
+        if !worker.send(full) {
             // the writer stopped on an error: report it
             return self.join();
         }
@@ -141,10 +136,9 @@ impl Out {
 
     /// Writes what is left and takes the writer back.
     fn join(&mut self) -> Result<(), String> {
-        self.tx = None;
-        match self.worker.take() {
-            Some(worker) => {
-                let (writer, result) = worker.join().map_err(|_| "the MCAP writer thread panicked".to_string())?;
+        match self.worker.as_mut().and_then(BatchWorker::join) {
+            Some(joined) => {
+                let (writer, result) = joined.map_err(|_| "the MCAP writer thread panicked".to_string())?;
                 self.writer = Some(writer);
                 result
             }
@@ -164,7 +158,7 @@ const ZSTD_LEVEL: i32 = -3;
 
 /// The mcap crate takes the level as `u32` and hands it to zstd as `level as i32` (mcap 0.26,
 /// `ChunkWriter::zstd_encoder`), so zstd's negative (fast) levels pass through as their two's
-/// complement. The test `negative_zstd_levels_reach_zstd` pins that down.
+/// complement. The test `negative_zstd_levels_reach_zstd_through_mcap` pins that down.
 fn zstd_level(level: i32) -> u32 {
     level as u32
 }
@@ -187,8 +181,6 @@ pub struct McapRecorder {
     start_ns: u64,
     /// One per moving joint, in the order of `tf_msg.transforms`.
     joint_tfs: Vec<JointTransform>,
-    /// The tool link's body and its pose in that body.
-    tool_frame: (Option<usize>, Pose),
     tf_msg: FrameTransforms,
     /// The transforms of fixed joints (constant; sent with the geometry, once a simulated second).
     fixed_tf_msg: FrameTransforms,
@@ -196,7 +188,6 @@ pub struct McapRecorder {
     telemetry: ControllerTelemetry,
     scene: SceneUpdate,
     model: Option<std::sync::Arc<Model>>,
-    dt: f64,
     steps_per_path_point: usize,
     steps_per_pose: usize,
     path_points: Vec<Point3>,
@@ -211,14 +202,12 @@ impl McapRecorder {
             channels: None,
             start_ns: 0,
             joint_tfs: Vec::new(),
-            tool_frame: (None, Pose::identity()),
             tf_msg: FrameTransforms::default(),
             fixed_tf_msg: FrameTransforms::default(),
             joints_msg: JointStates::default(),
             telemetry: ControllerTelemetry::default(),
             scene: SceneUpdate::default(),
             model: None,
-            dt: 0.001,
             steps_per_path_point: 20,
             steps_per_pose: 20,
             path_points: Vec::new(),
@@ -237,14 +226,6 @@ impl McapRecorder {
     fn timestamp(&self, t: f64) -> Timestamp {
         let ns = self.stamp(t);
         Timestamp::new((ns / 1_000_000_000) as u32, (ns % 1_000_000_000) as u32)
-    }
-
-    fn write_metadata(&mut self, name: &str, entries: BTreeMap<String, String>) -> Result<(), Error> {
-        let record = mcap::records::Metadata { name: name.into(), metadata: entries };
-        match self.out.as_mut() {
-            Some(out) => out.writer().write_metadata(&record).map_err(|e| Error::output(&self.path, e)),
-            None => Ok(()),
-        }
     }
 
     fn publish_path(&mut self, t: f64) -> Result<(), Error> {
@@ -383,7 +364,7 @@ impl Recorder for McapRecorder {
         let e = run.experiment;
         let model = &*e.model;
         let file = File::create(&self.path).map_err(|err| self.err(err))?;
-        // zstd on this (recorder) thread: zstd's own worker threads cost more than they save here
+        // zstd on the writer thread (`Out`): zstd's own worker threads cost more than they save here
         let options = mcap::WriteOptions::new()
             .compression(Some(mcap::Compression::Zstd))
             .compression_level(zstd_level(ZSTD_LEVEL))
@@ -393,7 +374,7 @@ impl Recorder for McapRecorder {
             .chunk_size(Some(512 * 1024))
             .library(format!("armscope {} (foxglove-sdk schemas, mcap-rust)", env!("CARGO_PKG_VERSION")));
         let writer = options.create(BufWriter::new(file)).map_err(|err| self.err(err))?;
-        self.out = Some(Out::new(writer));
+        let mut out = Out::new(writer);
         let now = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).unwrap_or_default();
         self.start_ns = now.as_nanos() as u64;
         // the configuration first: written later, it would close a chunk holding only schemas and
@@ -407,8 +388,7 @@ impl Recorder for McapRecorder {
         meta.insert("command".into(), run.trajectory.clone());
         meta.insert("start_time_unix_ns".into(), self.start_ns.to_string());
         meta.insert("timestamps".into(), "log time = start_time_unix_ns + simulation time (s) × 1e9".into());
-        self.write_metadata("armscope.config", meta)?;
-        let mut out = self.out.take().expect("just created");
+        out.write_metadata("armscope.config", meta).map_err(|err| self.err(err))?;
         let none = BTreeMap::new;
         // joint order and limits are constant: channel metadata, not repeated in every message
         let mut controller_meta = BTreeMap::new();
@@ -429,13 +409,11 @@ impl Recorder for McapRecorder {
         .map_err(|err| self.err(err))?;
         self.channels = Some(channels);
         self.out = Some(out);
-        self.dt = e.config.dt;
-        self.steps_per_path_point = ((0.05 / self.dt).round() as usize).max(1);
-        self.steps_per_pose = ((0.02 / self.dt).round() as usize).max(1);
+        let steps_per = |period: f64| ((period / e.config.dt).round() as usize).max(1);
+        self.steps_per_path_point = steps_per(0.05);
+        self.steps_per_pose = steps_per(0.02);
 
         // transforms: every link from its parent link; "world" → root when the root is not "world"
-        let tool = &model.frames[model.tool_frame];
-        self.tool_frame = (tool.body, tool.placement);
         let pairs = model.frames.iter().enumerate().filter(|(_, f)| f.parent_frame.is_some() || f.name != "world");
         // a link moves relative to its parent when its joint is a moving joint (the child's body's joint)
         let (moving, fixed): (Vec<_>, Vec<_>) = pairs.partition(|(_, f)| f.parent_frame.is_some_and(|p| model.frames[p].body != f.body));
@@ -518,21 +496,18 @@ impl Recorder for McapRecorder {
         }
         let tel = &mut self.telemetry;
         tel.time = s.t;
-        tel.tool_error = (s.tool_position - s.tool_target).norm();
+        tel.tool_error = s.tool_error();
         tel.tool_position.clear();
         tel.tool_position.extend_from_slice(s.tool_position.as_slice());
         for j in 0..s.q.len() {
             tel.target[j] = s.cmd[j];
-            tel.error[j] = s.cmd[j] - s.q[j];
+            tel.error[j] = s.tracking_error(j);
             tel.torque[j] = s.u[j];
             tel.tau_g[j] = s.tau_g[j];
             tel.saturated[j] = s.saturated[j] as u32;
             tel.chatter[j] = s.chatter[j] as u32;
         }
-        let tool = match self.tool_frame {
-            (Some(body), placement) => s.body_pose[body].compose(&placement),
-            (None, placement) => placement,
-        };
+        let tool = frame_pose_in(model, s.body_pose, model.tool_frame);
         let path = &self.path;
         let fail = |e: String| Error::output(path, e);
         let (out, ch) = (self.out.as_mut().expect("started"), self.channels.as_mut().expect("started"));
@@ -573,12 +548,10 @@ impl Recorder for McapRecorder {
         let mut meta = BTreeMap::new();
         meta.insert("summary".into(), serde_json::to_string(summary).unwrap_or_default());
         meta.insert("status".into(), serde_json::to_string(&summary.status).unwrap_or_default());
-        if let Some(out) = self.out.as_mut() {
-            out.close().map_err(|e| Error::output(&self.path, e))?;
-        }
-        self.write_metadata("armscope.summary", meta)?;
         self.channels = None;
         if let Some(mut out) = self.out.take() {
+            out.close().map_err(|e| self.err(e))?;
+            out.write_metadata("armscope.summary", meta).map_err(|e| self.err(e))?;
             out.writer().finish().map_err(|e| self.err(e))?;
         }
         Ok(())

@@ -9,6 +9,7 @@ mod rrd_file;
 mod summary_json;
 pub mod telemetry;
 mod threaded;
+mod worker;
 mod trace;
 mod tutorial_csv;
 

@@ -5,7 +5,7 @@
 
 use super::rrd_file::RrdFile;
 use super::{Recorder, RunInfo};
-use crate::dynamics::{Data, forward_kinematics, frame_pose};
+use crate::dynamics::frame_pose_in;
 use crate::error::Error;
 use crate::model::{Geometry, Model};
 use crate::sample::Sample;
@@ -16,6 +16,7 @@ use rerun::blueprint::components::{PanelState, PlayState};
 use rerun::{RecordingStream, TimeColumn};
 use std::collections::VecDeque;
 use std::path::PathBuf;
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 pub const TIMELINE: &str = "sim_time";
@@ -73,8 +74,7 @@ impl JointColumns {
 
 /// A link frame that moves: its entity and per-step world poses.
 struct MovingLink {
-    body: usize,
-    placement: Pose,
+    frame: usize,
     entity: String,
     translations: Vec<[f32; 3]>,
     rotations: Vec<rerun::Quaternion>,
@@ -85,6 +85,7 @@ pub struct RerunRecorder {
     rec: Option<RecordingStream>,
     /// The `.rrd`, closed by `finish` once the stream is flushed.
     file: Option<RrdFile>,
+    model: Option<Arc<Model>>,
     joint_names: Vec<String>,
     effort: Vec<f64>,
     times: Vec<f64>,
@@ -98,11 +99,9 @@ pub struct RerunRecorder {
     trail_times: Vec<f64>,
     trail_strips: Vec<Vec<[f32; 3]>>,
     path: Vec<[f32; 3]>,
-    block_steps: usize,
     steps_per_trail_point: usize,
     live: bool,
     last_flush: Instant,
-    last_t: f64,
     /// Messages for the user (no viewer found, …).
     pub notices: Vec<String>,
     notice_sink: Option<Box<dyn Fn(&str) + Send>>,
@@ -122,6 +121,7 @@ impl RerunRecorder {
             options,
             rec: None,
             file: None,
+            model: None,
             joint_names: Vec::new(),
             effort: Vec::new(),
             times: Vec::new(),
@@ -133,11 +133,9 @@ impl RerunRecorder {
             trail_times: Vec::new(),
             trail_strips: Vec::new(),
             path: Vec::new(),
-            block_steps: FILE_BLOCK_STEPS,
             steps_per_trail_point: 20,
             live: false,
             last_flush: Instant::now(),
-            last_t: 0.0,
             notices: Vec::new(),
             notice_sink: None,
         }
@@ -201,14 +199,14 @@ impl RerunRecorder {
             .map_err(|e| self.err(e))
     }
 
-    fn log_static_scene(&self, rec: &RecordingStream, model: &Model, data: &Data) -> Result<(), Error> {
+    fn log_static_scene(&self, rec: &RecordingStream, model: &Model) -> Result<(), Error> {
         let e = |err: rerun::RecordingStreamError| self.err(err);
         rec.log_static("world", &rerun::ViewCoordinates::RIGHT_HAND_Z_UP()).map_err(e)?;
-        for (f, frame) in model.frames.iter().enumerate() {
+        for frame in &model.frames {
             let entity = link_entity(&frame.name);
+            // a link on no body is fixed in the world: its placement is its pose
             if frame.body.is_none() {
-                let pose = frame_pose(model, data, f);
-                rec.log_static(entity.as_str(), &transform(&pose)).map_err(e)?;
+                rec.log_static(entity.as_str(), &transform(&frame.placement)).map_err(e)?;
             }
             for (i, visual) in frame.visuals.iter().enumerate() {
                 let path = format!("{entity}/visual_{i}");
@@ -503,8 +501,7 @@ impl Recorder for RerunRecorder {
         let rec = self.open_stream()?;
         self.joint_names = model.joints.iter().map(|j| j.name.clone()).collect();
         self.effort = e.controller().effort;
-        self.block_steps = FILE_BLOCK_STEPS;
-        let cap = self.block_steps + 1;
+        let cap = FILE_BLOCK_STEPS + 1;
         self.times = Vec::with_capacity(cap);
         self.joints = (0..model.dof()).map(|_| JointColumns::with_capacity(cap)).collect();
         self.tool = Vec::with_capacity(3 * cap);
@@ -513,15 +510,13 @@ impl Recorder for RerunRecorder {
             .iter()
             .enumerate()
             .filter(|(_, f)| f.body.is_some())
-            .map(|(_, f)| MovingLink { body: f.body.expect("filtered"), placement: f.placement, entity: link_entity(&f.name), translations: Vec::with_capacity(cap), rotations: Vec::with_capacity(cap) })
+            .map(|(frame, f)| MovingLink { frame, entity: link_entity(&f.name), translations: Vec::with_capacity(cap), rotations: Vec::with_capacity(cap) })
             .collect();
+        self.model = Some(e.model.clone());
         self.steps_per_trail_point = ((1.0 / TRAIL_RATE_HZ) / e.config.dt).round().max(1.0) as usize;
 
         blueprint(&self.joint_names, "").send(&rec, BlueprintActivation { make_active: true, make_default: true }).map_err(|x| self.err(x))?;
-        let mut data = Data::new(model);
-        let (q0, _) = e.initial_state();
-        forward_kinematics(model, &mut data, &q0);
-        self.log_static_scene(&rec, model, &data)?;
+        self.log_static_scene(&rec, model)?;
         self.log_series_styles(&rec)?;
         rec.log_static("config", &rerun::TextDocument::from_markdown(config_markdown(run))).map_err(|x| self.err(x))?;
         let commanded: Vec<[f32; 3]> = run.commanded_tool_path.iter().map(|p| [p.x as f32, p.y as f32, p.z as f32]).collect();
@@ -553,7 +548,7 @@ impl Recorder for RerunRecorder {
             let flag = |b: bool| if b { 1.0 } else { 0.0 };
             c.position.extend_from_slice(&[s.q[j], s.cmd[j]]);
             c.torque.extend_from_slice(&[s.u[j], s.tau_g[j]]);
-            c.status.extend_from_slice(&[s.cmd[j] - s.q[j], flag(s.saturated[j]), flag(s.chatter[j])]);
+            c.status.extend_from_slice(&[s.tracking_error(j), flag(s.saturated[j]), flag(s.chatter[j])]);
             if s.saturated[j] {
                 c.saturated_times.push(s.t);
                 c.saturated_torque.push(s.u[j]);
@@ -561,15 +556,15 @@ impl Recorder for RerunRecorder {
         }
         let p = s.tool_position;
         self.tool.extend_from_slice(&[p.x, p.y, p.z]);
-        self.tool_error.push((s.tool_position - s.tool_target).norm());
+        self.tool_error.push(s.tool_error());
         let tip = [p.x as f32, p.y as f32, p.z as f32];
+        let model = self.model.as_deref().expect("started");
         for link in &mut self.links {
-            let pose = s.body_pose[link.body].compose(&link.placement);
+            let pose = frame_pose_in(model, s.body_pose, link.frame);
             let t = pose.translation;
             link.translations.push([t.x as f32, t.y as f32, t.z as f32]);
             link.rotations.push(quaternion(&pose));
         }
-        self.last_t = s.t;
         if s.k.is_multiple_of(self.steps_per_trail_point) {
             self.trail.push_back(tip);
             let keep = (TRAIL_SECONDS * TRAIL_RATE_HZ) as usize;
@@ -580,7 +575,7 @@ impl Recorder for RerunRecorder {
             self.trail_times.push(s.t);
             self.trail_strips.push(self.trail.iter().copied().collect());
         }
-        let due = self.times.len() >= self.block_steps || (self.live && self.last_flush.elapsed() >= LIVE_FLUSH) || s.is_final;
+        let due = self.times.len() >= FILE_BLOCK_STEPS || (self.live && self.last_flush.elapsed() >= LIVE_FLUSH) || s.is_final;
         if due {
             self.flush_block()?;
         }

@@ -1,11 +1,10 @@
+use super::worker::BatchWorker;
 use super::{Recorder, RunInfo};
 use crate::error::Error;
 use crate::sample::Sample;
 use crate::spatial::Pose;
 use crate::summary::Summary;
 use nalgebra::Vector3;
-use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
-use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 /// Runs a recorder on its own thread: the simulation loop only copies each sample into a block,
@@ -14,9 +13,7 @@ use std::time::{Duration, Instant};
 pub struct Threaded<R: Recorder + Send + 'static> {
     inner: Option<R>,
     block: SampleBlock,
-    tx: Option<SyncSender<SampleBlock>>,
-    recycled: Option<Receiver<SampleBlock>>,
-    worker: Option<JoinHandle<(R, Result<(), Error>)>>,
+    worker: Option<BatchWorker<R, SampleBlock, Error>>,
     last_send: Instant,
     block_samples: usize,
     max_latency: Duration,
@@ -132,8 +129,6 @@ impl<R: Recorder + Send + 'static> Threaded<R> {
         Self {
             inner: Some(inner),
             block: SampleBlock::new(0, 0, 0),
-            tx: None,
-            recycled: None,
             worker: None,
             last_send: Instant::now(),
             block_samples: 250,
@@ -142,11 +137,11 @@ impl<R: Recorder + Send + 'static> Threaded<R> {
     }
 
     fn send_block(&mut self) -> Result<(), Error> {
-        let Some(tx) = &self.tx else { return Ok(()) };
+        let Some(worker) = &self.worker else { return Ok(()) };
         if self.block.len() == 0 {
             return Ok(());
         }
-        let fresh = match self.recycled.as_ref().and_then(|r| r.try_recv().ok()) {
+        let fresh = match worker.recycled() {
             Some(mut b) => {
                 b.clear();
                 b
@@ -155,17 +150,16 @@ impl<R: Recorder + Send + 'static> Threaded<R> {
         };
         let full = std::mem::replace(&mut self.block, fresh);
         self.last_send = Instant::now();
-        if tx.send(full).is_err() {
+        if !worker.send(full) {
             // the worker stopped on an error: report it
-            return self.join().map(|_| ());
+            return self.join();
         }
         Ok(())
     }
 
     fn join(&mut self) -> Result<(), Error> {
-        self.tx = None;
-        if let Some(worker) = self.worker.take() {
-            let (inner, result) = worker.join().expect("recorder thread panicked");
+        if let Some(joined) = self.worker.as_mut().and_then(BatchWorker::join) {
+            let (inner, result) = joined.expect("recorder thread panicked");
             self.inner = Some(inner);
             result?;
         }
@@ -179,23 +173,9 @@ impl<R: Recorder + Send + 'static> Recorder for Threaded<R> {
         inner.start(run)?;
         let model = &run.experiment.model;
         self.block = SampleBlock::new(model.dof(), model.dof(), self.block_samples);
-        let (tx, rx) = sync_channel::<SampleBlock>(4);
-        let (back_tx, back_rx) = sync_channel::<SampleBlock>(4);
-        self.tx = Some(tx);
-        self.recycled = Some(back_rx);
         // named after the recorder, so profiles and debuggers tell the threads apart
         let name = std::any::type_name::<R>().rsplit("::").next().unwrap_or("recorder").to_string();
-        let worker = std::thread::Builder::new().name(name).spawn(move || {
-            for block in rx {
-                for i in 0..block.len() {
-                    if let Err(e) = inner.record(&block.sample(i)) {
-                        return (inner, Err(e));
-                    }
-                }
-                let _ = back_tx.try_send(block);
-            }
-            (inner, Ok(()))
-        });
+        let worker = BatchWorker::spawn(&name, inner, |inner: &mut R, block: &SampleBlock| (0..block.len()).try_for_each(|i| inner.record(&block.sample(i))));
         self.worker = Some(worker.map_err(|e| Error::output(std::path::Path::new("recorder thread"), e))?);
         self.last_send = Instant::now();
         Ok(())

@@ -1,0 +1,50 @@
+//! A thread that owns some state and consumes batches sent to it, in order. Emptied batches come
+//! back for reuse, so a steady stream allocates nothing. Used by `Threaded` (samples to a recorder)
+//! and by the MCAP recorder (encoded messages to the file writer).
+
+use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
+use std::thread::JoinHandle;
+
+/// Batches in flight at most; the sender waits beyond that.
+const QUEUE: usize = 4;
+
+pub struct BatchWorker<S, B, E> {
+    tx: Option<SyncSender<B>>,
+    recycled: Receiver<B>,
+    handle: Option<JoinHandle<(S, Result<(), E>)>>,
+}
+
+impl<S: Send + 'static, B: Send + 'static, E: Send + 'static> BatchWorker<S, B, E> {
+    /// Starts thread `name` with `state`; `consume` is called with every batch sent, and the first
+    /// error it returns stops the thread.
+    pub fn spawn(name: &str, mut state: S, mut consume: impl FnMut(&mut S, &B) -> Result<(), E> + Send + 'static) -> std::io::Result<Self> {
+        let (tx, rx) = sync_channel::<B>(QUEUE);
+        let (back_tx, recycled) = sync_channel::<B>(QUEUE);
+        let handle = std::thread::Builder::new().name(name.to_string()).spawn(move || {
+            for batch in rx {
+                if let Err(e) = consume(&mut state, &batch) {
+                    return (state, Err(e));
+                }
+                let _ = back_tx.try_send(batch);
+            }
+            (state, Ok(()))
+        })?;
+        Ok(Self { tx: Some(tx), recycled, handle: Some(handle) })
+    }
+
+    /// A batch the thread is done with, if one is back (not emptied).
+    pub fn recycled(&self) -> Option<B> {
+        self.recycled.try_recv().ok()
+    }
+
+    /// Hands `batch` to the thread. False when the thread has stopped (on an error: `join` for it).
+    pub fn send(&self, batch: B) -> bool {
+        self.tx.as_ref().is_some_and(|tx| tx.send(batch).is_ok())
+    }
+
+    /// Lets the thread finish what was sent and returns its state and result (None if already joined).
+    pub fn join(&mut self) -> Option<std::thread::Result<(S, Result<(), E>)>> {
+        self.tx = None;
+        self.handle.take().map(JoinHandle::join)
+    }
+}
