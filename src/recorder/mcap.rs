@@ -363,7 +363,7 @@ impl Recorder for McapRecorder {
     fn start(&mut self, run: &RunInfo) -> Result<(), Error> {
         let e = run.experiment;
         let model = &*e.model;
-        let file = File::create(&self.path).map_err(|err| self.err(err))?;
+        let file = super::output_file::create_replacing(&self.path).map_err(|err| self.err(err))?;
         // zstd on the writer thread (`Out`): zstd's own worker threads cost more than they save here
         let options = mcap::WriteOptions::new()
             .compression(Some(mcap::Compression::Zstd))

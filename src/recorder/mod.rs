@@ -3,6 +3,7 @@
 
 mod console;
 mod mcap;
+mod output_file;
 mod pacer;
 pub mod rrd;
 mod rrd_file;

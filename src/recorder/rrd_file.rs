@@ -32,7 +32,7 @@ struct State {
 
 impl RrdFile {
     pub fn create(path: &Path) -> Result<Self, String> {
-        let file = File::create(path).map_err(|e| e.to_string())?;
+        let file = super::output_file::create_replacing(path).map_err(|e| e.to_string())?;
         let encoder = Encoder::new_eager(CrateVersion::LOCAL, EncodingOptions::PROTOBUF_UNCOMPRESSED, BufWriter::with_capacity(1 << 20, file)).map_err(|e| e.to_string())?;
         Ok(Self { path: path.to_path_buf(), state: Arc::new(Mutex::new(State { encoder: Some(encoder), error: None })) })
     }
