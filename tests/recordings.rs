@@ -211,6 +211,55 @@ fn rrd_holds_every_joint_series_with_one_row_per_step_equal_to_the_trace() {
     }
 }
 
+/// One entity's rows of a component: (time, the component's values).
+fn rrd_component(rrd: &Path, entity: &str, component: &str) -> Vec<(f64, Vec<f64>)> {
+    let out = tempfile::NamedTempFile::new().unwrap();
+    let status = Command::new("bash")
+        .arg(kit("rrd-query.sh"))
+        .args([rrd.to_str().unwrap(), "--entity", entity, "--timeline", "sim_time", "--component", component, "--out", out.path().to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(status.status.success(), "rrd-query {entity} {component}: {}", String::from_utf8_lossy(&status.stderr));
+    read_csv(out.path()).rows.into_iter().map(|r| (r[0], r[1..].to_vec())).collect()
+}
+
+#[test]
+fn rrd_poses_every_moving_link_at_every_step_as_the_simulated_arm() {
+    use armscope::dynamics::{body_poses, frame_pose_in};
+    let run = record(&["--duration", "0.4", "--no-mcap"]);
+    let model = armscope::model::load_urdf(&repo().join("assets/smallrobot_arm.urdf")).unwrap();
+    let q: Vec<Vec<f64>> = (0..6).map(|j| col(&run.trace, "q", j)).collect();
+    let mut poses = vec![armscope::spatial::Pose::identity(); model.joints.len()];
+    let moving: Vec<usize> = (0..model.frames.len()).filter(|&f| model.frames[f].body.is_some()).collect();
+    assert_eq!(moving.len(), 6);
+    let rows: Vec<_> = moving
+        .iter()
+        .map(|&f| {
+            let entity = format!("/world/robot/{}", model.frames[f].name);
+            (rrd_component(&run.rrd, &entity, "Transform3D:translation"), rrd_component(&run.rrd, &entity, "Transform3D:quaternion"))
+        })
+        .collect();
+    for k in 0..run.trace.rows.len() {
+        body_poses(&model, &q.iter().map(|c| c[k]).collect::<Vec<_>>(), &mut poses);
+        for (&f, (translations, rotations)) in moving.iter().zip(&rows) {
+            let want = frame_pose_in(&model, &poses, f);
+            let name = &model.frames[f].name;
+            assert_eq!((translations.len(), rotations.len()), (run.trace.rows.len(), run.trace.rows.len()), "{name}: one pose per step");
+            // stored as float32: 1e-6 is a few float32 ulps at these sizes (< 1 m, unit quaternions)
+            let (t, r) = (&translations[k].1, &rotations[k].1);
+            for a in 0..3 {
+                assert!((t[a] - want.translation[a]).abs() < 1e-6, "{name} translation {a} at step {k}: {} vs {}", t[a], want.translation[a]);
+            }
+            let [x, y, z, w] = want.quaternion_xyzw();
+            // q and −q are the same rotation
+            let sign = (r[0] * x + r[1] * y + r[2] * z + r[3] * w).signum();
+            for (got, want) in r.iter().zip([x, y, z, w]) {
+                assert!((got - sign * want).abs() < 1e-6, "{name} rotation (x, y, z, w) at step {k}: {r:?} vs {:?}", [x, y, z, w]);
+            }
+        }
+    }
+}
+
 #[test]
 fn rrd_has_the_3d_scene_configuration_summary_and_blueprint_and_passes_rerun_verify() {
     let run = record(&["--duration", "0.5", "--no-mcap"]);

@@ -77,7 +77,8 @@ struct MovingLink {
     frame: usize,
     entity: String,
     translations: Vec<[f32; 3]>,
-    rotations: Vec<rerun::Quaternion>,
+    /// [x, y, z, w] per step.
+    rotations: Vec<[f32; 4]>,
 }
 
 pub struct RerunRecorder {
@@ -302,8 +303,7 @@ impl RerunRecorder {
         let send = |entity: &str, time: TimeColumn, columns: Result<Vec<rerun::SerializedComponentColumn>, rerun::SerializationError>| -> Result<(), Error> {
             send_in_order(&rec, entity, time, columns.map_err(|x| self.err(x))?).map_err(|x| self.err(x))
         };
-        // `width` values per row
-        let scalars = |values: &[f64], width: usize| rerun::Scalars::new(values.iter().copied()).columns(std::iter::repeat_n(width, values.len() / width)).map(Iterator::collect);
+        let scalars = |values: &[f64], width: usize| Ok(vec![scalar_column(values, width)]);
         for (j, name) in self.joint_names.iter().enumerate() {
             let c = &self.joints[j];
             let base = format!("joints/{name}");
@@ -329,8 +329,11 @@ impl RerunRecorder {
             send("world/tool/trail", times, rerun::LineStrips3D::update_fields().with_strips(self.trail_strips.iter().cloned()).columns_of_unit_batches().map(Iterator::collect))?;
         }
         for link in &self.links {
-            let poses = rerun::Transform3D::update_fields().with_many_translation(link.translations.iter().copied()).with_many_quaternion(link.rotations.iter().copied());
-            send(link.entity.as_str(), time.clone(), poses.columns_of_unit_batches().map(Iterator::collect))?;
+            let poses = vec![
+                float32_column::<rerun::components::Translation3D>(link.translations.as_flattened(), rerun::Transform3D::descriptor_translation()),
+                float32_column::<rerun::components::RotationQuat>(link.rotations.as_flattened(), rerun::Transform3D::descriptor_quaternion()),
+            ];
+            send(link.entity.as_str(), time.clone(), Ok(poses))?;
         }
         self.times.clear();
         for j in &mut self.joints {
@@ -350,6 +353,34 @@ impl RerunRecorder {
         self.last_flush = Instant::now();
         Ok(())
     }
+}
+
+/// A `Scalars` column of `width` values per row, its Arrow array copied straight from the buffer:
+/// Rerun's generic serialization first turns every value into an `Option` with a validity flag
+/// (a third of this recorder's work, in memory that is new for every block).
+fn scalar_column(values: &[f64], width: usize) -> rerun::SerializedComponentColumn {
+    use rerun::external::arrow::array::{ArrayRef, Float64Array, ListArray};
+    use rerun::external::arrow::buffer::OffsetBuffer;
+    use rerun::external::arrow::datatypes::{DataType, Field};
+    let values: ArrayRef = Arc::new(Float64Array::from_iter_values(values.iter().copied()));
+    let rows = values.len() / width;
+    let list = ListArray::new(Arc::new(Field::new_list_field(DataType::Float64, true)), OffsetBuffer::from_lengths(std::iter::repeat_n(width, rows)), values, None);
+    rerun::SerializedComponentColumn::new(list, rerun::Scalars::descriptor_scalars())
+}
+
+/// A column of one fixed-size float32 component (a translation, a quaternion) per row, built
+/// from the values back to back, with the component's own Arrow type.
+fn float32_column<C: rerun::Loggable>(values: &[f32], descriptor: rerun::ComponentDescriptor) -> rerun::SerializedComponentColumn {
+    use rerun::external::arrow::array::{ArrayRef, FixedSizeListArray, Float32Array, ListArray};
+    use rerun::external::arrow::buffer::OffsetBuffer;
+    use rerun::external::arrow::datatypes::{DataType, Field};
+    let DataType::FixedSizeList(item, width) = C::arrow_datatype() else {
+        unreachable!("translations and quaternions are fixed-size lists of float32")
+    };
+    let rows = values.len() / width as usize;
+    let components: ArrayRef = Arc::new(FixedSizeListArray::new(item, width, Arc::new(Float32Array::from_iter_values(values.iter().copied())), None));
+    let list = ListArray::new(Arc::new(Field::new_list_field(C::arrow_datatype(), true)), OffsetBuffer::from_lengths(std::iter::repeat_n(1, rows)), components, None);
+    rerun::SerializedComponentColumn::new(list, descriptor)
 }
 
 /// `send_columns` for rows already in time order. Rerun's own first reorders every chunk by time
@@ -395,8 +426,9 @@ fn transform(pose: &Pose) -> rerun::Transform3D {
     rerun::Transform3D::from_translation_mat3x3([t.x as f32, t.y as f32, t.z as f32], mat3(pose))
 }
 
-fn quaternion(pose: &Pose) -> rerun::Quaternion {
-    rerun::Quaternion::from_xyzw(pose.quaternion_xyzw().map(|x| x as f32))
+/// [x, y, z, w], as Rerun stores a quaternion.
+fn quaternion_xyzw(pose: &Pose) -> [f32; 4] {
+    pose.quaternion_xyzw().map(|x| x as f32)
 }
 
 fn mat3(pose: &Pose) -> rerun::components::TransformMat3x3 {
@@ -563,7 +595,7 @@ impl Recorder for RerunRecorder {
             let pose = frame_pose_in(model, s.body_pose, link.frame);
             let t = pose.translation;
             link.translations.push([t.x as f32, t.y as f32, t.z as f32]);
-            link.rotations.push(quaternion(&pose));
+            link.rotations.push(quaternion_xyzw(&pose));
         }
         if s.k.is_multiple_of(self.steps_per_trail_point) {
             self.trail.push_back(tip);
