@@ -167,16 +167,21 @@ fn mcap_has_the_channels_schemas_and_per_step_messages_and_equals_the_trace() {
     assert!(done.metadata["summary"].contains("\"saturation_percent\""));
 }
 
-/// One entity's scalar rows: (time, the row's values, one per instance).
-fn rrd_series(rrd: &Path, entity: &str) -> Vec<(f64, Vec<f64>)> {
+/// One entity's rows of a component: (time, the component's values).
+fn rrd_component(rrd: &Path, entity: &str, component: &str) -> Vec<(f64, Vec<f64>)> {
     let out = tempfile::NamedTempFile::new().unwrap();
     let status = Command::new("bash")
         .arg(kit("rrd-query.sh"))
-        .args([rrd.to_str().unwrap(), "--entity", entity, "--timeline", "sim_time", "--out", out.path().to_str().unwrap()])
+        .args([rrd.to_str().unwrap(), "--entity", entity, "--timeline", "sim_time", "--component", component, "--out", out.path().to_str().unwrap()])
         .output()
         .unwrap();
-    assert!(status.status.success(), "rrd-query {entity}: {}", String::from_utf8_lossy(&status.stderr));
+    assert!(status.status.success(), "rrd-query {entity} {component}: {}", String::from_utf8_lossy(&status.stderr));
     read_csv(out.path()).rows.into_iter().map(|r| (r[0], r[1..].to_vec())).collect()
+}
+
+/// One entity's scalar rows: (time, the row's values, one per instance).
+fn rrd_series(rrd: &Path, entity: &str) -> Vec<(f64, Vec<f64>)> {
+    rrd_component(rrd, entity, "Scalars:scalars")
 }
 
 #[test]
@@ -209,18 +214,6 @@ fn rrd_holds_every_joint_series_with_one_row_per_step_equal_to_the_trace() {
     for (a, axis) in ["x", "y", "z"].iter().enumerate() {
         assert_eq!(tool.iter().map(|r| r.1[a]).collect::<Vec<_>>(), run.trace.column(axis), "tool {axis}");
     }
-}
-
-/// One entity's rows of a component: (time, the component's values).
-fn rrd_component(rrd: &Path, entity: &str, component: &str) -> Vec<(f64, Vec<f64>)> {
-    let out = tempfile::NamedTempFile::new().unwrap();
-    let status = Command::new("bash")
-        .arg(kit("rrd-query.sh"))
-        .args([rrd.to_str().unwrap(), "--entity", entity, "--timeline", "sim_time", "--component", component, "--out", out.path().to_str().unwrap()])
-        .output()
-        .unwrap();
-    assert!(status.status.success(), "rrd-query {entity} {component}: {}", String::from_utf8_lossy(&status.stderr));
-    read_csv(out.path()).rows.into_iter().map(|r| (r[0], r[1..].to_vec())).collect()
 }
 
 #[test]
