@@ -33,7 +33,9 @@ struct State {
 impl RrdFile {
     pub fn create(path: &Path) -> Result<Self, String> {
         let file = super::output_file::create_replacing(path).map_err(|e| e.to_string())?;
-        let encoder = Encoder::new_eager(CrateVersion::LOCAL, EncodingOptions::PROTOBUF_UNCOMPRESSED, BufWriter::with_capacity(1 << 20, file)).map_err(|e| e.to_string())?;
+        // the encoder writes each message whole: a buffer smaller than a block's chunks (100–250 KB)
+        // gathers the small messages and lets the chunks go straight to the file, uncopied
+        let encoder = Encoder::new_eager(CrateVersion::LOCAL, EncodingOptions::PROTOBUF_UNCOMPRESSED, BufWriter::with_capacity(64 << 10, file)).map_err(|e| e.to_string())?;
         Ok(Self { path: path.to_path_buf(), state: Arc::new(Mutex::new(State { encoder: Some(encoder), error: None })) })
     }
 
