@@ -4,12 +4,15 @@ use std::fs::File;
 use std::io;
 use std::path::Path;
 
-/// Creates `path`, replacing an old file by removing it first rather than truncating it: on ext4
-/// a file truncated and written again is flushed to disk synchronously when it is closed
-/// (`auto_da_alloc`), which for a 30 s run's recordings cost the run ~20 ms of its ~150.
+/// Creates `path`, replacing an old regular file by removing it first rather than truncating it:
+/// on ext4 a file truncated and written again is flushed to disk synchronously when it is closed
+/// (`auto_da_alloc`), which cost a 30 s run that overwrote its previous recordings 30–60 ms.
+/// Anything else at `path` (a symlink, `/dev/null`, a FIFO) is opened and written as it is.
 pub fn create_replacing(path: &Path) -> io::Result<File> {
-    // not there, a directory, or in a folder we may not remove from: `create` says what is wrong
-    let _ = std::fs::remove_file(path);
+    if std::fs::symlink_metadata(path).is_ok_and(|m| m.file_type().is_file()) {
+        // in a folder we may not remove from, `create` still truncates it (or says what is wrong)
+        let _ = std::fs::remove_file(path);
+    }
     File::create(path)
 }
 
@@ -29,6 +32,26 @@ mod tests {
         let fresh = dir.path().join("fresh.mcap");
         create_replacing(&fresh).unwrap().write_all(b"x").unwrap();
         assert_eq!(std::fs::read(&fresh).unwrap(), b"x");
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_symlink_is_written_through_not_replaced() {
+        let dir = tempfile::tempdir().unwrap();
+        let (target, link) = (dir.path().join("kept.rrd"), dir.path().join("latest.rrd"));
+        std::fs::write(&target, b"old").unwrap();
+        std::os::unix::fs::symlink(&target, &link).unwrap();
+        create_replacing(&link).unwrap().write_all(b"new").unwrap();
+        assert!(std::fs::symlink_metadata(&link).unwrap().file_type().is_symlink(), "the link is still a link");
+        assert_eq!(std::fs::read(&target).unwrap(), b"new");
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn dev_null_is_written_to_not_removed() {
+        // as root, removing it would delete the system's /dev/null
+        create_replacing(std::path::Path::new("/dev/null")).unwrap().write_all(b"discarded").unwrap();
+        assert!(!std::fs::symlink_metadata("/dev/null").unwrap().file_type().is_file());
     }
 
     #[test]
