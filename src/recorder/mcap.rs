@@ -508,7 +508,6 @@ impl Recorder for McapRecorder {
             tel.saturated[j] = s.saturated[j] as u32;
             tel.chatter[j] = s.chatter[j] as u32;
         }
-        let tool = frame_pose_in(model, s.body_pose, model.tool_frame);
         let path = &self.path;
         let fail = |e: String| Error::output(path, e);
         let (out, ch) = (self.out.as_mut().expect("started"), self.channels.as_mut().expect("started"));
@@ -517,6 +516,7 @@ impl Recorder for McapRecorder {
         out.log(&mut ch.controller, &self.telemetry, stamp).map_err(fail)?;
         // the tool pose at a display rate, 50 Hz (every step's tool position is in /controller)
         if s.k.is_multiple_of(self.steps_per_pose) || s.is_final {
+            let tool = frame_pose_in(model, s.body_pose, model.tool_frame);
             out.log(&mut ch.tool_pose, &PoseInFrame { timestamp: ts, frame_id: "world".into(), pose: Some(fox_pose(&tool)) }, stamp).map_err(fail)?;
         }
         // geometry once a simulated second, so a viewer that seeks always has it
@@ -535,7 +535,7 @@ impl Recorder for McapRecorder {
             }
         }
         if s.k.is_multiple_of(self.steps_per_path_point) || s.is_final {
-            let p = tool.translation;
+            let p = s.tool_position;
             self.path_points.push(Point3 { x: p.x, y: p.y, z: p.z });
             if self.path_points.len().is_multiple_of(10) || s.is_final {
                 self.publish_path(s.t)?;
