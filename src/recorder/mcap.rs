@@ -373,7 +373,8 @@ impl Recorder for McapRecorder {
             // dictionary" path (−5 % of the writer's work at the same size)
             .chunk_size(Some(512 * 1024))
             .library(format!("armscope {} (foxglove-sdk schemas, mcap-rust)", env!("CARGO_PKG_VERSION")));
-        // a chunk (~200 KiB compressed) per write call, as the .rrd's writer does
+        // zstd hands its output over in pieces of up to 128 KiB: gathered here, a chunk (~200 KiB
+        // compressed) takes a write call or two
         let writer = options.create(BufWriter::with_capacity(1 << 20, file)).map_err(|err| self.err(err))?;
         let mut out = Out::new(writer);
         let now = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).unwrap_or_default();

@@ -357,7 +357,7 @@ impl RerunRecorder {
 
 /// A `Scalars` column of `width` values per row, its Arrow array copied straight from the buffer:
 /// Rerun's generic serialization first turns every value into an `Option` with a validity flag
-/// (a third of this recorder's work, in memory that is new for every block).
+/// (a quarter of this recorder's thread's work, in memory that is new for every block).
 fn scalar_column(values: &[f64], width: usize) -> rerun::SerializedComponentColumn {
     use rerun::external::arrow::array::{ArrayRef, Float64Array, ListArray};
     use rerun::external::arrow::buffer::OffsetBuffer;
