@@ -7,7 +7,7 @@
 //! thread of its own (see `Out`).
 
 use super::telemetry::ControllerTelemetry;
-use super::worker::BatchWorker;
+use super::worker::{BatchWorker, Reusable};
 use super::{Recorder, RunInfo};
 use crate::error::Error;
 use crate::model::{Geometry, JointKind, Model};
@@ -59,6 +59,13 @@ type McapWriter = mcap::Writer<BufWriter<File>>;
 struct Batch {
     bytes: Vec<u8>,
     messages: Vec<(MessageHeader, usize)>,
+}
+
+impl Reusable for Batch {
+    fn clear(&mut self) {
+        self.bytes.clear();
+        self.messages.clear();
+    }
 }
 
 /// Messages per batch: ~250 control steps.
@@ -121,13 +128,7 @@ impl Out {
 
     fn send(&mut self) -> Result<(), String> {
         let Some(worker) = &self.worker else { return Ok(()) };
-        let fresh = worker.recycled().map_or_else(Batch::default, |mut b| {
-            b.bytes.clear();
-            b.messages.clear();
-            b
-        });
-        let full = std::mem::replace(&mut self.batch, fresh);
-        if !worker.send(full) {
+        if !worker.hand_over(&mut self.batch, Batch::default) {
             // the writer stopped on an error: report it
             return self.join();
         }

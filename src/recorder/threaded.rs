@@ -1,4 +1,4 @@
-use super::worker::BatchWorker;
+use super::worker::{BatchWorker, Reusable};
 use super::{Recorder, RunInfo};
 use crate::error::Error;
 use crate::sample::Sample;
@@ -68,21 +68,6 @@ impl SampleBlock {
         self.k.len()
     }
 
-    fn clear(&mut self) {
-        self.k.clear();
-        self.t.clear();
-        self.is_final.clear();
-        for v in [&mut self.q, &mut self.v, &mut self.cmd, &mut self.cmd_dot, &mut self.u, &mut self.tau_g] {
-            v.clear();
-        }
-        self.saturated.clear();
-        self.chatter.clear();
-        self.at_limit.clear();
-        self.tool.clear();
-        self.tool_target.clear();
-        self.body_pose.clear();
-    }
-
     fn push(&mut self, s: &Sample) {
         self.k.push(s.k);
         self.t.push(s.t);
@@ -123,6 +108,23 @@ impl SampleBlock {
     }
 }
 
+impl Reusable for SampleBlock {
+    fn clear(&mut self) {
+        self.k.clear();
+        self.t.clear();
+        self.is_final.clear();
+        for v in [&mut self.q, &mut self.v, &mut self.cmd, &mut self.cmd_dot, &mut self.u, &mut self.tau_g] {
+            v.clear();
+        }
+        self.saturated.clear();
+        self.chatter.clear();
+        self.at_limit.clear();
+        self.tool.clear();
+        self.tool_target.clear();
+        self.body_pose.clear();
+    }
+}
+
 impl<R: Recorder + Send + 'static> Threaded<R> {
     /// `max_latency`: a block is handed over at least this often (for live viewers).
     pub fn new(inner: R, max_latency: Duration) -> Self {
@@ -141,16 +143,9 @@ impl<R: Recorder + Send + 'static> Threaded<R> {
         if self.block.len() == 0 {
             return Ok(());
         }
-        let fresh = match worker.recycled() {
-            Some(mut b) => {
-                b.clear();
-                b
-            }
-            None => SampleBlock::new(self.block.n, self.block.bodies, self.block_samples),
-        };
-        let full = std::mem::replace(&mut self.block, fresh);
+        let (n, bodies, capacity) = (self.block.n, self.block.bodies, self.block_samples);
         self.last_send = Instant::now();
-        if !worker.send(full) {
+        if !worker.hand_over(&mut self.block, || SampleBlock::new(n, bodies, capacity)) {
             // the worker stopped on an error: report it
             return self.join();
         }

@@ -8,6 +8,11 @@ use std::thread::JoinHandle;
 /// Batches in flight at most; the sender waits beyond that.
 const QUEUE: usize = 4;
 
+/// A batch that can be emptied for reuse, keeping its memory.
+pub trait Reusable {
+    fn clear(&mut self);
+}
+
 pub struct BatchWorker<S, B, E> {
     tx: Option<SyncSender<B>>,
     recycled: Receiver<B>,
@@ -32,14 +37,22 @@ impl<S: Send + 'static, B: Send + 'static, E: Send + 'static> BatchWorker<S, B, 
         Ok(Self { tx: Some(tx), recycled, handle: Some(handle) })
     }
 
-    /// A batch the thread is done with, if one is back (not emptied).
-    pub fn recycled(&self) -> Option<B> {
-        self.recycled.try_recv().ok()
-    }
-
-    /// Hands `batch` to the thread. False when the thread has stopped (on an error: `join` for it).
-    pub fn send(&self, batch: B) -> bool {
-        self.tx.as_ref().is_some_and(|tx| tx.send(batch).is_ok())
+    /// Hands `batch` to the thread and leaves in its place an emptied batch the thread is done
+    /// with, or `fresh()` when none is back yet. False when the thread has stopped (on an error:
+    /// `join` for it).
+    pub fn hand_over(&self, batch: &mut B, fresh: impl FnOnce() -> B) -> bool
+    where
+        B: Reusable,
+    {
+        let empty = match self.recycled.try_recv() {
+            Ok(mut recycled) => {
+                recycled.clear();
+                recycled
+            }
+            Err(_) => fresh(),
+        };
+        let full = std::mem::replace(batch, empty);
+        self.tx.as_ref().is_some_and(|tx| tx.send(full).is_ok())
     }
 
     /// Lets the thread finish what was sent and returns its state and result (None if already joined).
