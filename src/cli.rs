@@ -578,7 +578,7 @@ pub fn trajectory(args: &TrajectoryArgs) -> Result<i32, Error> {
 
 /// `armscope analyze`.
 pub fn analyze(args: &AnalyzeArgs) -> Result<i32, Error> {
-    use crate::analysis::{Linearization, LoopPlant, largest_stable_period, spectral_radius, stabilizing_kd};
+    use crate::analysis::{Linearization, LoopPlant, largest_stable_period, spectral_radius, stabilizing_kd_over, worst_radius};
     let config = RunConfig {
         urdf: args.urdf.clone(),
         dt: args.dt,
@@ -598,11 +598,8 @@ pub fn analyze(args: &AnalyzeArgs) -> Result<i32, Error> {
     }
     let (kp, kd) = experiment.controller().effective_gains();
     let ff = !args.no_ff;
-    let lin = Linearization::at(model, &pose);
     let h = args.dt;
-    let (rho, participation) = spectral_radius(&lin.closed_loop(&kp, &kd, h, ff, args.plant));
-    let stable = rho < 1.0;
-    let largest_dt = largest_stable_period(&lin, &kp, &kd, h, ff, args.plant);
+    // the given pose first, then (--along-command) poses along the wave
     let poses: Vec<Vec<f64>> = if args.along_command {
         let wave = crate::trajectory::Wave { amplitude_rad: args.amp_deg.to_radians(), omega: args.freq };
         let period = 2.0 * std::f64::consts::PI / args.freq.abs().max(1e-6);
@@ -617,12 +614,12 @@ pub fn analyze(args: &AnalyzeArgs) -> Result<i32, Error> {
         vec![pose.clone()]
     };
     let lins: Vec<Linearization> = poses.iter().map(|p| Linearization::at(model, p)).collect();
-    let worst = crate::analysis::worst_radius(&lins, &kp, &kd, h, ff, args.plant);
-    let (stable_kd, stable_rho) = if args.along_command {
-        crate::analysis::stabilizing_kd_over(&lins, &kp, &kd, h, ff, args.plant)
-    } else {
-        stabilizing_kd(&lin, &kp, &kd, h, ff, args.plant)
-    };
+    let lin = &lins[0];
+    let (rho, participation) = spectral_radius(&lin.closed_loop(&kp, &kd, h, ff, args.plant));
+    let stable = rho < 1.0;
+    let largest_dt = largest_stable_period(lin, &kp, &kd, h, ff, args.plant);
+    let worst = worst_radius(&lins, &kp, &kd, h, ff, args.plant);
+    let (stable_kd, stable_rho) = stabilizing_kd_over(&lins, &kp, &kd, h, ff, args.plant);
     let names: Vec<String> = model.joints.iter().map(|j| j.name.clone()).collect();
     let mut drivers: Vec<(String, f64)> = names.iter().cloned().zip(participation.iter().copied()).collect();
     drivers.sort_by(|a, b| b.1.total_cmp(&a.1));

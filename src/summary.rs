@@ -127,6 +127,9 @@ impl SummaryBuilder {
     pub fn finish(&self, status: RunStatus, wall_time: f64) -> Summary {
         let in_window = self.window_samples > 0;
         let range = |a: usize| Range { min: self.tool_min[a], max: self.tool_max[a] };
+        let share_of_control_steps = |counts: &[u64]| -> Vec<f64> {
+            counts.iter().map(|&c| if self.control_steps == 0 { 0.0 } else { 100.0 * c as f64 / self.control_steps as f64 }).collect()
+        };
         Summary {
             status,
             joints: self.joints.clone(),
@@ -140,16 +143,8 @@ impl SummaryBuilder {
                 .iter()
                 .map(|&s| in_window.then(|| (s / self.window_samples as f64).sqrt()))
                 .collect(),
-            saturation_percent: self
-                .saturated_steps
-                .iter()
-                .map(|&c| if self.control_steps == 0 { 0.0 } else { 100.0 * c as f64 / self.control_steps as f64 })
-                .collect(),
-            chatter_percent: self
-                .chatter_steps
-                .iter()
-                .map(|&c| if self.control_steps == 0 { 0.0 } else { 100.0 * c as f64 / self.control_steps as f64 })
-                .collect(),
+            saturation_percent: share_of_control_steps(&self.saturated_steps),
+            chatter_percent: share_of_control_steps(&self.chatter_steps),
             peak_abs_torque: self.peak_torque.clone(),
             effort_limit: self.effort.clone(),
             limit_hits: self.limit_hits.clone(),

@@ -421,14 +421,15 @@ impl Recorder for McapRecorder {
         // a link moves relative to its parent when its joint is a moving joint (the child's body's joint)
         let (moving, fixed): (Vec<_>, Vec<_>) = pairs.partition(|(_, f)| f.parent_frame.is_some_and(|p| model.frames[p].body != f.body));
         let name_of = |f: Option<usize>| f.map_or("world".to_string(), |i| model.frames[i].name.clone());
+        // a parent link's placement on its body (the world's: identity)
+        let placement_of = |f: Option<usize>| f.map_or(Pose::identity(), |p| model.frames[p].placement);
         let transform = |p: Option<usize>, c: usize| FrameTransform { timestamp: None, parent_frame_id: name_of(p), child_frame_id: name_of(Some(c)), translation: None, rotation: None };
         self.tf_msg = FrameTransforms { transforms: moving.iter().map(|(c, f)| transform(f.parent_frame, *c)).collect() };
         self.joint_tfs = moving
             .iter()
             .map(|(_, f)| {
                 let joint = f.body.expect("a moving link has a body");
-                let parent_in_body = f.parent_frame.map_or(Pose::identity(), |p| model.frames[p].placement);
-                JointTransform { joint, before: parent_in_body.inverse().compose(&model.joints[joint].placement), after: f.placement }
+                JointTransform { joint, before: placement_of(f.parent_frame).inverse().compose(&model.joints[joint].placement), after: f.placement }
             })
             .collect();
         // links on the same body (or on the world) keep their relative pose: P_parent⁻¹ ∘ P_child
@@ -437,8 +438,7 @@ impl Recorder for McapRecorder {
                 .iter()
                 .map(|(c, f)| {
                     let mut m = transform(f.parent_frame, *c);
-                    let parent = f.parent_frame.map_or(Pose::identity(), |p| model.frames[p].placement);
-                    set_transform(&mut m, &parent.inverse().compose(&f.placement), None);
+                    set_transform(&mut m, &placement_of(f.parent_frame).inverse().compose(&f.placement), None);
                     m
                 })
                 .collect(),

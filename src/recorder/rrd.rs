@@ -300,10 +300,8 @@ impl RerunRecorder {
         }
         let time = TimeColumn::new_duration_secs(TIMELINE, self.times.iter().copied());
         let steps = self.times.len();
-        let send = |entity: &str, time: TimeColumn, columns: Result<Vec<rerun::SerializedComponentColumn>, rerun::SerializationError>| -> Result<(), Error> {
-            send_in_order(&rec, entity, time, columns.map_err(|x| self.err(x))?).map_err(|x| self.err(x))
-        };
-        let scalars = |values: &[f64], width: usize| Ok(vec![scalar_column(values, width)]);
+        let send = |entity: &str, time: TimeColumn, columns: Vec<rerun::SerializedComponentColumn>| send_in_order(&rec, entity, time, columns).map_err(|x| self.err(x));
+        let scalars = |values: &[f64], width: usize| vec![scalar_column(values, width)];
         for (j, name) in self.joint_names.iter().enumerate() {
             let c = &self.joints[j];
             let base = format!("joints/{name}");
@@ -326,14 +324,15 @@ impl RerunRecorder {
         send("tool_error", time.clone(), scalars(&self.tool_error, 1))?;
         if !self.trail_times.is_empty() {
             let times = TimeColumn::new_duration_secs(TIMELINE, self.trail_times.iter().copied());
-            send("world/tool/trail", times, rerun::LineStrips3D::update_fields().with_strips(self.trail_strips.iter().cloned()).columns_of_unit_batches().map(Iterator::collect))?;
+            let strips = rerun::LineStrips3D::update_fields().with_strips(self.trail_strips.iter().cloned()).columns_of_unit_batches().map_err(|x| self.err(x))?;
+            send("world/tool/trail", times, strips.collect())?;
         }
         for link in &self.links {
             let poses = vec![
                 float32_column::<rerun::components::Translation3D>(link.translations.as_flattened(), rerun::Transform3D::descriptor_translation()),
                 float32_column::<rerun::components::RotationQuat>(link.rotations.as_flattened(), rerun::Transform3D::descriptor_quaternion()),
             ];
-            send(link.entity.as_str(), time.clone(), Ok(poses))?;
+            send(link.entity.as_str(), time.clone(), poses)?;
         }
         self.times.clear();
         for j in &mut self.joints {
@@ -552,9 +551,9 @@ impl Recorder for RerunRecorder {
         self.log_series_styles(&rec)?;
         rec.log_static("config", &rerun::TextDocument::from_markdown(config_markdown(run))).map_err(|x| self.err(x))?;
         let commanded: Vec<[f32; 3]> = run.commanded_tool_path.iter().map(|p| [p.x as f32, p.y as f32, p.z as f32]).collect();
+        // a command that holds still has no path to draw
         let spread = commanded.iter().any(|p| (0..3).any(|a| (p[a] - commanded[0][a]).abs() > 1e-4));
-        let commanded = if spread { commanded } else { Vec::new() };
-        if !commanded.is_empty() {
+        if spread {
             rec.log_static(
                 "world/tool/commanded_path",
                 &rerun::LineStrips3D::new([commanded]).with_colors([rerun::Color::from_rgb(120, 120, 120)]).with_radii([0.0015]),
