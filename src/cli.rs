@@ -702,8 +702,7 @@ pub fn envelope(args: &EnvelopeArgs) -> Result<i32, Error> {
     }
     let jobs = args.jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
     let started = std::time::Instant::now();
-    let env = sweep(&config, &model, &freqs, &amps, 0.0, jobs)?;
-    let env = crate::envelope::Envelope { payload_kg: args.payload, ..env };
+    let env = sweep(&config, &model, &freqs, &amps, args.payload, jobs)?;
     std::fs::create_dir_all(&args.out).map_err(|e| Error::output(&args.out, e))?;
     let x_ticks: Vec<String> = freqs.iter().map(|f| format!("{f}")).collect();
     let y_ticks: Vec<String> = amps.iter().map(|a| format!("{a}")).collect();

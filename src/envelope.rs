@@ -54,15 +54,19 @@ pub fn with_payload(mut model: Model, kg: f64) -> Model {
 pub fn required_torque(model: &Model, trajectory: &dyn Trajectory, duration: f64, dt: f64) -> Vec<f64> {
     let n = model.dof();
     let mut data = Data::new(model);
-    let (mut q, mut qd, mut qd2, mut tmp) = (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+    let (mut q, mut qd, mut qdd) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+    let (mut qd_after, mut qd_before) = (vec![0.0; n], vec![0.0; n]);
     let mut peak = vec![0.0f64; n];
     let eps = 1e-5;
     let steps = (duration / dt).ceil() as usize;
     for k in 0..=steps {
         let t = k as f64 * dt;
-        trajectory.sample(t + eps, &mut tmp, &mut qd2);
-        trajectory.sample(t - eps, &mut tmp, &mut q);
-        let qdd: Vec<f64> = qd2.iter().zip(&q).map(|(a, b)| (a - b) / (2.0 * eps)).collect();
+        // the acceleration by central differences of the commanded velocity
+        trajectory.sample(t + eps, &mut q, &mut qd_after);
+        trajectory.sample(t - eps, &mut q, &mut qd_before);
+        for j in 0..n {
+            qdd[j] = (qd_after[j] - qd_before[j]) / (2.0 * eps);
+        }
         trajectory.sample(t, &mut q, &mut qd);
         let tau = rnea(model, &mut data, &q, &qd, &qdd);
         for j in 0..n {
@@ -72,10 +76,10 @@ pub fn required_torque(model: &Model, trajectory: &dyn Trajectory, duration: f64
     peak
 }
 
-/// Sweep the grid. `base` supplies the model, gains and everything else; each cell runs for the
-/// settle time plus one period of the wave (at most 30 s).
+/// Sweep the grid. `base` supplies the gains and everything else; `model` carries the payload
+/// `payload_kg` already (see [`with_payload`]; the number is recorded in the result). Each cell
+/// runs for the settle time plus one period of the wave (at most 30 s).
 pub fn sweep(base: &RunConfig, model: &Model, freqs: &[f64], amps_deg: &[f64], payload_kg: f64, jobs: usize) -> Result<Envelope, Error> {
-    let model = with_payload(model.clone(), payload_kg);
     let cells_in: Vec<(f64, f64)> = amps_deg.iter().flat_map(|&a| freqs.iter().map(move |&f| (f, a))).collect();
     let pool = rayon::ThreadPoolBuilder::new().num_threads(jobs.max(1)).build().map_err(|e| Error::flag("--jobs", e.to_string()))?;
     let first = Experiment::with_model(base.clone(), model.clone())?;
