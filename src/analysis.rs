@@ -106,13 +106,12 @@ pub fn spectral_radius(a: &DMatrix<f64>) -> (f64, Vec<f64>) {
     // the dominant mode's shape: null vector of (A − λI) by inverse iteration (complex)
     let c = a.map(|x| nalgebra::Complex::new(x, 0.0)) - DMatrix::<nalgebra::Complex<f64>>::identity(2 * n, 2 * n) * (dominant * nalgebra::Complex::new(1.0 + 1e-9, 0.0));
     let mut v = DVector::from_element(2 * n, nalgebra::Complex::new(1.0, 0.0));
-    if let Some(lu) = Some(c.lu()) {
-        for _ in 0..4 {
-            if let Some(next) = lu.solve(&v) {
-                let norm = next.norm();
-                if norm > 0.0 && norm.is_finite() {
-                    v = next / nalgebra::Complex::new(norm, 0.0);
-                }
+    let lu = c.lu();
+    for _ in 0..4 {
+        if let Some(next) = lu.solve(&v) {
+            let norm = next.norm();
+            if norm > 0.0 && norm.is_finite() {
+                v = next / nalgebra::Complex::new(norm, 0.0);
             }
         }
     }
