@@ -40,8 +40,8 @@ impl Canvas {
         }
     }
 
-    /// Text in capitals at (x, y), `scale` pixels per font pixel; returns the width drawn.
-    pub fn text(&mut self, x: usize, y: usize, text: &str, scale: usize, c: [u8; 3]) -> usize {
+    /// Text in capitals at (x, y), `scale` pixels per font pixel ([`Self::text_width`] wide).
+    pub fn text(&mut self, x: usize, y: usize, text: &str, scale: usize, c: [u8; 3]) {
         let mut cx = x;
         for ch in text.to_uppercase().chars() {
             if let Some((_, rows)) = FONT.iter().find(|(g, _)| *g == ch) {
@@ -55,7 +55,6 @@ impl Canvas {
             }
             cx += 4 * scale;
         }
-        cx - x
     }
 
     pub fn text_width(text: &str, scale: usize) -> usize {
