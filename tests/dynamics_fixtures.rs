@@ -1,4 +1,4 @@
-//! Agreement with Drake/Pinocchio on `../shared/reference/dynamics_fixtures.json`: 21 states of the
+//! Agreement with Drake/Pinocchio on `tests/fixtures/reference/dynamics_fixtures.json`: 21 states of the
 //! box model. Drake and Pinocchio agree with each other to ~1e-15 on M, τ_g, C·v, pose and
 //! Jacobian and to ~2.5e-11 on q̈, so 1e-9 (absolute; relative for q̈) leaves room only for
 //! round-off.

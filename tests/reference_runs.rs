@@ -1,5 +1,5 @@
 //! Whole runs through `armscope run --trace` against Drake's per-step records in
-//! `../shared/reference/steps/`. The reference README: an independent implementation of the same
+//! `tests/fixtures/reference/steps/`. The reference README: an independent implementation of the same
 //! discrete update stays within 3e-9 rad of the clean runs over 10 s (the loop is unstable, so
 //! round-off grows), hence the 1e-6 bound; continuous integrations agree to ~1e-8 rad until ~2 s,
 //! hence 1e-5 over the first 2 s.

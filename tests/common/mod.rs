@@ -5,6 +5,7 @@ use std::io::Read;
 use std::path::{Path, PathBuf};
 
 pub mod random_tree;
+pub mod rrd;
 
 pub fn repo() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -14,9 +15,9 @@ pub fn box_urdf() -> PathBuf {
     repo().join("assets/smallrobot_arm.urdf")
 }
 
-/// `../shared/reference/` beside the repository.
+/// The reference data, copied into `tests/fixtures/reference/` (see its README for where it came from).
 pub fn reference(file: &str) -> PathBuf {
-    repo().join("../shared/reference").join(file)
+    repo().join("tests/fixtures/reference").join(file)
 }
 
 /// A parsed CSV: header and rows of numbers (`nan` allowed).
