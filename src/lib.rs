@@ -5,6 +5,7 @@
 
 pub mod analysis;
 pub mod batch;
+pub mod builtin;
 pub mod cli;
 pub mod config;
 pub mod controller;

@@ -54,11 +54,11 @@ pub struct Manifest {
 }
 
 /// Flags the batch sets itself for every experiment.
-const RESERVED: [&str; 12] = ["name", "rrd", "mcap", "no-rrd", "no-mcap", "csv", "trace", "summary-json", "spawn", "connect", "realtime", "quiet"];
+const RESERVED: [&str; 13] = ["name", "rrd", "mcap", "no-rrd", "no-mcap", "csv", "trace", "summary-json", "spawn", "connect", "foxglove", "realtime", "quiet"];
 
 pub fn load_manifest(path: &Path) -> Result<Manifest, Error> {
     let flag = |m: String| Error::flag(format!("manifest {}", path.display()), m);
-    let text = std::fs::read_to_string(path).map_err(|e| flag(format!("cannot read: {e}")))?;
+    let text = crate::builtin::read_to_string(path).map_err(|e| flag(format!("cannot read: {e}")))?;
     let file: ManifestFile = toml::from_str(&text).map_err(|e| flag(e.message().to_string()))?;
     let name = file.name.clone().unwrap_or_else(|| path.file_stem().map_or("batch".into(), |s| s.to_string_lossy().to_string()));
     let base = path.parent().unwrap_or(Path::new("."));

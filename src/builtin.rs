@@ -1,0 +1,48 @@
+//! Files built into the binary, so that `cargo install` gives a tool that runs its own defaults in
+//! any folder: the tutorial's box model and its batch manifest. A default path that exists on disk
+//! (the repository's own `assets/`) is read from disk; where it does not, the built-in copy is used.
+
+use std::path::Path;
+
+pub const DEFAULT_URDF: &str = "assets/smallrobot_arm.urdf";
+pub const DEFAULT_MANIFEST: &str = "assets/experiments/tutorial.toml";
+
+const FILES: [(&str, &str); 2] = [
+    (DEFAULT_URDF, include_str!("../assets/smallrobot_arm.urdf")),
+    (DEFAULT_MANIFEST, include_str!("../assets/experiments/tutorial.toml")),
+];
+
+/// The text of `path`: the file's, or the built-in copy when `path` is a default that is not on disk.
+pub fn read_to_string(path: &Path) -> std::io::Result<String> {
+    match std::fs::read_to_string(path) {
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => builtin(path).map(str::to_string).ok_or(e),
+        other => other,
+    }
+}
+
+/// The built-in copy of a default file, by its default path.
+pub fn builtin(path: &Path) -> Option<&'static str> {
+    FILES.iter().find(|(name, _)| Path::new(name) == path).map(|(_, text)| *text)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_built_in_copies_are_the_repository_files() {
+        for (name, text) in FILES {
+            let on_disk = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join(name)).unwrap();
+            assert_eq!(on_disk, text, "{name}");
+        }
+    }
+
+    #[test]
+    fn a_missing_default_falls_back_to_the_built_in_copy_and_other_paths_do_not() {
+        let dir = tempfile::tempdir().unwrap();
+        let cwd = std::env::current_dir().unwrap();
+        assert!(builtin(Path::new(DEFAULT_URDF)).is_some());
+        assert!(read_to_string(&dir.path().join("nothing.urdf")).is_err());
+        assert!(builtin(&cwd.join(DEFAULT_URDF)).is_none(), "only the default path as given");
+    }
+}
