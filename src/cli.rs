@@ -131,7 +131,7 @@ pub struct BatchArgs {
     #[command(subcommand)]
     pub action: Option<BatchAction>,
     /// The manifest.
-    #[arg(value_name = "MANIFEST", default_value = "assets/experiments/tutorial.toml")]
+    #[arg(value_name = "MANIFEST", default_value = crate::builtin::DEFAULT_MANIFEST)]
     pub manifest: PathBuf,
     /// Experiments run at once (default: the number of cores).
     #[arg(long)]
@@ -244,6 +244,9 @@ pub struct RunArgs {
     /// A joint speed above this is reported as divergence, rad/s.
     #[arg(long, default_value_t = defaults().divergence_speed)]
     pub divergence_speed: f64,
+    /// Refuse physically inconsistent link inertias (as Drake does) instead of a notice.
+    #[arg(long)]
+    pub strict_inertia: bool,
 
     /// Write the tutorial's CSV (t, q, tool xyz every --print-every).
     #[arg(long, value_name = "PATH")]
@@ -279,6 +282,10 @@ pub struct RunArgs {
     /// Stream to a running Rerun viewer (default URL: rerun+http://127.0.0.1:9876/proxy).
     #[arg(long, value_name = "URL", num_args = 0..=1, default_missing_value = crate::recorder::DEFAULT_CONNECT_URL)]
     pub connect: Option<String>,
+    /// Serve the run live to Foxglove (Open connection → Foxglove WebSocket), the MCAP's channels,
+    /// at HOST:PORT (default 127.0.0.1:8765); with --realtime the arm moves at real speed.
+    #[arg(long, value_name = "HOST:PORT", num_args = 0..=1, default_missing_value = crate::recorder::foxglove_live::DEFAULT_ADDRESS)]
+    pub foxglove: Option<String>,
     /// Pace the simulation to the wall clock, FACTOR × real time (default 1).
     #[arg(long, value_name = "FACTOR", num_args = 0..=1, default_missing_value = "1")]
     pub realtime: Option<f64>,
@@ -355,6 +362,7 @@ impl RunArgs {
             tool: self.tool.clone(),
             settle_time: self.settle_time,
             divergence_speed: self.divergence_speed,
+            strict_inertia: self.strict_inertia,
         }
     }
 }
@@ -439,6 +447,7 @@ pub fn run(args: &RunArgs) -> Result<i32, Error> {
         rrd: rrd_path.clone(),
         mcap: mcap_path.clone(),
         live,
+        foxglove: args.foxglove.clone(),
         realtime: args.realtime,
         csv: args.csv.clone(),
         trace: args.trace.clone(),

@@ -51,9 +51,11 @@ pub struct RunConfig {
     pub settle_time: f64,
     /// A joint speed above this (rad/s or m/s) is divergence.
     pub divergence_speed: f64,
+    /// Refuse physically inconsistent link inertias instead of a notice.
+    pub strict_inertia: bool,
 }
 
-pub const DEFAULT_URDF: &str = "assets/smallrobot_arm.urdf";
+pub use crate::builtin::DEFAULT_URDF;
 
 impl Default for RunConfig {
     fn default() -> Self {
@@ -81,6 +83,7 @@ impl Default for RunConfig {
             tool: None,
             settle_time: 2.0,
             divergence_speed: 1e4,
+            strict_inertia: false,
         }
     }
 }

@@ -3,7 +3,7 @@
 
 use crate::error::Error;
 use crate::experiment::Experiment;
-use crate::recorder::{Console, LiveViewer, McapRecorder, Pacer, Recorder, RerunOptions, RerunRecorder, SummaryJson, Threaded, Trace, TutorialCsv};
+use crate::recorder::{Console, LiveViewer, McapOptions, McapRecorder, Pacer, Recorder, RerunOptions, RerunRecorder, SummaryJson, Threaded, Trace, TutorialCsv};
 use crate::sim::simulate;
 use crate::summary::Summary;
 use std::io::Write;
@@ -23,6 +23,8 @@ pub struct Outputs {
     pub rrd: Option<PathBuf>,
     pub mcap: Option<PathBuf>,
     pub live: Option<LiveViewer>,
+    /// `HOST:PORT` to serve the MCAP's channels live to Foxglove at.
+    pub foxglove: Option<String>,
     pub realtime: Option<f64>,
     pub csv: Option<PathBuf>,
     pub trace: Option<PathBuf>,
@@ -61,9 +63,15 @@ pub fn run_experiment(experiment: &Experiment, outputs: Outputs, stop: Option<&A
         }
         recorders.push(Box::new(Threaded::new(rrd, RECORDER_LATENCY)));
     }
-    if let Some(path) = &outputs.mcap {
-        create_parent(path)?;
-        recorders.push(Box::new(Threaded::new(McapRecorder::new(path.clone()), RECORDER_LATENCY)));
+    if outputs.mcap.is_some() || outputs.foxglove.is_some() {
+        if let Some(path) = &outputs.mcap {
+            create_parent(path)?;
+        }
+        let mut mcap = McapRecorder::new(McapOptions { file: outputs.mcap.clone(), live: outputs.foxglove.clone() });
+        if let Some(notice) = outputs.notice {
+            mcap.on_notice(notice);
+        }
+        recorders.push(Box::new(Threaded::new(mcap, RECORDER_LATENCY)));
     }
     if let Some(factor) = outputs.realtime {
         recorders.push(Box::new(Pacer::new(factor)));

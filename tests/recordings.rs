@@ -1,25 +1,18 @@
 //! Recordings read back by readers independent of the code that wrote them: the `.mcap` through
 //! the mcap crate (Foxglove's schemas through the official Foxglove types, armscope's own through
 //! prost-reflect and the schema embedded in the file, as Foxglove decodes it), the
-//! `.rrd` through the Python rerun-sdk 0.36.3 of `../shared/viewers` (installed by its setup.sh),
-//! compared value by value with the run's own per-step trace.
+//! `.rrd` through Rerun's own decoder and chunk types (`common::rrd`), compared value by value with
+//! the run's own per-step trace.
 
 mod common;
 
+use common::rrd::Rrd;
 use common::{Table, read_csv, repo};
 use foxglove::messages::{FrameTransforms, JointStates, PoseInFrame};
 use prost::Message as _;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;
-
-fn kit(script: &str) -> PathBuf {
-    repo().join("../shared/viewers").join(script)
-}
-
-fn viewers_home() -> PathBuf {
-    std::env::var_os("VIEWERS_HOME").map(PathBuf::from).unwrap_or_else(|| PathBuf::from(std::env::var("HOME").unwrap()).join(".cache/armscope-viewers"))
-}
 
 /// Run the armscope binary; returns (exit code, stdout, stderr).
 fn armscope(args: &[&str]) -> (i32, String, String) {
@@ -75,7 +68,8 @@ fn mcap_has_the_channels_schemas_and_per_step_messages_and_equals_the_trace() {
         ("/robot/geometry", "foxglove.SceneUpdate", "protobuf", None),
         ("/tool/path", "foxglove.SceneUpdate", "protobuf", None),
         ("/tool/commanded_path", "foxglove.SceneUpdate", "protobuf", Some(1)),
-        ("/robot_description", "armscope::recorder::mcap::RobotDescription", "json", Some(1)),
+        // the ROS convention by which Foxglove's URDF layer and Rerun's MCAP importer find the robot
+        ("/robot_description", "std_msgs/msg/String", "cdr", Some(1)),
     ];
     for (topic, schema, encoding, count) in expect {
         let msgs = topics.get(topic).unwrap_or_else(|| panic!("no {topic}"));
@@ -87,6 +81,10 @@ fn mcap_has_the_channels_schemas_and_per_step_messages_and_equals_the_trace() {
             assert_eq!(per_step, n, "{topic} messages");
         }
     }
+    let description = armscope::recorder::decode_robot_description(&topics["/robot_description"][0].3).expect("CDR std_msgs/String");
+    assert_eq!(description, std::fs::read_to_string(repo().join("assets/smallrobot_arm.urdf")).unwrap(), "the URDF text");
+    let schema_names: Vec<String> = topics.values().map(|m| m[0].1.clone()).collect();
+    assert!(schema_names.iter().all(|n| !n.contains("::")), "schema names without Rust paths: {schema_names:?}");
     // timestamps: start time + simulation time, exactly one control period apart
     let controller = &topics["/controller"];
     let t0 = controller[0].0;
@@ -167,26 +165,10 @@ fn mcap_has_the_channels_schemas_and_per_step_messages_and_equals_the_trace() {
     assert!(done.metadata["summary"].contains("\"saturation_percent\""));
 }
 
-/// One entity's rows of a component: (time, the component's values).
-fn rrd_component(rrd: &Path, entity: &str, component: &str) -> Vec<(f64, Vec<f64>)> {
-    let out = tempfile::NamedTempFile::new().unwrap();
-    let status = Command::new("bash")
-        .arg(kit("rrd-query.sh"))
-        .args([rrd.to_str().unwrap(), "--entity", entity, "--timeline", "sim_time", "--component", component, "--out", out.path().to_str().unwrap()])
-        .output()
-        .unwrap();
-    assert!(status.status.success(), "rrd-query {entity} {component}: {}", String::from_utf8_lossy(&status.stderr));
-    read_csv(out.path()).rows.into_iter().map(|r| (r[0], r[1..].to_vec())).collect()
-}
-
-/// One entity's scalar rows: (time, the row's values, one per instance).
-fn rrd_series(rrd: &Path, entity: &str) -> Vec<(f64, Vec<f64>)> {
-    rrd_component(rrd, entity, "Scalars:scalars")
-}
-
 #[test]
 fn rrd_holds_every_joint_series_with_one_row_per_step_equal_to_the_trace() {
     let run = record(&["--duration", "1.2", "--no-mcap"]);
+    let rrd = Rrd::open(&run.rrd);
     let steps = run.trace.rows.len();
     let t = run.trace.column("t");
     for j in 0..6 {
@@ -201,7 +183,7 @@ fn rrd_holds_every_joint_series_with_one_row_per_step_equal_to_the_trace() {
             ("status", Box::new(|k| vec![cmd[k] - q[k], saturated(k)])),
         ];
         for (leaf, want) in expected {
-            let got = rrd_series(&run.rrd, &format!("/joints/{name}/{leaf}"));
+            let got = rrd.series(&format!("/joints/{name}/{leaf}"));
             assert_eq!(got.len(), steps, "{name}/{leaf}: one row per step");
             for (k, (time, values)) in got.iter().enumerate() {
                 assert!((time - t[k]).abs() < 1e-9, "{name}/{leaf} time {time} vs {}", t[k]);
@@ -210,7 +192,7 @@ fn rrd_holds_every_joint_series_with_one_row_per_step_equal_to_the_trace() {
             }
         }
     }
-    let tool = rrd_series(&run.rrd, "/tool/position");
+    let tool = rrd.series("/tool/position");
     for (a, axis) in ["x", "y", "z"].iter().enumerate() {
         assert_eq!(tool.iter().map(|r| r.1[a]).collect::<Vec<_>>(), run.trace.column(axis), "tool {axis}");
     }
@@ -220,6 +202,7 @@ fn rrd_holds_every_joint_series_with_one_row_per_step_equal_to_the_trace() {
 fn rrd_poses_every_moving_link_at_every_step_as_the_simulated_arm() {
     use armscope::dynamics::{body_poses, frame_pose_in};
     let run = record(&["--duration", "0.4", "--no-mcap"]);
+    let rrd = Rrd::open(&run.rrd);
     let model = armscope::model::load_urdf(&repo().join("assets/smallrobot_arm.urdf")).unwrap();
     let q: Vec<Vec<f64>> = (0..6).map(|j| col(&run.trace, "q", j)).collect();
     let mut poses = vec![armscope::spatial::Pose::identity(); model.joints.len()];
@@ -229,7 +212,7 @@ fn rrd_poses_every_moving_link_at_every_step_as_the_simulated_arm() {
         .iter()
         .map(|&f| {
             let entity = format!("/world/robot/{}", model.frames[f].name);
-            (rrd_component(&run.rrd, &entity, "Transform3D:translation"), rrd_component(&run.rrd, &entity, "Transform3D:quaternion"))
+            (rrd.component(&entity, "Transform3D:translation"), rrd.component(&entity, "Transform3D:quaternion"))
         })
         .collect();
     for k in 0..run.trace.rows.len() {
@@ -256,19 +239,15 @@ fn rrd_poses_every_moving_link_at_every_step_as_the_simulated_arm() {
 #[test]
 fn rrd_has_the_3d_scene_configuration_summary_and_blueprint_and_passes_rerun_verify() {
     let run = record(&["--duration", "0.5", "--no-mcap"]);
-    let out = Command::new("bash").arg(kit("rrd-query.sh")).args([run.rrd.to_str().unwrap(), "--json"]).output().unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let text = String::from_utf8_lossy(&out.stdout);
+    let rrd = Rrd::open(&run.rrd);
+    let entities = rrd.entities();
     for entity in ["/config", "/summary", "/world/robot/upper_arm_link", "/world/robot/upper_arm_link/visual_0", "/world/robot/tool_link/tip", "/world/tool/trail", "/world/tool/commanded_path", "/world/tool/path"] {
-        assert!(text.contains(&format!("\"{entity}\"")), "entity {entity} missing from the recording");
+        assert!(entities.contains_key(entity), "entity {entity} missing from the recording");
     }
-    let listing = Command::new("bash").arg(kit("rrd-query.sh")).arg(run.rrd.to_str().unwrap()).output().unwrap();
-    let listing = String::from_utf8_lossy(&listing.stdout);
-    assert!(listing.contains("blueprints in file: 1"), "{listing}");
-    assert!(listing.contains("Boxes3D:half_sizes"), "link geometry");
-    let rerun = viewers_home().join("bin/rerun");
-    let verify = Command::new(&rerun).args(["rrd", "verify", run.rrd.to_str().unwrap()]).output().expect("rerun CLI from the viewers kit");
-    assert!(verify.status.success(), "rerun rrd verify: {}{}", String::from_utf8_lossy(&verify.stdout), String::from_utf8_lossy(&verify.stderr));
+    assert_eq!(rrd.blueprints, 1, "the file carries its layout");
+    assert!(entities.values().any(|e| e.components.contains_key("Boxes3D:half_sizes")), "link geometry");
+    assert!(rrd.verify_errors.is_empty(), "what rerun rrd verify checks: {:?}", rrd.verify_errors);
+    assert!(rrd.verified_columns > 100, "Rerun's components were checked: {}", rrd.verified_columns);
 }
 
 #[test]
@@ -296,10 +275,9 @@ fn an_interrupted_run_leaves_both_files_readable_up_to_that_point() {
     let summary = mcap::Summary::read(&bytes).unwrap().expect("the MCAP was closed properly");
     let done = mcap::read::metadata(&bytes, &summary.metadata_indexes[1]).unwrap();
     assert!(done.metadata["status"].contains("interrupted"));
-    let rows = rrd_series(&rrd, "/joints/J2/position");
-    assert_eq!(rows.len(), n, "the .rrd holds the same steps as the .mcap");
-    let verify = Command::new(viewers_home().join("bin/rerun")).args(["rrd", "verify", rrd.to_str().unwrap()]).output().unwrap();
-    assert!(verify.status.success(), "{}", String::from_utf8_lossy(&verify.stderr));
+    let rrd = Rrd::open(&rrd);
+    assert_eq!(rrd.series("/joints/J2/position").len(), n, "the .rrd holds the same steps as the .mcap");
+    assert!(rrd.verify_errors.is_empty(), "what rerun rrd verify checks: {:?}", rrd.verify_errors);
 }
 
 #[test]
@@ -320,7 +298,7 @@ fn no_viewer_listening_is_reported_and_the_files_are_still_written() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(0), "{err}");
     assert!(err.contains("could not start the Rerun viewer") && err.contains("install"), "{err}");
-    assert_eq!(rrd_series(&rrd, "/joints/J1/position").len(), 201);
+    assert_eq!(Rrd::open(&rrd).series("/joints/J1/position").len(), 201);
 }
 
 #[test]
@@ -343,4 +321,42 @@ fn realtime_paces_simulated_time_to_the_wall_clock() {
     let (code, _, err) = armscope(&["run", "--quiet", "--realtime", "0", "--no-rrd", "--no-mcap"]);
     assert_eq!(code, 2);
     assert!(err.contains("--realtime"), "{err}");
+}
+
+#[test]
+fn mcap_tool_path_comes_in_pieces_each_point_once_with_a_bounded_overview_for_seeking() {
+    use foxglove::messages::SceneUpdate;
+    // 30 s at 20 Hz: 601 path points, more than the overview keeps (512), so it is thinned
+    let run = record(&["--duration", "30", "--no-rrd"]);
+    let topics = mcap_messages(&run.mcap);
+    let mut drawn: Vec<[f64; 3]> = Vec::new();
+    let mut ids = std::collections::BTreeSet::new();
+    let mut last_overview = Vec::new();
+    for (i, m) in topics["/tool/path"].iter().enumerate() {
+        let update = SceneUpdate::decode(&m.3[..]).unwrap();
+        let [piece, overview] = &update.entities[..] else { panic!("a piece and the overview in message {i}") };
+        assert!(ids.insert(piece.id.clone()), "piece {} published once", piece.id);
+        assert_eq!(overview.id, "path-overview");
+        let points: Vec<[f64; 3]> = piece.lines[0].points.iter().map(|p| [p.x, p.y, p.z]).collect();
+        assert!(points.len() <= 11, "a piece is at most half a second at 20 Hz");
+        // each piece starts where the last one ended (no gap), and adds only new points
+        if let Some(end) = drawn.last() {
+            assert_eq!(points[0], *end, "piece {i} starts at the previous end");
+            drawn.extend_from_slice(&points[1..]);
+        } else {
+            drawn.extend_from_slice(&points);
+        }
+        last_overview = overview.lines[0].points.iter().map(|p| [p.x, p.y, p.z]).collect::<Vec<_>>();
+        assert!(last_overview.len() <= 513, "the overview stays bounded: {}", last_overview.len());
+        assert_eq!(last_overview.last(), points.last(), "the overview reaches the newest point");
+    }
+    // the pieces together are the tool's position every 50 ms and at the end, each once
+    let want: Vec<[f64; 3]> = (0..run.trace.rows.len())
+        .filter(|&k| k % 50 == 0 || k == run.trace.rows.len() - 1)
+        .map(|k| ["x", "y", "z"].map(|a| run.trace.rows[k][run.trace.col(a)]))
+        .collect();
+    assert_eq!(drawn, want);
+    // the overview is a thinning of the path: every point of it is a path point, first to last
+    assert_eq!(last_overview.first(), want.first());
+    assert!(last_overview.len() > 256 && last_overview.iter().all(|p| want.contains(p)));
 }

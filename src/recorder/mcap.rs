@@ -6,6 +6,8 @@
 //! file directly (the SDK's sink machinery costs more per message than the encoding itself), on a
 //! thread of its own (see `Out`).
 
+use super::foxglove_live::FoxgloveLive;
+use super::robot_description::RobotDescription;
 use super::telemetry::ControllerTelemetry;
 use super::worker::{BatchWorker, Reusable};
 use super::{Recorder, RunInfo};
@@ -21,8 +23,6 @@ use foxglove::messages::{
 };
 use foxglove::Encode;
 use mcap::records::MessageHeader;
-use schemars::JsonSchema;
-use serde::Serialize;
 use std::collections::BTreeMap;
 use std::fs::File;
 use std::io::BufWriter;
@@ -38,11 +38,6 @@ pub const TOPIC_TOOL_PATH: &str = "/tool/path";
 pub const TOPIC_COMMANDED_PATH: &str = "/tool/commanded_path";
 pub const TOPIC_ROBOT_DESCRIPTION: &str = "/robot_description";
 
-/// The URDF text (as ROS's std_msgs/String carries it).
-#[derive(Clone, Debug, Serialize, JsonSchema)]
-pub struct RobotDescription {
-    pub data: String,
-}
 
 /// A channel of messages of type T.
 struct Topic<T> {
@@ -71,36 +66,78 @@ impl Reusable for Batch {
 /// Messages per batch: ~250 control steps.
 const BATCH_MESSAGES: usize = 1000;
 
-/// The MCAP file, written on a thread of its own: this (recorder) thread encodes the messages,
+/// Where the encoded messages go: the file, the live Foxglove clients, or both (the same bytes).
+struct Sinks {
+    file: Option<McapWriter>,
+    live: Option<FoxgloveLive>,
+}
+
+impl Sinks {
+    fn write(&mut self, batch: &Batch) -> Result<(), String> {
+        let mut start = 0;
+        for (header, end) in &batch.messages {
+            let bytes = &batch.bytes[start..*end];
+            if let Some(file) = &mut self.file {
+                file.write_to_known_channel(header, bytes).map_err(|e| e.to_string())?;
+            }
+            if let Some(live) = &self.live {
+                live.log(header.channel_id, bytes, header.log_time);
+            }
+            start = *end;
+        }
+        Ok(())
+    }
+}
+
+/// The MCAP output, written on a thread of its own: this (recorder) thread encodes the messages,
 /// the writer thread frames and compresses them (zstd, the larger half of the work), so the two
 /// halves run on both cores instead of one.
 struct Out {
-    /// The writer while schemas, channels and metadata are added (before `spawn`, after `close`).
-    writer: Option<McapWriter>,
+    /// The sinks while schemas, channels and metadata are added (before `spawn`, after `close`).
+    sinks: Option<Sinks>,
     batch: Batch,
-    worker: Option<BatchWorker<McapWriter, Batch, String>>,
+    worker: Option<BatchWorker<Sinks, Batch, String>>,
+    /// The next channel id when there is no file to hand them out.
+    next_channel: u16,
 }
 
 impl Out {
-    fn new(writer: McapWriter) -> Self {
-        Self { writer: Some(writer), batch: Batch::default(), worker: None }
+    fn new(sinks: Sinks) -> Self {
+        Self { sinks: Some(sinks), batch: Batch::default(), worker: None, next_channel: 1 }
     }
 
-    fn writer(&mut self) -> &mut McapWriter {
-        self.writer.as_mut().expect("the writer is here before spawn and after close")
+    fn sinks(&mut self) -> &mut Sinks {
+        self.sinks.as_mut().expect("the sinks are here before spawn and after close")
     }
 
-    fn channel<T: Encode>(&mut self, topic: &str, metadata: BTreeMap<String, String>) -> mcap::McapResult<Topic<T>> {
-        let schema_id = match T::get_schema() {
-            Some(s) => self.writer().add_schema(&s.name, &s.encoding, &s.data)?,
-            None => 0,
+    /// A channel in both sinks; `latched`: a late live client gets its last message.
+    fn channel<T: Encode>(&mut self, topic: &str, metadata: BTreeMap<String, String>, latched: bool) -> Result<Topic<T>, String> {
+        let schema = T::get_schema();
+        let encoding = T::get_message_encoding();
+        let next = self.next_channel;
+        let sinks = self.sinks();
+        let id = match &mut sinks.file {
+            Some(file) => {
+                let schema_id = match &schema {
+                    Some(s) => file.add_schema(&s.name, &s.encoding, &s.data).map_err(|e| e.to_string())?,
+                    None => 0,
+                };
+                file.add_channel(schema_id, topic, &encoding, &metadata).map_err(|e| e.to_string())?
+            }
+            None => next,
         };
-        let id = self.writer().add_channel(schema_id, topic, &T::get_message_encoding(), &metadata)?;
+        if let Some(live) = &mut sinks.live {
+            live.add_channel(id, topic, &encoding, schema, metadata, latched)?;
+        }
+        self.next_channel = id + 1;
         Ok(Topic { id, sequence: 0, _message: PhantomData })
     }
 
     fn write_metadata(&mut self, name: &str, metadata: BTreeMap<String, String>) -> mcap::McapResult<()> {
-        self.writer().write_metadata(&mcap::records::Metadata { name: name.into(), metadata })
+        match &mut self.sinks().file {
+            Some(file) => file.write_metadata(&mcap::records::Metadata { name: name.into(), metadata }),
+            None => Ok(()),
+        }
     }
 
     fn log<T: Encode>(&mut self, topic: &mut Topic<T>, msg: &T, time_ns: u64) -> Result<(), String> {
@@ -111,17 +148,10 @@ impl Out {
         if self.batch.messages.len() >= BATCH_MESSAGES { self.send() } else { Ok(()) }
     }
 
-    /// Moves the writer to its thread; messages logged from now on are written there.
+    /// Moves the sinks to their thread; messages logged from now on are written there.
     fn spawn(&mut self) -> Result<(), String> {
-        let writer = self.writer.take().expect("spawned once");
-        let worker = BatchWorker::spawn("McapWriter", writer, |writer: &mut McapWriter, batch: &Batch| {
-            let mut start = 0;
-            for (header, end) in &batch.messages {
-                writer.write_to_known_channel(header, &batch.bytes[start..*end]).map_err(|e| e.to_string())?;
-                start = *end;
-            }
-            Ok(())
-        });
+        let sinks = self.sinks.take().expect("spawned once");
+        let worker = BatchWorker::spawn("McapWriter", sinks, |sinks: &mut Sinks, batch: &Batch| sinks.write(batch));
         self.worker = Some(worker.map_err(|e| e.to_string())?);
         Ok(())
     }
@@ -135,12 +165,12 @@ impl Out {
         Ok(())
     }
 
-    /// Writes what is left and takes the writer back.
+    /// Writes what is left and takes the sinks back.
     fn join(&mut self) -> Result<(), String> {
         match self.worker.as_mut().and_then(BatchWorker::join) {
             Some(joined) => {
-                let (writer, result) = joined.map_err(|_| "the MCAP writer thread panicked".to_string())?;
-                self.writer = Some(writer);
+                let (sinks, result) = joined.map_err(|_| "the MCAP writer thread panicked".to_string())?;
+                self.sinks = Some(sinks);
                 result
             }
             None => Ok(()),
@@ -175,8 +205,20 @@ struct Channels {
     robot_description: Topic<RobotDescription>,
 }
 
+/// Where the MCAP recorder's messages go: a file, live Foxglove clients, or both.
+#[derive(Clone, Debug, Default)]
+pub struct McapOptions {
+    pub file: Option<PathBuf>,
+    /// `HOST:PORT` to serve the Foxglove WebSocket protocol at.
+    pub live: Option<String>,
+}
+
 pub struct McapRecorder {
+    options: McapOptions,
+    /// What error messages name: the file, or the live address.
     path: PathBuf,
+    /// Told where the live server listens.
+    notice: Option<fn(&str)>,
     out: Option<Out>,
     channels: Option<Channels>,
     start_ns: u64,
@@ -191,14 +233,82 @@ pub struct McapRecorder {
     model: Option<std::sync::Arc<Model>>,
     steps_per_path_point: usize,
     steps_per_pose: usize,
-    path_points: Vec<Point3>,
+    tool_path: ToolPath,
     last_scene_second: i64,
 }
 
+/// Points of the tool path at most in one piece (a piece every half simulated second at 20 Hz).
+const PATH_PIECE_POINTS: usize = 10;
+/// Points of the path's overview at most.
+const PATH_OVERVIEW_POINTS: usize = 512;
+
+/// The tool's path, published incrementally: each message carries the new piece (its own entity,
+/// kept, so that playing the file draws the whole path, each point published once) and an overview
+/// of everything so far thinned to at most `PATH_OVERVIEW_POINTS` (one entity, replaced), which is
+/// what a viewer shows after seeking (it shows a topic's latest message). So the topic's size grows
+/// linearly with the duration.
+#[derive(Default)]
+struct ToolPath {
+    /// The points since the last piece, starting with the last piece's last point (no gap).
+    piece: Vec<Point3>,
+    pieces: usize,
+    overview: Vec<Point3>,
+    /// Every `stride`-th point goes into the overview; doubled (and the overview halved) when full.
+    stride: usize,
+    seen: usize,
+}
+
+impl ToolPath {
+    fn push(&mut self, p: Point3) {
+        let stride = self.stride.max(1);
+        if self.seen.is_multiple_of(stride) {
+            self.overview.push(p.clone());
+            if self.overview.len() > PATH_OVERVIEW_POINTS {
+                // keep every other point: the overview then holds every (2·stride)-th point
+                self.overview = self.overview.iter().step_by(2).cloned().collect();
+                self.stride = stride * 2;
+            }
+        }
+        self.seen += 1;
+        self.piece.push(p);
+    }
+
+    /// Whether a piece is due (`PATH_PIECE_POINTS` new points).
+    fn piece_full(&self) -> bool {
+        self.piece.len() > PATH_PIECE_POINTS
+    }
+
+    /// The message with the new piece and the overview; starts the next piece.
+    fn take_update(&mut self, timestamp: Timestamp) -> Option<SceneUpdate> {
+        if self.piece.len() < 2 {
+            return None;
+        }
+        let red = color([1.0, 0.25, 0.2, 1.0]);
+        let last = self.piece.last().cloned().expect("two points");
+        let piece = std::mem::replace(&mut self.piece, vec![last.clone()]);
+        let mut overview = self.overview.clone();
+        if overview.last() != Some(&last) {
+            overview.push(last);
+        }
+        let entity = |id: String, points: Vec<Point3>, thickness: f64| SceneEntity {
+            timestamp: Some(timestamp),
+            frame_id: "world".into(),
+            id,
+            lines: vec![line(points, red, thickness)],
+            ..Default::default()
+        };
+        self.pieces += 1;
+        Some(SceneUpdate { deletions: vec![], entities: vec![entity(format!("path-{}", self.pieces), piece, 3.0), entity("path-overview".into(), overview, 2.0)] })
+    }
+}
+
 impl McapRecorder {
-    pub fn new(path: PathBuf) -> Self {
+    pub fn new(options: McapOptions) -> Self {
+        let path = options.file.clone().unwrap_or_else(|| PathBuf::from(format!("foxglove live at {}", options.live.as_deref().unwrap_or(""))));
         Self {
+            options,
             path,
+            notice: None,
             out: None,
             channels: None,
             start_ns: 0,
@@ -211,9 +321,14 @@ impl McapRecorder {
             model: None,
             steps_per_path_point: 20,
             steps_per_pose: 20,
-            path_points: Vec::new(),
+            tool_path: ToolPath::default(),
             last_scene_second: -1,
         }
+    }
+
+    /// Where the user is told the live server's address.
+    pub fn on_notice(&mut self, notice: fn(&str)) {
+        self.notice = Some(notice);
     }
 
     fn err(&self, e: impl std::fmt::Display) -> Error {
@@ -230,22 +345,10 @@ impl McapRecorder {
     }
 
     fn publish_path(&mut self, t: f64) -> Result<(), Error> {
-        if self.path_points.len() < 2 {
-            return Ok(());
-        }
-        let entity = SceneEntity {
-            timestamp: Some(self.timestamp(t)),
-            frame_id: "world".into(),
-            // one entity, replaced as the path grows: a viewer that seeks shows only a topic's
-            // latest message, so each message carries the whole path so far
-            id: "path".into(),
-            lines: vec![line(self.path_points.clone(), color([1.0, 0.25, 0.2, 1.0]), 3.0)],
-            ..Default::default()
-        };
+        let Some(update) = self.tool_path.take_update(self.timestamp(t)) else { return Ok(()) };
         let stamp = self.stamp(t);
         let (out, ch) = (self.out.as_mut().expect("started"), self.channels.as_mut().expect("started"));
-        out.log(&mut ch.tool_path, &SceneUpdate { deletions: vec![], entities: vec![entity] }, stamp).map_err(|e| Error::output(&self.path, e))?;
-        Ok(())
+        out.log(&mut ch.tool_path, &update, stamp).map_err(|e| Error::output(&self.path, e))
     }
 }
 
@@ -364,7 +467,16 @@ impl Recorder for McapRecorder {
     fn start(&mut self, run: &RunInfo) -> Result<(), Error> {
         let e = run.experiment;
         let model = &*e.model;
-        let file = super::output_file::create_replacing(&self.path).map_err(|err| self.err(err))?;
+        let file = match &self.options.file {
+            Some(path) => {
+                // the Foxglove layout for this model, beside the recording
+                let layout = super::foxglove_layout::layout(model, &e.initial_state().0);
+                let layout_path = super::foxglove_layout::layout_path(path);
+                std::fs::write(&layout_path, serde_json::to_string_pretty(&layout).unwrap_or_default()).map_err(|err| Error::output(&layout_path, err))?;
+                Some(super::output_file::create_replacing(path).map_err(|err| self.err(err))?)
+            }
+            None => None,
+        };
         // zstd on the writer thread (`Out`): zstd's own worker threads cost more than they save here
         let options = mcap::WriteOptions::new()
             .compression(Some(mcap::Compression::Zstd))
@@ -376,8 +488,18 @@ impl Recorder for McapRecorder {
             .library(format!("armscope {} (foxglove-sdk schemas, mcap-rust)", env!("CARGO_PKG_VERSION")));
         // zstd hands its output over in pieces of up to 128 KiB: gathered here, a chunk (~200 KiB
         // compressed) takes a write call or two
-        let writer = options.create(BufWriter::with_capacity(1 << 20, file)).map_err(|err| self.err(err))?;
-        let mut out = Out::new(writer);
+        let file = file.map(|file| options.create(BufWriter::with_capacity(1 << 20, file))).transpose().map_err(|err| self.err(err))?;
+        let live = match &self.options.live {
+            Some(address) => {
+                let live = FoxgloveLive::start(address).map_err(|err| Error::flag("--foxglove", err))?;
+                if let Some(notice) = self.notice {
+                    notice(&format!("Foxglove live at ws://{} (Foxglove: Open connection → Foxglove WebSocket)", live.address()));
+                }
+                Some(live)
+            }
+            None => None,
+        };
+        let mut out = Out::new(Sinks { file, live });
         let now = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).unwrap_or_default();
         self.start_ns = now.as_nanos() as u64;
         // the configuration first: written later, it would close a chunk holding only schemas and
@@ -397,16 +519,16 @@ impl Recorder for McapRecorder {
         let mut controller_meta = BTreeMap::new();
         controller_meta.insert("joints".to_string(), serde_json::to_string(&model.joints.iter().map(|j| &j.name).collect::<Vec<_>>()).unwrap_or_default());
         controller_meta.insert("torque_limit".to_string(), serde_json::to_string(&e.controller().effort).unwrap_or_default());
-        let channels = (|| -> mcap::McapResult<Channels> {
+        let channels = (|| -> Result<Channels, String> {
             Ok(Channels {
-                tf: out.channel(TOPIC_TF, none())?,
-                scene: out.channel(TOPIC_SCENE, none())?,
-                joint_states: out.channel(TOPIC_JOINT_STATES, none())?,
-                controller: out.channel(TOPIC_CONTROLLER, controller_meta)?,
-                tool_pose: out.channel(TOPIC_TOOL_POSE, none())?,
-                tool_path: out.channel(TOPIC_TOOL_PATH, none())?,
-                commanded_path: out.channel(TOPIC_COMMANDED_PATH, none())?,
-                robot_description: out.channel(TOPIC_ROBOT_DESCRIPTION, none())?,
+                tf: out.channel(TOPIC_TF, none(), false)?,
+                scene: out.channel(TOPIC_SCENE, none(), true)?,
+                joint_states: out.channel(TOPIC_JOINT_STATES, none(), false)?,
+                controller: out.channel(TOPIC_CONTROLLER, controller_meta, false)?,
+                tool_pose: out.channel(TOPIC_TOOL_POSE, none(), false)?,
+                tool_path: out.channel(TOPIC_TOOL_PATH, none(), false)?,
+                commanded_path: out.channel(TOPIC_COMMANDED_PATH, none(), true)?,
+                robot_description: out.channel(TOPIC_ROBOT_DESCRIPTION, none(), true)?,
             })
         })()
         .map_err(|err| self.err(err))?;
@@ -538,8 +660,8 @@ impl Recorder for McapRecorder {
         }
         if s.k.is_multiple_of(self.steps_per_path_point) || s.is_final {
             let p = s.tool_position;
-            self.path_points.push(Point3 { x: p.x, y: p.y, z: p.z });
-            if self.path_points.len().is_multiple_of(10) || s.is_final {
+            self.tool_path.push(Point3 { x: p.x, y: p.y, z: p.z });
+            if self.tool_path.piece_full() || s.is_final {
                 self.publish_path(s.t)?;
             }
         }
@@ -555,7 +677,13 @@ impl Recorder for McapRecorder {
         if let Some(mut out) = self.out.take() {
             out.close().map_err(|e| self.err(e))?;
             out.write_metadata("armscope.summary", meta).map_err(|e| self.err(e))?;
-            out.writer().finish().map_err(|e| self.err(e))?;
+            let sinks = out.sinks();
+            if let Some(file) = &mut sinks.file {
+                file.finish().map_err(|e| self.err(e))?;
+            }
+            if let Some(live) = &mut sinks.live {
+                live.stop();
+            }
         }
         Ok(())
     }

@@ -2,10 +2,13 @@
 //! trait; a new format is one new file.
 
 mod console;
+pub mod foxglove_layout;
+pub mod foxglove_live;
 mod mcap;
 mod output_file;
 mod pacer;
 pub mod rrd;
+mod robot_description;
 mod rrd_file;
 mod summary_json;
 pub mod telemetry;
@@ -15,7 +18,8 @@ mod trace;
 mod tutorial_csv;
 
 pub use console::Console;
-pub use mcap::{McapRecorder, TOPIC_CONTROLLER, TOPIC_JOINT_STATES};
+pub use mcap::{McapOptions, McapRecorder, TOPIC_CONTROLLER, TOPIC_JOINT_STATES};
+pub use robot_description::{RobotDescription, decode as decode_robot_description};
 pub use telemetry::ControllerTelemetry;
 pub use pacer::Pacer;
 pub use rrd::{DEFAULT_CONNECT_URL, LiveViewer, RerunOptions, RerunRecorder};

@@ -5,7 +5,7 @@
 
 use armscope::config::RunConfig;
 use armscope::experiment::Experiment;
-use armscope::recorder::{McapRecorder, Recorder, RerunOptions, RerunRecorder, Threaded};
+use armscope::recorder::{McapOptions, McapRecorder, Recorder, RerunOptions, RerunRecorder, Threaded};
 use armscope::sim::simulate;
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::path::Path;
@@ -22,7 +22,7 @@ fn run(experiment: &Experiment, dir: &Path, rrd: bool, mcap: bool) -> usize {
         recorders.push(Box::new(Threaded::new(RerunRecorder::new(options), Duration::from_millis(20))));
     }
     if mcap {
-        recorders.push(Box::new(Threaded::new(McapRecorder::new(dir.join("bench.mcap")), Duration::from_millis(20))));
+        recorders.push(Box::new(Threaded::new(McapRecorder::new(McapOptions { file: Some(dir.join("bench.mcap")), live: None }), Duration::from_millis(20))));
     }
     let mut refs: Vec<&mut dyn Recorder> = recorders.iter_mut().map(|r| r.as_mut() as &mut dyn Recorder).collect();
     simulate(experiment, &mut refs, None).unwrap().steps
