@@ -5,7 +5,7 @@ use crate::controller::PdGravityController;
 use crate::error::Error;
 use crate::gains::{Gains, TUTORIAL_KD, TUTORIAL_KP, auto_tune, is_tutorial_model};
 use crate::integrator::{ContinuousPlant, DiscretePlant, Plant, Tolerances};
-use crate::model::{Model, load_urdf};
+use crate::model::{LoadOptions, Model, load_urdf_with};
 use crate::trajectory::{Hold, JointSchedule, JointStep, Trajectory, Wave};
 use nalgebra::Vector3;
 use std::sync::Arc;
@@ -31,7 +31,7 @@ pub struct Experiment {
 impl Experiment {
     /// Load the model named by the config and check every setting against it.
     pub fn prepare(config: RunConfig) -> Result<Self, Error> {
-        let model = load_urdf(&config.urdf)?;
+        let model = load_urdf_with(&config.urdf, LoadOptions { strict_inertia: config.strict_inertia })?;
         Self::with_model(config, model)
     }
 

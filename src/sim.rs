@@ -197,7 +197,8 @@ fn divergence(experiment: &Experiment, q: &[f64], v: &[f64], time: f64) -> Optio
     let joints = &experiment.model.joints;
     let sweeps = |i: usize| {
         let range = joints[i].upper - joints[i].lower;
-        range.is_finite() && v[i].abs() * dt >= 0.9 * range
+        // a joint that does not move sweeps nothing, whatever its range (a zero-width one included)
+        range.is_finite() && v[i] != 0.0 && v[i].abs() * dt >= 0.9 * range
     };
     let bad = (0..q.len()).find(|&i| !q[i].is_finite() || !v[i].is_finite() || v[i].abs() > limit || sweeps(i))?;
     let joint = joints[bad].name.clone();

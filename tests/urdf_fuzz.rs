@@ -95,8 +95,11 @@ proptest! {
         match result.unwrap() {
             Ok(model) => {
                 prop_assert!(model.dof() > 0);
-                for j in &model.joints {
-                    prop_assert!(j.inertia.mass > 0.0 && j.inertia.mass.is_finite());
+                // every moving joint moves something: a positive diagonal of the mass matrix
+                let mut data = armscope::dynamics::Data::new(&model);
+                let m = armscope::dynamics::crba(&model, &mut data, &vec![0.0; model.dof()]);
+                for (i, j) in model.joints.iter().enumerate() {
+                    prop_assert!(m[(i, i)] > 0.0 && j.inertia.mass.is_finite(), "joint {} moves nothing: {m}", j.name);
                 }
             }
             Err(e) => {

@@ -46,14 +46,14 @@ pub enum ModelErrorKind {
     Negative { joint: String, field: &'static str, value: f64 },
     #[error("link '{link}': mass {mass} is negative")]
     NegativeMass { link: String, mass: f64 },
-    #[error("link '{link}' (moved by joint '{joint}'): mass is {mass}; a moving body needs a positive mass")]
-    NoMass { link: String, joint: String, mass: f64 },
+    #[error("joint '{joint}' moves nothing: link '{link}' and everything beyond it have no mass or inertia about the joint's motion; give link '{link}' an <inertial>")]
+    MovesNothing { joint: String, link: String },
+    #[error("this is a xacro file; expand it to a URDF first: xacro FILE.urdf.xacro > FILE.urdf (ROS's xacro, also `pip install xacro`)")]
+    Xacro,
     #[error("link '{link}': inertia is not positive definite (principal moments {moments})")]
     InertiaNotPositive { link: String, moments: String },
     #[error("link '{link}': inertia breaks the triangle inequality (principal moments {moments}: each must be at most the sum of the other two)")]
     InertiaTriangle { link: String, moments: String },
     #[error("transmission '{transmission}': {what}")]
     Transmission { transmission: String, what: String },
-    #[error("link '{link}': mesh '{filename}' not found (looked for {looked})")]
-    MeshNotFound { link: String, filename: String, looked: String },
 }

@@ -4,7 +4,7 @@ mod error;
 mod urdf;
 
 pub use error::{ModelError, ModelErrorKind};
-pub use urdf::{load_urdf, load_urdf_str};
+pub use urdf::{LoadOptions, load_urdf, load_urdf_str, load_urdf_str_with, load_urdf_with};
 
 use crate::spatial::{Pose, RigidInertia};
 use nalgebra::Vector3;

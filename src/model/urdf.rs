@@ -10,23 +10,42 @@ use std::path::{Path, PathBuf};
 /// Gravity of every loaded model; `--no-gravity` replaces it.
 pub const STANDARD_GRAVITY: [f64; 3] = [0.0, 0.0, -9.81];
 
+/// How strictly a URDF is read.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct LoadOptions {
+    /// Refuse physically inconsistent inertias (not positive definite, triangle inequality broken),
+    /// as Drake does; by default they are a notice and the URDF's numbers are used, as Pinocchio does.
+    pub strict_inertia: bool,
+}
+
 pub fn load_urdf(path: &Path) -> Result<Model, ModelError> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| ModelError { file: path.to_path_buf(), kind: K::Io(e.to_string()) })?;
-    load_urdf_str(&text, path)
+    load_urdf_with(path, LoadOptions::default())
+}
+
+pub fn load_urdf_with(path: &Path, options: LoadOptions) -> Result<Model, ModelError> {
+    let fail = |kind| ModelError { file: path.to_path_buf(), kind };
+    if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("xacro")) {
+        return Err(fail(K::Xacro));
+    }
+    let text = crate::builtin::read_to_string(path).map_err(|e| fail(K::Io(e.to_string())))?;
+    load_urdf_str_with(&text, path, options)
 }
 
 /// Load URDF text; `source` names it in messages and anchors relative mesh paths.
 pub fn load_urdf_str(text: &str, source: &Path) -> Result<Model, ModelError> {
+    load_urdf_str_with(text, source, LoadOptions::default())
+}
+
+pub fn load_urdf_str_with(text: &str, source: &Path, options: LoadOptions) -> Result<Model, ModelError> {
     let fail = |kind| ModelError { file: source.to_path_buf(), kind };
-    build(text, source).map_err(fail)
+    build(text, source, options).map_err(fail)
 }
 
 fn one_line(s: impl ToString) -> String {
     s.to_string().split_whitespace().collect::<Vec<_>>().join(" ")
 }
 
-fn build(text: &str, source: &Path) -> Result<Model, K> {
+fn build(text: &str, source: &Path, options: LoadOptions) -> Result<Model, K> {
     let doc = roxmltree::Document::parse(text).map_err(|e| K::Xml(one_line(e)))?;
     if doc.root_element().tag_name().name() != "robot" {
         return Err(K::Urdf(format!("root element is <{}>, expected <robot>", doc.root_element().tag_name().name())));
@@ -53,10 +72,13 @@ fn build(text: &str, source: &Path) -> Result<Model, K> {
 
     // Numbers, per element.
     for link in &robot.links {
-        check_link(link)?;
+        check_link(link, options, &mut notices)?;
     }
     for joint in &robot.joints {
         check_joint(joint)?;
+        if joint.mimic.is_some() && joint.joint_type == urdf_rs::JointType::Fixed {
+            notices.push(format!("joint '{}' is fixed; ignoring its <mimic>", joint.name));
+        }
     }
 
     // Tree structure.
@@ -125,11 +147,7 @@ fn build(text: &str, source: &Path) -> Result<Model, K> {
         if let Some(b) = body {
             body_inertia[b] = body_inertia[b].combined(&link_inertia(ul).transformed(&placement));
         }
-        let visuals = ul
-            .visual
-            .iter()
-            .map(|v| make_visual(v, &ul.name, &robot.materials, base_dir))
-            .collect::<Result<Vec<_>, _>>()?;
+        let visuals = link_visuals(ul, &robot.materials, base_dir, &mut notices);
         frame_of_link[link] = Some(frames.len());
         frames.push(Frame {
             name: ul.name.clone(),
@@ -151,16 +169,19 @@ fn build(text: &str, source: &Path) -> Result<Model, K> {
         return Err(K::NoMovingJoints);
     }
 
-    // Moving bodies need mass, and an inertia a real body can have.
     for (joint, inertia) in joints.iter_mut().zip(body_inertia) {
-        if !(inertia.mass > 0.0) {
-            return Err(K::NoMass { link: joint.child_link.clone(), joint: joint.name.clone(), mass: inertia.mass });
-        }
-        check_inertia(&joint.child_link, &inertia.inertia_com)?;
         joint.inertia = inertia;
     }
+    // Massless links are fine (frames, sensors, tools) as long as every moving joint moves
+    // something: the mass matrix is then positive definite.
+    match joint_moving_nothing(&joints) {
+        Some(Ok(j)) => return Err(K::MovesNothing { joint: joints[j].name.clone(), link: joints[j].child_link.clone() }),
+        // finite numbers whose sums overflow (1e308 in a URDF)
+        Some(Err(j)) => return Err(K::NonFinite { element: format!("link '{}'", joints[j].child_link), field: "inertia of the links it carries", value: f64::INFINITY }),
+        None => {}
+    }
 
-    let actuators = actuators_from_transmissions(&doc, &joints)?;
+    let actuators = actuators_from_transmissions(&doc, &robot, &joints, &mut notices)?;
     let actuators = if actuators.is_empty() {
         joints
             .iter()
@@ -194,7 +215,7 @@ fn pose(p: &urdf_rs::Pose) -> Pose {
 
 fn joint_kind(joint: &urdf_rs::Joint) -> Result<Option<JointKind>, K> {
     use urdf_rs::JointType as T;
-    if joint.mimic.is_some() {
+    if joint.mimic.is_some() && joint.joint_type != T::Fixed {
         return Err(K::Mimic(joint.name.clone()));
     }
     match joint.joint_type {
@@ -212,6 +233,11 @@ fn make_joint(uj: &urdf_rs::Joint, kind: JointKind, parent: Option<usize>, place
     let axis = Vector3::from(uj.axis.xyz.0);
     let (lower, upper) = match kind {
         JointKind::Continuous => (f64::NEG_INFINITY, f64::INFINITY),
+        // SolidWorks' URDF exporter writes lower = upper = 0 as a placeholder for "no limits"
+        _ if uj.limit.lower == uj.limit.upper => {
+            notices.push(format!("joint '{}' has lower = upper = {} (a placeholder, as exporters write it); treating it as unlimited", uj.name, uj.limit.lower));
+            (f64::NEG_INFINITY, f64::INFINITY)
+        }
         _ => (uj.limit.lower, uj.limit.upper),
     };
     let effort = if uj.limit.effort > 0.0 {
@@ -254,7 +280,7 @@ fn finite(element: &str, field: &'static str, values: &[f64]) -> Result<(), K> {
     }
 }
 
-fn check_link(link: &urdf_rs::Link) -> Result<(), K> {
+fn check_link(link: &urdf_rs::Link, options: LoadOptions, notices: &mut Vec<String>) -> Result<(), K> {
     let element = format!("link '{}'", link.name);
     let inertial = &link.inertial;
     finite(&element, "inertial origin", &[inertial.origin.xyz.0, inertial.origin.rpy.0].concat())?;
@@ -275,9 +301,42 @@ fn check_link(link: &urdf_rs::Link) -> Result<(), K> {
         return Err(K::NegativeMass { link: link.name.clone(), mass: inertial.mass.value });
     }
     if inertial.mass.value > 0.0 {
-        check_inertia(&link.name, &link_inertia(link).inertia_com)?;
+        match check_inertia(&link.name, &link_inertia(link).inertia_com) {
+            Err(e) if !options.strict_inertia => {
+                notices.push(format!("{e}; running with the URDF's numbers, as Pinocchio does (--strict-inertia refuses it)"))
+            }
+            result => result?,
+        }
     }
     Ok(())
+}
+
+/// The first moving joint whose whole subtree has no inertia about its motion (no rotational
+/// inertia about a revolute axis, no mass along a prismatic one) at the zero pose: the mass
+/// matrix's diagonal entry, from the composite inertias of the subtrees. `Err(joint)`: that
+/// joint's subtree inertia is not finite.
+fn joint_moving_nothing(joints: &[Joint]) -> Option<Result<usize, usize>> {
+    let mut composite: Vec<RigidInertia> = joints.iter().map(|j| j.inertia).collect();
+    for i in (0..joints.len()).rev() {
+        if let Some(p) = joints[i].parent {
+            composite[p] = composite[p].combined(&composite[i].transformed(&joints[i].placement));
+        }
+    }
+    (0..joints.len()).find_map(|i| {
+        let (c, a) = (&composite[i], &joints[i].axis);
+        let about_motion = match joints[i].kind {
+            JointKind::Prismatic => c.mass,
+            JointKind::Revolute | JointKind::Continuous => {
+                let about_origin = c.inertia_com + (Matrix3::identity() * c.com.norm_squared() - c.com * c.com.transpose()) * c.mass;
+                a.dot(&(about_origin * a))
+            }
+        };
+        if !about_motion.is_finite() {
+            Some(Err(i))
+        } else {
+            (about_motion <= 0.0).then_some(Ok(i))
+        }
+    })
 }
 
 /// A rotational inertia a rigid body can have: positive definite, and each principal moment at most
@@ -333,36 +392,90 @@ fn check_joint(joint: &urdf_rs::Joint) -> Result<(), K> {
     Ok(())
 }
 
-fn make_visual(v: &urdf_rs::Visual, link: &str, materials: &[urdf_rs::Material], base_dir: &Path) -> Result<Visual, K> {
-    let geometry = match &v.geometry {
+/// A link's visuals. A mesh that cannot be found (a URDF shared without its mesh folder is common)
+/// is a notice, and the link is drawn without it: with its collision shapes if they can be drawn,
+/// else as a box with the link's inertia. The simulation does not need the geometry.
+fn link_visuals(link: &urdf_rs::Link, materials: &[urdf_rs::Material], base_dir: &Path, notices: &mut Vec<String>) -> Vec<Visual> {
+    let mut missing = false;
+    let mut visuals: Vec<Visual> = link
+        .visual
+        .iter()
+        .filter_map(|v| match geometry(&v.geometry, base_dir) {
+            Ok(geometry) => Some(Visual { origin: pose(&v.origin), geometry, rgba: rgba(v, materials) }),
+            Err(looked) => {
+                let filename = match &v.geometry {
+                    urdf_rs::Geometry::Mesh { filename, .. } => filename.as_str(),
+                    _ => "",
+                };
+                notices.push(format!("link '{}': mesh '{filename}' not found (looked for {looked}); drawing the link without it", link.name));
+                missing = true;
+                None
+            }
+        })
+        .collect();
+    if missing && visuals.is_empty() {
+        visuals = link.collision.iter().filter_map(|c| geometry(&c.geometry, base_dir).ok().map(|g| Visual { origin: pose(&c.origin), geometry: g, rgba: None })).collect();
+    }
+    if missing && visuals.is_empty() {
+        visuals.extend(inertia_box(link));
+    }
+    visuals
+}
+
+fn geometry(g: &urdf_rs::Geometry, base_dir: &Path) -> Result<Geometry, String> {
+    Ok(match g {
         urdf_rs::Geometry::Box { size } => Geometry::Box { size: size.0 },
         urdf_rs::Geometry::Cylinder { radius, length } => Geometry::Cylinder { radius: *radius, length: *length },
         urdf_rs::Geometry::Capsule { radius, length } => Geometry::Capsule { radius: *radius, length: *length },
         urdf_rs::Geometry::Sphere { radius } => Geometry::Sphere { radius: *radius },
-        urdf_rs::Geometry::Mesh { filename, scale } => Geometry::Mesh {
-            path: resolve_mesh(filename, base_dir).map_err(|looked| K::MeshNotFound {
-                link: link.to_string(),
-                filename: filename.clone(),
-                looked,
-            })?,
-            scale: scale.map_or([1.0; 3], |s| s.0),
-        },
-    };
-    let rgba = v.material.as_ref().and_then(|m| {
+        urdf_rs::Geometry::Mesh { filename, scale } => Geometry::Mesh { path: resolve_mesh(filename, base_dir)?, scale: scale.map_or([1.0; 3], |s| s.0) },
+    })
+}
+
+fn rgba(v: &urdf_rs::Visual, materials: &[urdf_rs::Material]) -> Option<[f32; 4]> {
+    v.material.as_ref().and_then(|m| {
         m.color
             .as_ref()
             .or_else(|| materials.iter().find(|g| g.name == m.name).and_then(|g| g.color.as_ref()))
             .map(|c| c.rgba.0.map(|x| x as f32))
-    });
-    Ok(Visual { origin: pose(&v.origin), geometry, rgba })
+    })
 }
 
-/// Resolve a mesh reference: `package://PKG/rest` (searched for a folder PKG, or a folder named PKG,
-/// at or above the URDF's folder), `file://` and plain paths (relative to the URDF's folder).
+/// The box of uniform density with the link's mass and principal moments, on its principal axes
+/// at its centre of mass; `None` for a link without mass.
+fn inertia_box(link: &urdf_rs::Link) -> Option<Visual> {
+    let inertia = link_inertia(link);
+    if !(inertia.mass > 0.0) {
+        return None;
+    }
+    let eigen = SymmetricEigen::new(inertia.inertia_com);
+    let (i, m) = (eigen.eigenvalues, inertia.mass);
+    // a box a×b×c: I_x = m(b² + c²)/12, …, so a² = 6(I_y + I_z − I_x)/m
+    let side = |k: usize| (6.0 * (i[(k + 1) % 3] + i[(k + 2) % 3] - i[k]) / m).max(0.0).sqrt().max(0.005);
+    let mut rotation = eigen.eigenvectors;
+    if rotation.determinant() < 0.0 {
+        rotation.column_mut(2).neg_mut();
+    }
+    Some(Visual { origin: Pose::new(rotation, inertia.com), geometry: Geometry::Box { size: [side(0), side(1), side(2)] }, rgba: Some([0.6, 0.6, 0.65, 0.5]) })
+}
+
+/// Resolve a mesh reference: `package://PKG/rest` (searched as ROS does, in ROS_PACKAGE_PATH's
+/// folders and AMENT_PREFIX_PATH's `share/`, then for a folder PKG, or a folder named PKG, at or
+/// above the URDF's folder), `file://` and plain paths (relative to the URDF's folder).
 fn resolve_mesh(filename: &str, base_dir: &Path) -> Result<PathBuf, String> {
     let mut candidates: Vec<PathBuf> = Vec::new();
     if let Some(rest) = filename.strip_prefix("package://") {
         let (package, relative) = rest.split_once('/').unwrap_or((rest, ""));
+        let paths = |var: &str| std::env::var_os(var).map(|v| std::env::split_paths(&v).collect::<Vec<_>>()).unwrap_or_default();
+        for dir in paths("ROS_PACKAGE_PATH") {
+            if dir.file_name().is_some_and(|n| n == package) {
+                candidates.push(dir.join(relative));
+            }
+            candidates.push(dir.join(package).join(relative));
+        }
+        for prefix in paths("AMENT_PREFIX_PATH") {
+            candidates.push(prefix.join("share").join(package).join(relative));
+        }
         for dir in base_dir.ancestors() {
             if dir.file_name().is_some_and(|n| n == package) {
                 candidates.push(dir.join(relative));
@@ -380,8 +493,9 @@ fn resolve_mesh(filename: &str, base_dir: &Path) -> Result<PathBuf, String> {
     }
 }
 
-/// One actuator per `<transmission>`; empty when the URDF declares none.
-fn actuators_from_transmissions(doc: &roxmltree::Document, joints: &[Joint]) -> Result<Vec<Actuator>, K> {
+/// One actuator per `<transmission>`; empty when the URDF declares none. A transmission on a joint
+/// that does not move (fixed) or that the URDF does not have is a notice and is ignored.
+fn actuators_from_transmissions(doc: &roxmltree::Document, robot: &urdf_rs::Robot, joints: &[Joint], notices: &mut Vec<String>) -> Result<Vec<Actuator>, K> {
     let mut actuators: Vec<Actuator> = Vec::new();
     for t in doc.root_element().children().filter(|n| n.has_tag_name("transmission")) {
         let name = t.attribute("name").unwrap_or("(unnamed)").to_string();
@@ -396,10 +510,11 @@ fn actuators_from_transmissions(doc: &roxmltree::Document, joints: &[Joint]) -> 
             )));
         }
         let joint_name = joint_nodes[0].attribute("name").ok_or_else(|| fail("<joint> has no name".into()))?;
-        let joint = joints
-            .iter()
-            .position(|j| j.name == joint_name)
-            .ok_or_else(|| fail(format!("joint '{joint_name}' is not a moving joint of this model")))?;
+        let Some(joint) = joints.iter().position(|j| j.name == joint_name) else {
+            let what = if robot.joints.iter().any(|j| j.name == joint_name) { "a fixed joint" } else { "a joint this URDF does not have" };
+            notices.push(format!("transmission '{name}' drives joint '{joint_name}', {what}; ignoring the transmission"));
+            continue;
+        };
         if actuators.iter().any(|a| a.joint == joint) {
             return Err(fail(format!("joint '{joint_name}' already has an actuator")));
         }

@@ -1,0 +1,170 @@
+//! What real robot descriptions contain and Pinocchio and Drake load, in generated URDFs: massless
+//! frame links, inconsistent inertias (a notice, or an error with --strict-inertia), a moving joint
+//! that moves nothing (an error naming it), 0..0 limit placeholders, transmissions and mimics on
+//! fixed joints, meshes that are missing or found through ROS's package paths, xacro files.
+
+mod common;
+
+use armscope::dynamics::{Data, crba};
+use armscope::model::{Geometry, LoadOptions, Model, load_urdf_str, load_urdf_str_with};
+use std::path::Path;
+use std::process::Command;
+
+fn inertial(mass: f64, ixx: f64, iyy: f64, izz: f64) -> String {
+    format!(r#"<inertial><mass value="{mass}"/><inertia ixx="{ixx}" ixy="0" ixz="0" iyy="{iyy}" iyz="0" izz="{izz}"/></inertial>"#)
+}
+
+/// world ─weld─ base ─J1 (z)─ upper ─J2 (y)─ fore, and whatever `extra` adds.
+fn arm(fore_inertial: &str, j2_limits: &str, extra: &str) -> String {
+    format!(
+        r#"<robot name="t"><link name="world"/><link name="base">{base}</link><link name="upper">{upper}</link><link name="fore">{fore_inertial}</link>
+<joint name="weld" type="fixed"><parent link="world"/><child link="base"/></joint>
+<joint name="J1" type="revolute"><parent link="base"/><child link="upper"/><axis xyz="0 0 1"/><limit lower="-2" upper="2" effort="5" velocity="1"/></joint>
+<joint name="J2" type="revolute"><origin xyz="0 0 0.2"/><parent link="upper"/><child link="fore"/><axis xyz="0 1 0"/><limit {j2_limits} effort="5" velocity="1"/></joint>
+{extra}</robot>"#,
+        base = inertial(1.0, 0.01, 0.01, 0.01),
+        upper = inertial(1.0, 0.01, 0.01, 0.01),
+    )
+}
+
+const GOOD_FORE: &str = r#"<inertial><origin xyz="0.1 0 0"/><mass value="0.5"/><inertia ixx="0.001" ixy="0" ixz="0" iyy="0.002" iyz="0" izz="0.002"/></inertial>"#;
+const LIMITS: &str = r#"lower="-1" upper="1""#;
+
+fn load(text: &str) -> Model {
+    load_urdf_str(text, Path::new("t.urdf")).unwrap_or_else(|e| panic!("{e}"))
+}
+
+fn mass_matrix_at_zero(model: &Model) -> nalgebra::DMatrix<f64> {
+    let mut data = Data::new(model);
+    let q = vec![0.0; model.dof()];
+    crba(model, &mut data, &q);
+    data.mass_matrix.clone()
+}
+
+#[test]
+fn massless_frame_links_on_fixed_joints_load_without_a_word() {
+    let tool = r#"<link name="tool_frame"/><link name="camera"><inertial><mass value="0"/><inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/></inertial></link>
+<joint name="tool_joint" type="fixed"><origin xyz="0.3 0 0"/><parent link="fore"/><child link="tool_frame"/></joint>
+<joint name="camera_joint" type="fixed"><parent link="upper"/><child link="camera"/></joint>"#;
+    let model = load(&arm(GOOD_FORE, LIMITS, tool));
+    assert_eq!(model.dof(), 2);
+    assert_eq!(model.frames[model.tool_frame].name, "tool_frame", "the deepest leaf is the tool");
+    assert!(model.notices.iter().all(|n| !n.contains("tool_frame") && !n.contains("camera")), "{:?}", model.notices);
+}
+
+#[test]
+fn a_massless_link_between_moving_joints_is_fine_when_the_subtree_has_inertia() {
+    // J2 moves a massless link; J3 hangs a mass from it: J2 still moves something
+    let extra = format!(
+        r#"<link name="hand">{}</link><joint name="J3" type="revolute"><origin xyz="0.2 0 0"/><parent link="fore"/><child link="hand"/><axis xyz="1 0 0"/><limit {LIMITS} effort="1" velocity="1"/></joint>"#,
+        inertial(0.2, 1e-4, 1e-4, 1e-4)
+    );
+    let model = load(&arm(&inertial(0.0, 0.0, 0.0, 0.0), LIMITS, &extra));
+    let m = mass_matrix_at_zero(&model);
+    assert!(m.clone().cholesky().is_some(), "M positive definite: {m}");
+}
+
+#[test]
+fn a_joint_that_moves_nothing_is_an_error_naming_the_joint_and_link() {
+    let err = load_urdf_str(&arm(&inertial(0.0, 0.0, 0.0, 0.0), LIMITS, ""), Path::new("t.urdf")).unwrap_err().to_string();
+    assert!(err.starts_with("t.urdf: ") && err.contains("joint 'J2'") && err.contains("link 'fore'") && err.contains("moves nothing"), "{err}");
+    // a point mass on the axis has no inertia about it either
+    let on_axis = r#"<inertial><mass value="1"/><inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/></inertial>"#;
+    let err = load_urdf_str(&arm(on_axis, LIMITS, ""), Path::new("t.urdf")).unwrap_err().to_string();
+    assert!(err.contains("joint 'J2'"), "{err}");
+}
+
+#[test]
+fn inconsistent_inertias_are_a_notice_and_the_urdfs_numbers_are_used_unless_strict() {
+    // a thin rod along x: zero about its own axis (not positive definite), moved about y
+    let rod = r#"<inertial><origin xyz="0.1 0 0"/><mass value="0.5"/><inertia ixx="0" ixy="0" ixz="0" iyy="0.002" iyz="0" izz="0.002"/></inertial>"#;
+    // the triangle inequality broken (izz > ixx + iyy), as exporters write for sensor mounts
+    let triangle = r#"<inertial><origin xyz="0.1 0 0"/><mass value="0.5"/><inertia ixx="0.001" ixy="0" ixz="0" iyy="0.001" iyz="0" izz="0.005"/></inertial>"#;
+    for (inertia, what) in [(rod, "not positive definite"), (triangle, "triangle inequality")] {
+        let text = arm(inertia, LIMITS, "");
+        let model = load(&text);
+        let notice = model.notices.iter().find(|n| n.contains("link 'fore'")).unwrap_or_else(|| panic!("no notice: {:?}", model.notices));
+        assert!(notice.contains(what) && notice.contains("--strict-inertia"), "{notice}");
+        // the URDF's numbers, unchanged
+        let izz = armscope::model::load_urdf_str(&text, Path::new("t.urdf")).unwrap().joints[1].inertia.inertia_com[(2, 2)];
+        assert_eq!(izz, if what == "triangle inequality" { 0.005 } else { 0.002 });
+        assert!(mass_matrix_at_zero(&model).cholesky().is_some());
+        let strict = load_urdf_str_with(&text, Path::new("t.urdf"), LoadOptions { strict_inertia: true }).unwrap_err().to_string();
+        assert!(strict.contains("link 'fore'") && strict.contains(what), "{strict}");
+    }
+}
+
+#[test]
+fn zero_width_limits_are_a_placeholder_for_unlimited_and_never_a_divergence() {
+    let model = load(&arm(GOOD_FORE, r#"lower="0" upper="0""#, ""));
+    assert!(model.joints[1].lower.is_infinite() && model.joints[1].upper.is_infinite());
+    assert!(model.notices.iter().any(|n| n.contains("joint 'J2'") && n.contains("unlimited")), "{:?}", model.notices);
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("zero.urdf");
+    std::fs::write(&path, arm(GOOD_FORE, r#"lower="0" upper="0""#, "")).unwrap();
+    for extra in [&["--static"][..], &["--kp", "0", "--kd", "0", "--no-ff"][..]] {
+        let out = Command::new(env!("CARGO_BIN_EXE_armscope"))
+            .args(["run", "--quiet", "--duration", "0.5", "--no-rrd", "--no-mcap", "--urdf", path.to_str().unwrap()])
+            .args(extra)
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    }
+}
+
+#[test]
+fn transmissions_and_mimics_on_joints_that_do_not_move_are_ignored_with_a_notice() {
+    let extra = r#"<link name="finger"/><joint name="finger_joint" type="fixed"><parent link="fore"/><child link="finger"/><mimic joint="J2"/></joint>
+<transmission name="finger_trans"><joint name="finger_joint"/><actuator name="finger_motor"/></transmission>
+<transmission name="ghost_trans"><joint name="no_such_joint"/><actuator name="ghost"/></transmission>
+<transmission name="j2_trans"><joint name="J2"/><actuator name="m2"><mechanicalReduction>4</mechanicalReduction></actuator></transmission>"#;
+    let model = load(&arm(GOOD_FORE, LIMITS, extra));
+    let has = |a: &str, b: &str| model.notices.iter().any(|n| n.contains(a) && n.contains(b));
+    assert!(has("finger_trans", "fixed joint") && has("ghost_trans", "does not have") && has("finger_joint", "<mimic>"), "{:?}", model.notices);
+    assert_eq!(model.actuators.len(), 1);
+    assert_eq!((model.actuators[0].joint, model.actuators[0].gear_ratio), (1, 4.0));
+}
+
+#[test]
+fn a_missing_mesh_is_a_notice_and_the_link_is_drawn_from_its_collision_shape_or_inertia() {
+    let dir = tempfile::tempdir().unwrap();
+    let visual = |mesh: &str| format!(r#"<visual><geometry><mesh filename="{mesh}"/></geometry></visual>"#);
+    let fore = format!("{GOOD_FORE}{}<collision><origin xyz=\"0.1 0 0\"/><geometry><box size=\"0.2 0.03 0.03\"/></geometry></collision>", visual("package://arm_description/meshes/fore.stl"));
+    let text = arm(&fore, LIMITS, "").replace(r#"<link name="upper">"#, &format!(r#"<link name="upper">{}"#, visual("meshes/upper.dae")));
+    let path = dir.path().join("t.urdf");
+    std::fs::write(&path, &text).unwrap();
+    let model = armscope::model::load_urdf(&path).unwrap();
+    let frame = |name: &str| &model.frames[model.frame_index(name).unwrap()];
+    assert!(matches!(frame("fore").visuals[..], [armscope::model::Visual { geometry: Geometry::Box { size: [0.2, 0.03, 0.03] }, .. }]), "collision box");
+    // no collision shape: a box of the link's inertia (1 kg, 0.01 kg·m² about each axis: a cube of side √0.06)
+    let Geometry::Box { size } = frame("upper").visuals[0].geometry else { panic!("inertia box") };
+    assert!(size.iter().all(|s| (s - 0.06f64.sqrt()).abs() < 1e-9), "{size:?}");
+    for mesh in ["package://arm_description/meshes/fore.stl", "meshes/upper.dae"] {
+        assert!(model.notices.iter().any(|n| n.contains(mesh) && n.contains("not found")), "{mesh}: {:?}", model.notices);
+    }
+    // found through ROS_PACKAGE_PATH, as ROS finds it: a run in another process with that path set
+    let packages = tempfile::tempdir().unwrap();
+    let meshes = packages.path().join("arm_description/meshes");
+    std::fs::create_dir_all(&meshes).unwrap();
+    std::fs::copy(common::repo().join("assets/smallrobotarm/meshes/link2.stl"), meshes.join("fore.stl")).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_armscope"))
+        .args(["run", "--duration", "0.1", "--no-rrd", "--no-mcap", "--quiet", "--urdf", path.to_str().unwrap()])
+        .env("ROS_PACKAGE_PATH", packages.path())
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    assert!(!err.contains("fore.stl") && err.contains("upper.dae"), "fore.stl found, upper.dae still missing: {err}");
+}
+
+#[test]
+fn a_xacro_file_gets_one_line_saying_how_to_expand_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("arm.urdf.xacro");
+    std::fs::write(&path, r#"<robot xmlns:xacro="http://www.ros.org/wiki/xacro" name="x"><xacro:property name="l" value="1"/></robot>"#).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_armscope")).args(["run", "--urdf", path.to_str().unwrap()]).output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2));
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    assert!(err.contains("arm.urdf.xacro") && err.contains("xacro") && err.contains("expand"), "{err}");
+}
