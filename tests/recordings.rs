@@ -59,8 +59,10 @@ fn mcap_has_the_channels_schemas_and_per_step_messages_and_equals_the_trace() {
     let steps = run.trace.rows.len();
     assert_eq!(steps, 1501);
     let topics = mcap_messages(&run.mcap);
+    // the 3D poses at the display rate, 100 Hz: every 10th step and the last
+    let pose_steps = (steps - 1).div_ceil(10) + 1;
     let expect = [
-        ("/tf", "foxglove.FrameTransforms", "protobuf", Some(steps)),
+        ("/tf", "foxglove.FrameTransforms", "protobuf", Some(pose_steps)),
         ("/joint_states", "foxglove.JointStates", "protobuf", Some(steps)),
         ("/controller", "armscope.ControllerTelemetry", "protobuf", Some(steps)),
         // the pose at the display rate of the path, 50 Hz: every 20th step and the last
@@ -75,7 +77,8 @@ fn mcap_has_the_channels_schemas_and_per_step_messages_and_equals_the_trace() {
         let msgs = topics.get(topic).unwrap_or_else(|| panic!("no {topic}"));
         assert_eq!(msgs[0].1, schema, "{topic} schema");
         assert_eq!(msgs[0].2, encoding, "{topic} encoding");
-        // the per-step topics carry one message per step (/tf has the fixed joints once a second on top)
+        // the per-step topics carry one message per step (/tf per pose step, with the fixed joints
+        // once a second on top)
         if let Some(n) = count {
             let per_step = if topic == "/tf" { msgs.iter().filter(|m| FrameTransforms::decode(&m.3[..]).unwrap().transforms.len() == 6).count() } else { msgs.len() };
             assert_eq!(per_step, n, "{topic} messages");
@@ -134,7 +137,13 @@ fn mcap_has_the_channels_schemas_and_per_step_messages_and_equals_the_trace() {
     let fixed = FrameTransforms::decode(&topics["/tf"].iter().find(|m| FrameTransforms::decode(&m.3[..]).unwrap().transforms.len() != 6).unwrap().3[..]).unwrap();
     assert_eq!(fixed.transforms[0].parent_frame_id, "world");
     assert_eq!(fixed.transforms[0].child_frame_id, "base_link");
-    let last = topics["/tf"].iter().rev().find(|m| FrameTransforms::decode(&m.3[..]).unwrap().transforms.len() == 6).unwrap();
+    let moving: Vec<_> = topics["/tf"].iter().filter(|m| FrameTransforms::decode(&m.3[..]).unwrap().transforms.len() == 6).collect();
+    for m in &moving {
+        let k = ((m.0 - t0) / 1_000_000) as usize;
+        assert!(k % 10 == 0 || k == steps - 1, "/tf at step {k}");
+    }
+    let last = moving.last().unwrap();
+    assert_eq!(((last.0 - t0) / 1_000_000) as usize, steps - 1, "the last step's pose is there");
     let tf = FrameTransforms::decode(&last.3[..]).unwrap();
     let chain: Vec<(&str, &str)> = tf.transforms.iter().map(|t| (t.parent_frame_id.as_str(), t.child_frame_id.as_str())).collect();
     assert_eq!(chain, [("base_link", "carrier_link"), ("carrier_link", "upper_arm_link"), ("upper_arm_link", "forearm_link"), ("forearm_link", "wrist1_link"), ("wrist1_link", "wrist2_link"), ("wrist2_link", "tool_link")]);
@@ -199,7 +208,7 @@ fn rrd_holds_every_joint_series_with_one_row_per_step_equal_to_the_trace() {
 }
 
 #[test]
-fn rrd_poses_every_moving_link_at_every_step_as_the_simulated_arm() {
+fn rrd_poses_every_moving_link_at_the_display_rate_as_the_simulated_arm() {
     use armscope::dynamics::{body_poses, frame_pose_in};
     let run = record(&["--duration", "0.4", "--no-mcap"]);
     let rrd = Rrd::open(&run.rrd);
@@ -215,14 +224,18 @@ fn rrd_poses_every_moving_link_at_every_step_as_the_simulated_arm() {
             (rrd.component(&entity, "Transform3D:translation"), rrd.component(&entity, "Transform3D:quaternion"))
         })
         .collect();
-    for k in 0..run.trace.rows.len() {
+    // every 10th step (100 Hz) and the last
+    let steps = run.trace.rows.len();
+    let pose_steps: Vec<usize> = (0..steps).filter(|&k| k % 10 == 0 || k == steps - 1).collect();
+    for (i, &k) in pose_steps.iter().enumerate() {
         body_poses(&model, &q.iter().map(|c| c[k]).collect::<Vec<_>>(), &mut poses);
         for (&f, (translations, rotations)) in moving.iter().zip(&rows) {
             let want = frame_pose_in(&model, &poses, f);
             let name = &model.frames[f].name;
-            assert_eq!((translations.len(), rotations.len()), (run.trace.rows.len(), run.trace.rows.len()), "{name}: one pose per step");
+            assert_eq!((translations.len(), rotations.len()), (pose_steps.len(), pose_steps.len()), "{name}: one pose per display step");
+            assert!((translations[i].0 - run.trace.rows[k][0]).abs() < 1e-9, "{name}: pose {i} at step {k}");
             // stored as float32: 1e-6 is a few float32 ulps at these sizes (< 1 m, unit quaternions)
-            let (t, r) = (&translations[k].1, &rotations[k].1);
+            let (t, r) = (&translations[i].1, &rotations[i].1);
             for a in 0..3 {
                 assert!((t[a] - want.translation[a]).abs() < 1e-6, "{name} translation {a} at step {k}: {} vs {}", t[a], want.translation[a]);
             }

@@ -232,7 +232,8 @@ pub struct McapRecorder {
     scene: SceneUpdate,
     model: Option<std::sync::Arc<Model>>,
     steps_per_path_point: usize,
-    steps_per_pose: usize,
+    steps_per_tool_pose: usize,
+    steps_per_tf: usize,
     tool_path: ToolPath,
     last_scene_second: i64,
 }
@@ -320,7 +321,8 @@ impl McapRecorder {
             scene: SceneUpdate::default(),
             model: None,
             steps_per_path_point: 20,
-            steps_per_pose: 20,
+            steps_per_tool_pose: 20,
+            steps_per_tf: 10,
             tool_path: ToolPath::default(),
             last_scene_second: -1,
         }
@@ -536,7 +538,8 @@ impl Recorder for McapRecorder {
         self.out = Some(out);
         let steps_per = |period: f64| ((period / e.config.dt).round() as usize).max(1);
         self.steps_per_path_point = steps_per(0.05);
-        self.steps_per_pose = steps_per(0.02);
+        self.steps_per_tool_pose = steps_per(0.02);
+        self.steps_per_tf = super::steps_per_pose(e.config.dt);
 
         // transforms: every link from its parent link; "world" → root when the root is not "world"
         let pairs = model.frames.iter().enumerate().filter(|(_, f)| f.parent_frame.is_some() || f.name != "world");
@@ -610,8 +613,11 @@ impl Recorder for McapRecorder {
         let stamp = self.stamp(s.t);
         let ts = Some(self.timestamp(s.t));
         let model = self.model.as_ref().expect("started");
-        for (m, tf) in self.tf_msg.transforms.iter_mut().zip(&self.joint_tfs) {
-            set_transform(m, &tf.pose(&model.joints[tf.joint], s.q[tf.joint]), ts);
+        let pose_step = s.k.is_multiple_of(self.steps_per_tf) || s.is_final;
+        if pose_step {
+            for (m, tf) in self.tf_msg.transforms.iter_mut().zip(&self.joint_tfs) {
+                set_transform(m, &tf.pose(&model.joints[tf.joint], s.q[tf.joint]), ts);
+            }
         }
         self.joints_msg.timestamp = ts;
         for (j, state) in self.joints_msg.joints.iter_mut().enumerate() {
@@ -635,11 +641,14 @@ impl Recorder for McapRecorder {
         let path = &self.path;
         let fail = |e: String| Error::output(path, e);
         let (out, ch) = (self.out.as_mut().expect("started"), self.channels.as_mut().expect("started"));
-        out.log(&mut ch.tf, &self.tf_msg, stamp).map_err(fail)?;
+        // the 3D poses at the display rate (every step's joint positions are in /joint_states)
+        if pose_step {
+            out.log(&mut ch.tf, &self.tf_msg, stamp).map_err(fail)?;
+        }
         out.log(&mut ch.joint_states, &self.joints_msg, stamp).map_err(fail)?;
         out.log(&mut ch.controller, &self.telemetry, stamp).map_err(fail)?;
         // the tool pose at a display rate, 50 Hz (every step's tool position is in /controller)
-        if s.k.is_multiple_of(self.steps_per_pose) || s.is_final {
+        if s.k.is_multiple_of(self.steps_per_tool_pose) || s.is_final {
             let tool = frame_pose_in(model, s.body_pose, model.tool_frame);
             out.log(&mut ch.tool_pose, &PoseInFrame { timestamp: ts, frame_id: "world".into(), pose: Some(fox_pose(&tool)) }, stamp).map_err(fail)?;
         }

@@ -50,6 +50,17 @@ pub trait Recorder {
     fn finish(&mut self, run: &RunInfo, summary: &Summary) -> Result<(), Error>;
 }
 
+/// The rate of the arm's 3D poses in the recordings (link transforms in the `.rrd`, `/tf` in the
+/// `.mcap`): a display rate, 100 Hz, while the plots keep every control step. At every step the
+/// poses were a fifth of both files (per simulated second: `.rrd` 1.46 → 1.13 MB, `.mcap` 0.57 →
+/// 0.44 MB) for motion no screen shows: 100 Hz is still more than one pose per displayed frame.
+pub const POSE_RATE_HZ: f64 = 100.0;
+
+/// Control steps between two recorded poses (1 when the control rate is below the pose rate).
+pub fn steps_per_pose(dt: f64) -> usize {
+    ((1.0 / POSE_RATE_HZ) / dt).round().max(1.0) as usize
+}
+
 /// Whether t_k = k·dt is the first sample at or after a multiple of `period`.
 pub fn is_on_period(k: usize, dt: f64, period: f64) -> bool {
     if k == 0 {

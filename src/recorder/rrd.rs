@@ -72,12 +72,12 @@ impl JointColumns {
     }
 }
 
-/// A link frame that moves: its entity and per-step world poses.
+/// A link frame that moves: its entity and its world poses at the display rate.
 struct MovingLink {
     frame: usize,
     entity: String,
     translations: Vec<[f32; 3]>,
-    /// [x, y, z, w] per step.
+    /// [x, y, z, w] per pose.
     rotations: Vec<[f32; 4]>,
 }
 
@@ -95,6 +95,9 @@ pub struct RerunRecorder {
     tool: Vec<f64>,
     tool_error: Vec<f64>,
     links: Vec<MovingLink>,
+    /// When the links' poses were taken (every `steps_per_pose` steps and the last).
+    pose_times: Vec<f64>,
+    steps_per_pose: usize,
     trail: VecDeque<[f32; 3]>,
     /// The trail as it was at each of its updates in this block (sent with the block).
     trail_times: Vec<f64>,
@@ -111,6 +114,8 @@ pub struct RerunRecorder {
 /// Steps per block in a file-only recording: ~4 s of simulation per chunk (fewer, larger chunks
 /// cost less to encode; Rerun's store keeps chunks of up to 4096 rows).
 const FILE_BLOCK_STEPS: usize = 4096;
+/// Chunks waiting for the encoder at most, bytes (a block of chunks is ~5 MB).
+const BYTES_IN_FLIGHT: u64 = 4 << 20;
 /// A live viewer gets a block at least this often.
 const LIVE_FLUSH: Duration = Duration::from_millis(40);
 const TRAIL_SECONDS: f64 = 2.0;
@@ -130,6 +135,8 @@ impl RerunRecorder {
             tool: Vec::new(),
             tool_error: Vec::new(),
             links: Vec::new(),
+            pose_times: Vec::new(),
+            steps_per_pose: 10,
             trail: VecDeque::new(),
             trail_times: Vec::new(),
             trail_strips: Vec::new(),
@@ -196,6 +203,9 @@ impl RerunRecorder {
         }
         rerun::RecordingStreamBuilder::new("armscope")
             .recording_name(self.options.name.clone())
+            // the encoder is slower than the blocks arrive: what waits for it is bounded by this
+            // (Rerun's default, 100 MiB, made a 10-minute run's memory 4× the 30 s run's)
+            .batcher_config(rerun::log::ChunkBatcherConfig { max_bytes_in_flight: BYTES_IN_FLIGHT, ..rerun::log::ChunkBatcherConfig::DEFAULT })
             .set_sinks(sinks)
             .map_err(|e| self.err(e))
     }
@@ -293,7 +303,9 @@ impl RerunRecorder {
         Ok(())
     }
 
-    fn flush_block(&mut self) -> Result<(), Error> {
+    /// Sends the block's series; the poses too when they fill a chunk of their own, when a live
+    /// viewer waits for them, or at the end (`all`).
+    fn flush_block(&mut self, all: bool) -> Result<(), Error> {
         let Some(rec) = self.rec.clone() else { return Ok(()) };
         if self.times.is_empty() {
             return Ok(());
@@ -327,12 +339,16 @@ impl RerunRecorder {
             let strips = rerun::LineStrips3D::update_fields().with_strips(self.trail_strips.iter().cloned()).columns_of_unit_batches().map_err(|x| self.err(x))?;
             send("world/tool/trail", times, strips.collect())?;
         }
-        for link in &self.links {
-            let poses = vec![
-                float32_column::<rerun::components::Translation3D>(link.translations.as_flattened(), rerun::Transform3D::descriptor_translation()),
-                float32_column::<rerun::components::RotationQuat>(link.rotations.as_flattened(), rerun::Transform3D::descriptor_quaternion()),
-            ];
-            send(link.entity.as_str(), time.clone(), poses)?;
+        let send_poses = !self.pose_times.is_empty() && (all || self.live || self.pose_times.len() >= FILE_BLOCK_STEPS);
+        if send_poses {
+            let pose_time = TimeColumn::new_duration_secs(TIMELINE, self.pose_times.iter().copied());
+            for link in &self.links {
+                let poses = vec![
+                    float32_column::<rerun::components::Translation3D>(link.translations.as_flattened(), rerun::Transform3D::descriptor_translation()),
+                    float32_column::<rerun::components::RotationQuat>(link.rotations.as_flattened(), rerun::Transform3D::descriptor_quaternion()),
+                ];
+                send(link.entity.as_str(), pose_time.clone(), poses)?;
+            }
         }
         self.times.clear();
         for j in &mut self.joints {
@@ -342,9 +358,12 @@ impl RerunRecorder {
         self.tool_error.clear();
         self.trail_times.clear();
         self.trail_strips.clear();
-        for link in &mut self.links {
-            link.translations.clear();
-            link.rotations.clear();
+        if send_poses {
+            self.pose_times.clear();
+            for link in &mut self.links {
+                link.translations.clear();
+                link.rotations.clear();
+            }
         }
         if self.live {
             let _ = rec.flush_async();
@@ -545,6 +564,7 @@ impl Recorder for RerunRecorder {
             .collect();
         self.model = Some(e.model.clone());
         self.steps_per_trail_point = ((1.0 / TRAIL_RATE_HZ) / e.config.dt).round().max(1.0) as usize;
+        self.steps_per_pose = super::steps_per_pose(e.config.dt);
 
         blueprint(&self.joint_names, "").send(&rec, BlueprintActivation { make_active: true, make_default: true }).map_err(|x| self.err(x))?;
         self.log_static_scene(&rec, model)?;
@@ -589,12 +609,15 @@ impl Recorder for RerunRecorder {
         self.tool.extend_from_slice(&[p.x, p.y, p.z]);
         self.tool_error.push(s.tool_error());
         let tip = [p.x as f32, p.y as f32, p.z as f32];
-        let model = self.model.as_deref().expect("started");
-        for link in &mut self.links {
-            let pose = frame_pose_in(model, s.body_pose, link.frame);
-            let t = pose.translation;
-            link.translations.push([t.x as f32, t.y as f32, t.z as f32]);
-            link.rotations.push(quaternion_xyzw(&pose));
+        if s.k.is_multiple_of(self.steps_per_pose) || s.is_final {
+            let model = self.model.as_deref().expect("started");
+            self.pose_times.push(s.t);
+            for link in &mut self.links {
+                let pose = frame_pose_in(model, s.body_pose, link.frame);
+                let t = pose.translation;
+                link.translations.push([t.x as f32, t.y as f32, t.z as f32]);
+                link.rotations.push(quaternion_xyzw(&pose));
+            }
         }
         if s.k.is_multiple_of(self.steps_per_trail_point) {
             self.trail.push_back(tip);
@@ -608,13 +631,13 @@ impl Recorder for RerunRecorder {
         }
         let due = self.times.len() >= FILE_BLOCK_STEPS || (self.live && self.last_flush.elapsed() >= LIVE_FLUSH) || s.is_final;
         if due {
-            self.flush_block()?;
+            self.flush_block(s.is_final)?;
         }
         Ok(())
     }
 
     fn finish(&mut self, _run: &RunInfo, summary: &Summary) -> Result<(), Error> {
-        self.flush_block()?;
+        self.flush_block(true)?;
         let Some(rec) = self.rec.take() else { return Ok(()) };
         if self.path.len() > 1 {
             rec.log_static("world/tool/path", &rerun::LineStrips3D::new([self.path.clone()]).with_colors([rerun::Color::from_rgb(230, 60, 60)]).with_radii([0.001]))
