@@ -247,6 +247,10 @@ pub struct RunArgs {
     /// Refuse physically inconsistent link inertias (as Drake does) instead of a notice.
     #[arg(long)]
     pub strict_inertia: bool,
+    /// Initial joint positions (rad or m): a comma list in joint order, or NAME=VALUE pairs
+    /// (default: each joint's 0 clamped into its range). The default wave swings around them.
+    #[arg(long, value_name = "LIST", allow_hyphen_values = true)]
+    pub q0: Option<String>,
 
     /// Write the tutorial's CSV (t, q, tool xyz every --print-every).
     #[arg(long, value_name = "PATH")]
@@ -363,6 +367,7 @@ impl RunArgs {
             settle_time: self.settle_time,
             divergence_speed: self.divergence_speed,
             strict_inertia: self.strict_inertia,
+            q0: self.q0.clone(),
         }
     }
 }

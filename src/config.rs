@@ -53,6 +53,9 @@ pub struct RunConfig {
     pub divergence_speed: f64,
     /// Refuse physically inconsistent link inertias instead of a notice.
     pub strict_inertia: bool,
+    /// Initial joint positions: a comma list in joint order, or NAME=VALUE pairs (others: 0
+    /// clamped into the joint's range).
+    pub q0: Option<String>,
 }
 
 pub use crate::builtin::DEFAULT_URDF;
@@ -84,6 +87,7 @@ impl Default for RunConfig {
             settle_time: 2.0,
             divergence_speed: 1e4,
             strict_inertia: false,
+            q0: None,
         }
     }
 }

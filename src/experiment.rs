@@ -6,7 +6,8 @@ use crate::error::Error;
 use crate::gains::{Gains, TUTORIAL_KD, TUTORIAL_KP, auto_tune, is_tutorial_model};
 use crate::integrator::{ContinuousPlant, DiscretePlant, Plant, Tolerances};
 use crate::model::{LoadOptions, Model, load_urdf_with};
-use crate::trajectory::{Hold, JointSchedule, JointStep, Trajectory, Wave};
+use crate::analysis::LoopPlant;
+use crate::trajectory::{Hold, JointSchedule, JointStep, JointWave, Trajectory, Wave};
 use nalgebra::Vector3;
 use std::sync::Arc;
 
@@ -26,6 +27,8 @@ pub struct Experiment {
     pub trajectory: Box<dyn Trajectory>,
     /// Number of control steps: the run records states k = 0..=steps.
     pub steps: usize,
+    /// The start pose (`--q0`, or 0 clamped into each joint's range).
+    pub start: Vec<f64>,
 }
 
 impl Experiment {
@@ -57,10 +60,11 @@ impl Experiment {
             model.set_tool_frame(tool).map_err(|m| Error::flag("--tool", m))?;
         }
         let plant = plant_spec(&config)?;
-        let trajectory = trajectory(&config, &model)?;
-        let gains = gains(&config, &model)?;
+        let start = start_pose(&config, &model)?;
+        let trajectory = trajectory(&config, &model, &start)?;
+        let gains = gains(&config, &model, &start, trajectory.as_ref(), &plant)?;
         let steps = (config.duration / config.dt - 1e-9).ceil() as usize;
-        Ok(Self { config, model: Arc::new(model), gains, plant, trajectory, steps })
+        Ok(Self { config, model: Arc::new(model), gains, plant, trajectory, steps, start })
     }
 
     pub fn controller(&self) -> PdGravityController {
@@ -83,9 +87,9 @@ impl Experiment {
         }
     }
 
-    /// The start state: every joint at 0, at rest.
+    /// The start state: the start pose (`--q0`, or every joint at 0 clamped into its range), at rest.
     pub fn initial_state(&self) -> (Vec<f64>, Vec<f64>) {
-        (vec![0.0; self.model.dof()], vec![0.0; self.model.dof()])
+        (self.start.clone(), vec![0.0; self.model.dof()])
     }
 
     pub fn dt(&self) -> f64 {
@@ -144,7 +148,37 @@ fn plant_spec(config: &RunConfig) -> Result<PlantSpec, Error> {
     }
 }
 
-fn trajectory(config: &RunConfig, model: &Model) -> Result<Box<dyn Trajectory>, Error> {
+/// The start pose: `--q0` (a list in joint order, or NAME=VALUE pairs), the other joints at 0
+/// clamped into their ranges.
+fn start_pose(config: &RunConfig, model: &Model) -> Result<Vec<f64>, Error> {
+    let mut q: Vec<f64> = model.joints.iter().map(|j| 0f64.clamp(j.lower, j.upper)).collect();
+    let Some(spec) = &config.q0 else { return Ok(q) };
+    let fail = |m: String| Error::flag("--q0", m);
+    let items: Vec<&str> = spec.split(',').map(str::trim).filter(|s| !s.is_empty()).collect();
+    let number = |text: &str| text.parse::<f64>().ok().filter(|v| v.is_finite()).ok_or_else(|| fail(format!("'{text}' is not a finite number")));
+    if items.iter().any(|i| i.contains('=')) {
+        for item in items {
+            let (name, value) = item.split_once('=').ok_or_else(|| fail(format!("'{item}' is not NAME=VALUE (give all as pairs or none)")))?;
+            let j = model.joint_index(name.trim()).ok_or_else(|| fail(format!("no moving joint '{}' (joints: {})", name.trim(), model.joints.iter().map(|j| j.name.as_str()).collect::<Vec<_>>().join(", "))))?;
+            q[j] = number(value.trim())?;
+        }
+    } else {
+        if items.len() != model.dof() {
+            return Err(fail(format!("expected {} values (one per joint, or NAME=VALUE pairs), got {}", model.dof(), items.len())));
+        }
+        for (qi, item) in q.iter_mut().zip(items) {
+            *qi = number(item)?;
+        }
+    }
+    for (j, &v) in model.joints.iter().zip(&q) {
+        if v < j.lower || v > j.upper {
+            return Err(fail(format!("joint '{}' at {v} is outside its range [{}, {}]", j.name, j.lower, j.upper)));
+        }
+    }
+    Ok(q)
+}
+
+fn trajectory(config: &RunConfig, model: &Model, start: &[f64]) -> Result<Box<dyn Trajectory>, Error> {
     if let Some(path) = &config.trajectory {
         if config.hold || config.test_joint.is_some() {
             return Err(Error::flag("--trajectory", "cannot be combined with --static or --test-joint"));
@@ -161,7 +195,12 @@ fn trajectory(config: &RunConfig, model: &Model) -> Result<Box<dyn Trajectory>, 
     if config.hold {
         return Ok(Box::new(Hold));
     }
-    Ok(Box::new(Wave { amplitude_rad: config.amp_deg.to_radians(), omega: config.freq }))
+    let fitted = JointWave::fitted(model, start, config.amp_deg, config.freq);
+    if fitted.is_uniform_about_zero(config.amp_deg.to_radians()) {
+        // the tutorial's wave exactly (the box model)
+        return Ok(Box::new(Wave { amplitude_rad: config.amp_deg.to_radians(), omega: config.freq }));
+    }
+    Ok(Box::new(fitted))
 }
 
 /// A joint given by number (1-based, as J1..J6) or by name.
@@ -178,12 +217,25 @@ pub fn resolve_joint(spec: &str, model: &Model) -> Result<usize, Error> {
     })
 }
 
-fn gains(config: &RunConfig, model: &Model) -> Result<Gains, Error> {
+fn gains(config: &RunConfig, model: &Model, start: &[f64], trajectory: &dyn Trajectory, plant: &PlantSpec) -> Result<Gains, Error> {
     let n = model.dof();
     let base = if is_tutorial_model(model) && !config.auto_tune {
-        Gains { kp: TUTORIAL_KP.to_vec(), kd: TUTORIAL_KD.to_vec(), source: "tutorial".into(), effective_inertia: None }
+        Gains { kp: TUTORIAL_KP.to_vec(), kd: TUTORIAL_KD.to_vec(), source: "tutorial".into(), effective_inertia: None, spectral_radius: None }
     } else {
-        auto_tune(model, &vec![0.0; n], config.dt)
+        // the poses the command goes through: the start and 24 along its first period (or the run)
+        let period = if config.freq > 0.0 { std::f64::consts::TAU / config.freq } else { config.duration };
+        let span = period.min(config.duration);
+        let (mut cmd, mut cmd_dot) = (vec![0.0; n], vec![0.0; n]);
+        let mut poses = vec![start.to_vec()];
+        for i in 0..24 {
+            trajectory.sample(span * i as f64 / 24.0, &mut cmd, &mut cmd_dot);
+            poses.push(cmd.iter().zip(&model.joints).map(|(&c, j)| c.clamp(j.lower, j.upper)).collect());
+        }
+        let loop_plant = match plant {
+            PlantSpec::Discrete { .. } => LoopPlant::Discrete,
+            PlantSpec::Continuous { .. } => LoopPlant::Continuous,
+        };
+        auto_tune(model, &poses, config.dt, !config.no_ff, loop_plant)
     };
     let expand = |flag: &str, values: &Option<Vec<f64>>, default: Vec<f64>| -> Result<(Vec<f64>, bool), Error> {
         match values {
@@ -208,5 +260,5 @@ fn gains(config: &RunConfig, model: &Model) -> Result<Gains, Error> {
         (true, false) => format!("kp from flags, kd {}", base.source),
         (false, true) => format!("kp {}, kd from flags", base.source),
     };
-    Ok(Gains { kp, kd, source, effective_inertia: base.effective_inertia })
+    Ok(Gains { kp, kd, source, effective_inertia: base.effective_inertia, spectral_radius: base.spectral_radius })
 }

@@ -168,3 +168,92 @@ fn a_xacro_file_gets_one_line_saying_how_to_expand_it() {
     assert_eq!(err.trim().lines().count(), 1, "{err}");
     assert!(err.contains("arm.urdf.xacro") && err.contains("xacro") && err.contains("expand"), "{err}");
 }
+
+/// A small hobby arm as exporters write it: a heavy shoulder, a wrist of a few grams with joint
+/// damping, and a prismatic finger with a 4 cm range; limits 0..0 on the wrist roll.
+fn hobby_arm() -> String {
+    format!(
+        r#"<robot name="hobby"><link name="world"/><link name="base">{base}</link><link name="shoulder">{shoulder}</link><link name="upper">{upper}</link>
+<link name="wrist">{wrist}</link><link name="finger">{finger}</link>
+<joint name="fix" type="fixed"><parent link="world"/><child link="base"/></joint>
+<joint name="pan" type="revolute"><parent link="base"/><child link="shoulder"/><axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="3" velocity="5"/></joint>
+<joint name="lift" type="revolute"><origin xyz="0 0 0.05"/><parent link="shoulder"/><child link="upper"/><axis xyz="0 1 0"/><limit lower="-2" upper="2" effort="4" velocity="5"/></joint>
+<joint name="roll" type="revolute"><origin xyz="0.15 0 0"/><parent link="upper"/><child link="wrist"/><axis xyz="1 0 0"/><limit lower="0" upper="0" effort="0.5" velocity="5"/><dynamics damping="0.05"/></joint>
+<joint name="grip" type="prismatic"><origin xyz="0.03 0 0"/><parent link="wrist"/><child link="finger"/><axis xyz="0 1 0"/><limit lower="0" upper="0.04" effort="5" velocity="0.1"/></joint>
+</robot>"#,
+        base = inertial(1.0, 1e-3, 1e-3, 1e-3),
+        shoulder = inertial(0.2, 1e-4, 1e-4, 1e-4),
+        upper = r#"<inertial><origin xyz="0.07 0 0"/><mass value="0.15"/><inertia ixx="2e-5" ixy="0" ixz="0" iyy="3e-4" iyz="0" izz="3e-4"/></inertial>"#,
+        wrist = inertial(0.01, 1e-6, 1e-6, 1e-6),
+        finger = inertial(0.005, 1e-7, 1e-7, 1e-7),
+    )
+}
+
+fn run_summary(urdf: &str, extra: &[&str]) -> (i32, serde_json::Value, String) {
+    let dir = tempfile::tempdir().unwrap();
+    let (path, json) = (dir.path().join("arm.urdf"), dir.path().join("s.json"));
+    std::fs::write(&path, urdf).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_armscope"))
+        .args(["run", "--quiet", "--no-rrd", "--no-mcap", "--urdf", path.to_str().unwrap(), "--summary-json", json.to_str().unwrap()])
+        .args(extra)
+        .output()
+        .unwrap();
+    let doc = std::fs::read_to_string(&json).ok().and_then(|t| serde_json::from_str(&t).ok()).unwrap_or(serde_json::Value::Null);
+    (out.status.code().unwrap_or(-1), doc, String::from_utf8_lossy(&out.stderr).into())
+}
+
+#[test]
+fn the_default_experiment_on_any_arm_is_stable_tracks_and_fits_the_joint_ranges() {
+    // auto-tuned gains, stable along the command with a gain margin of 2
+    let (code, doc, err) = run_summary(&hobby_arm(), &["--duration", "10"]);
+    assert_eq!(code, 0, "{err}");
+    let s = &doc["summary"];
+    for j in 0..4 {
+        let chatter = s["chatter_percent"][j].as_f64().unwrap();
+        let error = s["max_abs_error"][j].as_f64().unwrap();
+        assert!(chatter < 5.0, "joint {j}: chatter {chatter} %");
+        // a 30° (5 cm) wave after 2 s of settling: within 1 % of the amplitude
+        assert!(error < 0.005, "joint {j}: max error {error}");
+    }
+    assert!(doc["gains"]["spectral_radius"].as_f64().unwrap() < 1.0, "{}", doc["gains"]);
+    // the prismatic finger's 4 cm range: a swing of a quarter of it (1 cm), inside the range
+    let dir = tempfile::tempdir().unwrap();
+    let trace = dir.path().join("t.csv");
+    let (code, _, err) = run_summary(&hobby_arm(), &["--duration", "13", "--trace", trace.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    let t = common::read_csv(&trace);
+    let grip: Vec<f64> = t.column("cmd4").into_iter().filter(|v| v.is_finite()).collect();
+    let (lo, hi) = grip.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
+    assert!((hi - lo - 0.02).abs() < 1e-3 && lo >= 0.0 && hi <= 0.04, "finger command [{lo}, {hi}]");
+    let q: Vec<f64> = t.column("q4");
+    assert!(q.iter().all(|&v| (-1e-9..=0.04 + 1e-9).contains(&v)), "the finger stays in its range");
+}
+
+#[test]
+fn q0_sets_the_start_pose_by_list_or_by_name_and_bad_values_are_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let trace = dir.path().join("t.csv");
+    let (code, _, err) = run_summary(&hobby_arm(), &["--duration", "0.01", "--static", "--q0", "lift=0.5,grip=0.02", "--trace", trace.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    let t = common::read_csv(&trace);
+    assert_eq!([t.rows[0][t.col("q1")], t.rows[0][t.col("q2")], t.rows[0][t.col("q4")]], [0.0, 0.5, 0.02]);
+    let (code, _, err) = run_summary(&hobby_arm(), &["--duration", "0.01", "--q0", "0.1,-0.2,0,0.01", "--trace", trace.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(common::read_csv(&trace).rows[0][1..5], [0.1, -0.2, 0.0, 0.01]);
+    for (q0, needle) in [("lift=3", "outside its range"), ("elbow=1", "no moving joint 'elbow'"), ("1,2", "expected 4 values"), ("lift=x", "'x' is not a finite number")] {
+        let (code, _, err) = run_summary(&hobby_arm(), &["--duration", "0.01", "--q0", q0]);
+        assert_eq!(code, 2, "{q0}: {err}");
+        assert!(err.contains("--q0") && err.contains(needle), "{q0}: {err}");
+    }
+}
+
+#[test]
+fn a_differential_transmission_is_a_notice_and_its_joints_are_driven_directly() {
+    let extra = r#"<transmission name="wrist_trans"><joint name="J1"/><joint name="J2"/><actuator name="a"/><actuator name="b"/></transmission>"#;
+    let model = load(&arm(GOOD_FORE, LIMITS, extra));
+    assert!(model.notices.iter().any(|n| n.contains("wrist_trans") && n.contains("2 joints")), "{:?}", model.notices);
+    let mut driven: Vec<usize> = model.actuators.iter().map(|a| a.joint).collect();
+    driven.sort();
+    assert_eq!(driven, [0, 1]);
+    assert_eq!(model.effort_limits(), [5.0, 5.0]);
+}

@@ -34,7 +34,7 @@ fn mesh_model_has_transmissions_meshes_and_the_tutorials_proportions() {
     let total: f64 = model.joints.iter().map(|j| j.inertia.mass).sum::<f64>() + 0.782;
     assert!((total - 2.27).abs() < 0.01, "total mass {total}");
     // effective inertias of the distal joints are of the tutorial's order (3e-5 and 6e-6)
-    let gains = armscope::gains::auto_tune(&model, &[0.0; 6], 0.001);
+    let gains = armscope::gains::auto_tune(&model, &[vec![0.0; 6]], 0.001, true, armscope::analysis::LoopPlant::Discrete);
     let inertia = gains.effective_inertia.unwrap();
     assert!(inertia[3] > 1e-5 && inertia[3] < 6e-5, "J4 {}", inertia[3]);
     assert!(inertia[4] > 2e-6 && inertia[4] < 1.2e-5, "J5 {}", inertia[4]);
@@ -120,6 +120,20 @@ fn mesh_model_runs_on_the_continuous_plant_with_auto_tuned_gains() {
     assert_eq!(doc["gains"]["effective_inertia"].as_array().unwrap().len(), 6);
 }
 
+/// The gains of the tutorial's rule, which earlier versions auto-tuned with and which the discrete
+/// plant cannot hold for this model's light wrist: kp = min(effort/0.05, 0.5·(1.5/dt)²·I),
+/// kd = 1.6·√(kp·I), I = M_ii at q = 0 (dt = 1 ms). As `--kp`, `--kd` lists.
+fn tutorial_rule_gains(urdf: &std::path::Path) -> (String, String) {
+    let model = load_urdf(urdf).unwrap();
+    let mut data = armscope::dynamics::Data::new(&model);
+    let m = armscope::dynamics::crba(&model, &mut data, &vec![0.0; model.dof()]).clone();
+    let effort = model.effort_limits();
+    let kp: Vec<f64> = (0..model.dof()).map(|i| (effort[i] / 0.05).min(0.5 * 1500.0f64.powi(2) * m[(i, i)])).collect();
+    let kd: Vec<f64> = kp.iter().enumerate().map(|(i, kp)| 1.6 * (kp * m[(i, i)]).sqrt()).collect();
+    let list = |v: &[f64]| v.iter().map(|x| x.to_string()).collect::<Vec<_>>().join(",");
+    (list(&kp), list(&kd))
+}
+
 /// The mesh model with motors that are not clipped (no transmissions, `effort="0"`): the
 /// tutorial's gain rule puts the semi-implicit discrete loop of the light wrist joints past
 /// stability (|z| ≈ 1.35 per step for one joint alone); within a few steps the joints bang from
@@ -146,8 +160,9 @@ fn discrete_plant_divergence_is_caught_named_and_the_files_are_finished() {
     let path = pkg.join("unclipped.urdf");
     std::fs::write(&path, unclipped).unwrap();
     let (rrd, mcap) = (dir.path().join("d.rrd"), dir.path().join("d.mcap"));
+    let (kp, kd) = tutorial_rule_gains(&path);
     let out = Command::new(env!("CARGO_BIN_EXE_armscope"))
-        .args(["run", "--quiet", "--urdf", path.to_str().unwrap(), "--duration", "5", "--rrd", rrd.to_str().unwrap(), "--mcap", mcap.to_str().unwrap()])
+        .args(["run", "--quiet", "--urdf", path.to_str().unwrap(), "--duration", "5", "--rrd", rrd.to_str().unwrap(), "--mcap", mcap.to_str().unwrap(), "--kp", &kp, "--kd", &kd])
         .output()
         .unwrap();
     let stderr = String::from_utf8_lossy(&out.stderr);
@@ -162,14 +177,16 @@ fn discrete_plant_divergence_is_caught_named_and_the_files_are_finished() {
     assert!(rrd.metadata().unwrap().len() > 0);
 }
 
-/// The mesh model as specified (clipped motors) on the discrete plant: the energy audit catches the
-/// numerically unstable plant within milliseconds; the same model on the continuous plant runs on.
+/// The mesh model as specified (clipped motors) on the discrete plant with the tutorial rule's gains:
+/// the energy audit catches the numerically unstable plant within milliseconds; the same model on
+/// the continuous plant runs on.
 #[test]
 fn mesh_model_on_the_discrete_plant_is_caught_as_divergent() {
     let dir = tempfile::tempdir().unwrap();
     let (rrd, mcap) = (dir.path().join("m.rrd"), dir.path().join("m.mcap"));
+    let (kp, kd) = tutorial_rule_gains(&mesh_urdf());
     let out = Command::new(env!("CARGO_BIN_EXE_armscope"))
-        .args(["run", "--quiet", "--urdf", mesh_urdf().to_str().unwrap(), "--duration", "10", "--rrd", rrd.to_str().unwrap(), "--mcap", mcap.to_str().unwrap()])
+        .args(["run", "--quiet", "--urdf", mesh_urdf().to_str().unwrap(), "--duration", "10", "--rrd", rrd.to_str().unwrap(), "--mcap", mcap.to_str().unwrap(), "--kp", &kp, "--kd", &kd])
         .output()
         .unwrap();
     let stderr = String::from_utf8_lossy(&out.stderr);

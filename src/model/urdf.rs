@@ -196,7 +196,7 @@ fn build(text: &str, source: &Path, options: LoadOptions) -> Result<Model, K> {
     let is_leaf = |f: usize| !frames.iter().any(|g| g.parent_frame == Some(f));
     let tool_frame = (0..frames.len()).filter(|&f| is_leaf(f)).fold(0, |best, f| if depth[f] > depth[best] { f } else { best });
 
-    Ok(Model {
+    let model = Model {
         name: robot.name.clone(),
         source: source.to_path_buf(),
         urdf_text: text.to_string(),
@@ -206,7 +206,15 @@ fn build(text: &str, source: &Path, options: LoadOptions) -> Result<Model, K> {
         actuators,
         tool_frame,
         notices,
-    })
+    };
+    // finite numbers whose products overflow (a massless link 1e308 m away): the mass matrix the
+    // simulation will use, computed once here, must be finite
+    let mut data = crate::dynamics::Data::new(&model);
+    let m = crate::dynamics::crba(&model, &mut data, &vec![0.0; model.dof()]);
+    if let Some(j) = (0..model.dof()).find(|&j| m.row(j).iter().any(|x| !x.is_finite())) {
+        return Err(K::NonFinite { element: format!("link '{}'", model.joints[j].child_link), field: "mass matrix (numbers too large)", value: f64::INFINITY });
+    }
+    Ok(model)
 }
 
 fn pose(p: &urdf_rs::Pose) -> Pose {
@@ -497,17 +505,21 @@ fn resolve_mesh(filename: &str, base_dir: &Path) -> Result<PathBuf, String> {
 /// that does not move (fixed) or that the URDF does not have is a notice and is ignored.
 fn actuators_from_transmissions(doc: &roxmltree::Document, robot: &urdf_rs::Robot, joints: &[Joint], notices: &mut Vec<String>) -> Result<Vec<Actuator>, K> {
     let mut actuators: Vec<Actuator> = Vec::new();
+    let mut directly_driven: Vec<usize> = Vec::new();
     for t in doc.root_element().children().filter(|n| n.has_tag_name("transmission")) {
         let name = t.attribute("name").unwrap_or("(unnamed)").to_string();
         let fail = |what: String| K::Transmission { transmission: name.clone(), what };
         let joint_nodes: Vec<_> = t.children().filter(|n| n.has_tag_name("joint")).collect();
         let actuator_nodes: Vec<_> = t.children().filter(|n| n.has_tag_name("actuator")).collect();
         if joint_nodes.len() != 1 || actuator_nodes.len() > 1 {
-            return Err(fail(format!(
-                "has {} joints and {} actuators; only simple transmissions (one joint, one actuator) are supported",
+            // e.g. a differential wrist: its joints are driven directly, with their URDF effort limits
+            notices.push(format!(
+                "transmission '{name}' has {} joints and {} actuators; only simple transmissions (one joint, one actuator) are modelled: its joints get a motor each with their URDF effort",
                 joint_nodes.len(),
                 actuator_nodes.len()
-            )));
+            ));
+            directly_driven.extend(joint_nodes.iter().filter_map(|n| n.attribute("name")).filter_map(|n| joints.iter().position(|j| j.name == n)));
+            continue;
         }
         let joint_name = joint_nodes[0].attribute("name").ok_or_else(|| fail("<joint> has no name".into()))?;
         let Some(joint) = joints.iter().position(|j| j.name == joint_name) else {
@@ -531,6 +543,11 @@ fn actuators_from_transmissions(doc: &roxmltree::Document, robot: &urdf_rs::Robo
             },
         };
         actuators.push(Actuator { name: actuator_name, joint, effort: joints[joint].effort, gear_ratio });
+    }
+    for joint in directly_driven {
+        if !actuators.iter().any(|a| a.joint == joint) {
+            actuators.push(Actuator { name: joints[joint].name.clone(), joint, effort: joints[joint].effort, gear_ratio: 1.0 });
+        }
     }
     Ok(actuators)
 }

@@ -94,10 +94,12 @@ impl Console {
         )
         .map_err(io)?;
         if let Some(inertia) = &e.gains.effective_inertia {
-            writeln!(self.out, "  auto-tuned gains (kp = min(effort/0.05, 0.5·(1.5/dt)²·I), kd = 1.6·√(kp·I), I = M_ii at the start pose):").map_err(io)?;
-            writeln!(self.out, "    {:<8}{:>14}{:>12}{:>12}", "joint", "I (kg·m²)", "kp", "kd").map_err(io)?;
+            let radius = e.gains.spectral_radius.map_or(String::new(), |r| format!(", worst spectral radius of the sampled loop along the command {r:.3}"));
+            writeln!(self.out, "  auto-tuned gains (kp = min(effort/0.05, I·ω² + D·ω), kd = 2·√(kp·I), I = smallest M_ii along the command, ω lowered until the sampled loop is stable with twice the gains{radius}):").map_err(io)?;
+            let w = m.joints.iter().map(|j| j.name.chars().count() + 1).max().unwrap_or(0).max(8);
+            writeln!(self.out, "    {:<w$}{:>14}{:>12}{:>12}", "joint", "I (kg·m²)", "kp", "kd").map_err(io)?;
             for (j, joint) in m.joints.iter().enumerate() {
-                writeln!(self.out, "    {:<8}{:>14.4e}{:>12.4}{:>12.5}", joint.name, inertia[j], e.gains.kp[j], e.gains.kd[j]).map_err(io)?;
+                writeln!(self.out, "    {:<w$}{:>14.4e}{:>12.4}{:>12.5}", joint.name, inertia[j], e.gains.kp[j], e.gains.kd[j]).map_err(io)?;
             }
         }
         writeln!(self.out, "  duration {} s ({} steps)", e.config.duration, e.steps).map_err(io)?;
@@ -134,7 +136,8 @@ pub fn write_summary(out: &mut dyn Write, s: &Summary) -> std::io::Result<()> {
         "Summary: {:.3} s simulated in {} steps, {:.3} s wall time ({:.0}x real time)",
         s.simulated_time, s.steps, s.wall_time, speed
     )?;
-    let w = 9;
+    // columns as wide as the longest joint name (UR5's `shoulder_lift_joint`), at least 9
+    let w = s.joints.iter().map(|n| n.chars().count() + 1).max().unwrap_or(0).max(9);
     let row = |label: &str, cells: Vec<String>| format!("  {label:<22}{}", cells.iter().map(|c| format!("{c:>w$}")).collect::<String>());
     writeln!(out, "{}", row("joint", s.joints.clone()))?;
     let opt = |v: &Option<f64>| v.map_or("n/a".to_string(), |x| format!("{x:.4}"));

@@ -1,11 +1,13 @@
 //! Joint commands over time. A new kind of command is one new file implementing [`Trajectory`].
 
 mod hold;
+mod joint_wave;
 mod schedule;
 mod step;
 mod wave;
 
 pub use hold::Hold;
+pub use joint_wave::JointWave;
 pub use schedule::JointSchedule;
 pub use step::JointStep;
 pub use wave::Wave;
