@@ -32,6 +32,25 @@ pub enum Command {
     Analyze(AnalyzeArgs),
     /// How fast can the arm go: sweep wave frequency × amplitude, map where each motor runs out of torque.
     Envelope(EnvelopeArgs),
+    /// What armscope made of a URDF: joints, limits, motors, notices; with --states, the dynamics
+    /// (M, τ_g, C·v, q̈, link poses) at given states as JSON, to compare with other libraries.
+    Model(ModelArgs),
+}
+
+#[derive(Args, Debug)]
+pub struct ModelArgs {
+    #[arg(long, value_name = "PATH", default_value = crate::config::DEFAULT_URDF)]
+    pub urdf: PathBuf,
+    /// A JSON list of states by joint name, [{"q": {"J1": 0.1}, "v": {...}, "tau": {...}}, ...]:
+    /// print the dynamics at each as JSON.
+    #[arg(long, value_name = "FILE")]
+    pub states: Option<PathBuf>,
+    /// The model as JSON instead of a table.
+    #[arg(long)]
+    pub json: bool,
+    /// Refuse physically inconsistent link inertias (as Drake does) instead of a notice.
+    #[arg(long)]
+    pub strict_inertia: bool,
 }
 
 #[derive(Args, Debug)]
@@ -409,6 +428,7 @@ fn run_command(command: Command) -> Result<i32, Error> {
         Command::Trajectory(args) => trajectory(&args),
         Command::Analyze(args) => analyze(&args),
         Command::Envelope(args) => envelope(&args),
+        Command::Model(args) => model(&args),
     }
 }
 
@@ -479,6 +499,24 @@ pub fn run(args: &RunArgs) -> Result<i32, Error> {
         RunStatus::Interrupted { .. } => Ok(130),
         RunStatus::Completed => Ok(0),
     }
+}
+
+/// `armscope model`.
+pub fn model(args: &ModelArgs) -> Result<i32, Error> {
+    let model = crate::model::load_urdf_with(&args.urdf, crate::model::LoadOptions { strict_inertia: args.strict_inertia })?;
+    for notice in &model.notices {
+        eprintln!("armscope: notice: {notice}");
+    }
+    if let Some(path) = &args.states {
+        let text = std::fs::read_to_string(path).map_err(|e| Error::flag("--states", format!("{}: {e}", path.display())))?;
+        let states: Vec<crate::inspect::State> = serde_json::from_str(&text).map_err(|e| Error::flag("--states", format!("{}: {e}", path.display())))?;
+        println!("{}", crate::inspect::dynamics_at(&model, &states)?);
+    } else if args.json {
+        println!("{}", serde_json::to_string_pretty(&crate::inspect::describe(&model)).unwrap_or_default());
+    } else {
+        print!("{}", crate::inspect::table(&model));
+    }
+    Ok(0)
 }
 
 /// `armscope batch`.

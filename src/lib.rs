@@ -15,6 +15,7 @@ pub mod error;
 pub mod experiment;
 pub mod gains;
 pub mod heatmap;
+pub mod inspect;
 pub mod ik;
 pub mod integrator;
 pub mod meshgen;
