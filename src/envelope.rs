@@ -44,7 +44,7 @@ pub fn with_payload(mut model: Model, kg: f64) -> Model {
         let frame = &model.frames[model.tool_frame];
         if let Some(body) = frame.body {
             let point = crate::spatial::RigidInertia { mass: kg, com: frame.placement.translation, inertia_com: nalgebra::Matrix3::zeros() };
-            model.joints[body].inertia = model.joints[body].inertia.combined(&point);
+            model.bodies[body].inertia = model.bodies[body].inertia.combined(&point);
         }
     }
     model

@@ -101,7 +101,7 @@ impl Experiment {
     pub fn commanded_tool_path(&self, interval: f64) -> Vec<Vector3<f64>> {
         let model = &*self.model;
         let n = model.dof();
-        let mut poses = vec![crate::spatial::Pose::identity(); n];
+        let mut poses = vec![crate::spatial::Pose::identity(); model.bodies.len()];
         let (mut cmd, mut cmd_dot) = (vec![0.0; n], vec![0.0; n]);
         let samples = (self.config.duration / interval).ceil() as usize;
         (0..=samples)

@@ -7,7 +7,7 @@
 //! d1 = 0.133 (shoulder height), d4 = 0.1175 (forearm), d6 = 0.028 (flange). Gear ratios 4.8, 4, 5,
 //! 2.8, 2.1. As the tutorial's SolidWorks export: root link `base` with no world joint, five
 //! actuated joints declared by `<transmission>`s (motor1..motor5, efforts 100/50/30/20/10 N·m), the
-//! tool roll J6 without one (passive, nearly inertia-free: the discrete plant's pitfall), no joint
+//! tool roll J6 without one and without an effort limit (passive, nearly inertia-free: the discrete plant's pitfall), no joint
 //! damping, total mass ≈ 2.27 kg, and distal links so light that J4 and J5 see effective
 //! inertias of ~3e-5 and ~6e-6 kg·m².
 
@@ -90,7 +90,7 @@ fn joints() -> Vec<JointSpec> {
         JointSpec { name: "J4", parent: "link3", child: "link4", origin: [J4_ALONG, 0.0, R3], axis: [1.0, 0.0, 0.0], limit: 3.05, effort: 20.0, ratio: 2.8 },
         JointSpec { name: "J5", parent: "link4", child: "link5", origin: [D4 - J4_ALONG, 0.0, 0.0], axis: [0.0, 1.0, 0.0], limit: 2.0, effort: 10.0, ratio: 2.1 },
         // the tool flange's roll: direct drive (ratio 1) and, as in the tutorial's export, no transmission
-        JointSpec { name: "J6", parent: "link5", child: "tool", origin: [D6, 0.0, 0.0], axis: [1.0, 0.0, 0.0], limit: 3.05, effort: 5.0, ratio: 1.0 },
+        JointSpec { name: "J6", parent: "link5", child: "tool", origin: [D6, 0.0, 0.0], axis: [1.0, 0.0, 0.0], limit: 3.05, effort: 0.0, ratio: 1.0 },
     ]
 }
 

@@ -19,7 +19,7 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
     let dt = experiment.dt();
     let mut data = Data::new(model);
     // where the command puts the arm (poses only), for the tool's target
-    let mut command_poses = vec![crate::spatial::Pose::identity(); n];
+    let mut command_poses = vec![crate::spatial::Pose::identity(); model.bodies.len()];
     let mut plant = experiment.make_plant();
     let controller = experiment.controller();
     let info = RunInfo {
@@ -142,7 +142,7 @@ impl EnergyAudit {
     }
 
     fn potential_energy(&self, model: &crate::model::Model, data: &Data) -> f64 {
-        model.joints.iter().enumerate().map(|(i, j)| -j.inertia.mass * self.gravity.dot(&data.body_pose[i].transform_point(&j.inertia.com))).sum()
+        model.bodies.iter().enumerate().map(|(i, j)| -j.inertia.mass * self.gravity.dot(&data.body_pose[i].transform_point(&j.inertia.com))).sum()
     }
 
     fn remember(&mut self, v: &[f64]) {

@@ -121,8 +121,98 @@ fn transmissions_and_mimics_on_joints_that_do_not_move_are_ignored_with_a_notice
     let model = load(&arm(GOOD_FORE, LIMITS, extra));
     let has = |a: &str, b: &str| model.notices.iter().any(|n| n.contains(a) && n.contains(b));
     assert!(has("finger_trans", "fixed joint") && has("ghost_trans", "does not have") && has("finger_joint", "<mimic>"), "{:?}", model.notices);
-    assert_eq!(model.actuators.len(), 1);
-    assert_eq!((model.actuators[0].joint, model.actuators[0].gear_ratio), (1, 4.0));
+    // J2's motor from its transmission; J1, without one, driven directly with its URDF effort
+    assert_eq!(model.actuators.len(), 2);
+    assert_eq!((model.actuators[1].joint, model.actuators[1].gear_ratio), (1, 4.0));
+    assert_eq!((model.actuators[0].joint, model.actuators[0].effort), (0, 5.0));
+    assert!(has("'J1'", "driven directly"), "{:?}", model.notices);
+}
+
+/// A two-finger gripper on J2's link: `right` mimics `left` with multiplier −1 and offset 0.01; `tip`
+/// mimics `right` (a chain: q_tip = 2·q_right = −2·q_left − 0.02... + its own offset).
+fn gripper_arm() -> String {
+    let finger = |name: &str, child: &str, y: f64, mimic: &str, damping: f64| {
+        format!(
+            r#"<link name="{child}">{}</link><joint name="{name}" type="prismatic"><origin xyz="0.2 {y} 0"/><parent link="fore"/><child link="{child}"/><axis xyz="0 1 0"/><limit lower="-0.05" upper="0.05" effort="20" velocity="1"/><dynamics damping="{damping}"/>{mimic}</joint>"#,
+            inertial(0.1, 1e-4, 1e-4, 1e-4)
+        )
+    };
+    let extra = finger("left", "left_finger", 0.02, "", 0.5)
+        + &finger("right", "right_finger", -0.02, r#"<mimic joint="left" multiplier="-1" offset="0.01"/>"#, 0.3)
+        + &format!(
+            r#"<link name="tip">{}</link><joint name="tip_joint" type="revolute"><origin xyz="0.03 0 0"/><parent link="right_finger"/><child link="tip"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/><dynamics damping="0.2"/><mimic joint="right" multiplier="2" offset="0.1"/></joint>"#,
+            inertial(0.05, 1e-5, 1e-5, 1e-5)
+        );
+    arm(GOOD_FORE, LIMITS, &extra)
+}
+
+#[test]
+fn mimic_joints_follow_their_master_and_the_coordinates_are_the_independent_joints() {
+    let model = load(&gripper_arm());
+    let names: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();
+    assert_eq!(names, ["J1", "J2", "left"], "the coordinates are the independent joints");
+    assert_eq!(model.bodies.len(), 5);
+    let coupling = |name: &str| model.couplings[model.bodies.iter().position(|b| b.name == name).unwrap()];
+    let (right, tip) = (coupling("right"), coupling("tip_joint"));
+    assert_eq!((right.coordinate, right.multiplier, right.offset), (2, -1.0, 0.01));
+    // q_tip = 2·q_right + 0.1 = 2·(−q_left + 0.01) + 0.1
+    assert_eq!((tip.coordinate, tip.multiplier), (2, -2.0));
+    assert!((tip.offset - 0.12).abs() < 1e-15);
+    // D_r = GᵀDG: left's own 0.5 + (−1)²·0.3 + (−2)²·0.2
+    assert!((model.joints[2].damping - 1.6).abs() < 1e-12, "{}", model.joints[2].damping);
+    let has = |a: &str| model.notices.iter().any(|n| n.contains(a));
+    assert!(has("joint 'right' mimics 'left' (q = -1·q + 0.01)") && has("joint 'tip_joint' mimics 'left'"), "{:?}", model.notices);
+}
+
+/// The coordinates' dynamics equal the full tree's projected through the coupling: with G the
+/// body-from-coordinate Jacobian (q_bodies = G·q + offset), M = GᵀM_full G, τ_g = Gᵀτ_g,full,
+/// C·v = Gᵀ(C·v)_full; and ABA's q̈ solves M q̈ = τ + τ_g − C·v. The full tree is the same URDF with
+/// the `<mimic>` tags removed, evaluated at the bodies' positions and velocities.
+#[test]
+fn mimic_dynamics_are_the_full_trees_projected_through_the_coupling() {
+    use armscope::dynamics::{aba, bias_forces, forward_kinematics, frame_pose, gravity_forces};
+    let coupled = load(&gripper_arm());
+    let full = load(&gripper_arm().replace(r#"<mimic joint="left" multiplier="-1" offset="0.01"/>"#, "").replace(r#"<mimic joint="right" multiplier="2" offset="0.1"/>"#, ""));
+    assert_eq!((coupled.dof(), full.dof()), (3, 5));
+    // full coordinates in body order: J1, J2, left, right, tip_joint; G maps the 3 coordinates onto them
+    let g = nalgebra::DMatrix::from_row_slice(5, 3, &[1., 0., 0., 0., 1., 0., 0., 0., 1., 0., 0., -1., 0., 0., -2.]);
+    let offset = nalgebra::DVector::from_row_slice(&[0., 0., 0., 0.01, 0.12]);
+    let (mut dc, mut df) = (Data::new(&coupled), Data::new(&full));
+    for (q, v, tau) in [([0.3, -0.7, 0.02], [0.5, -1.0, 0.3], [0.1, 2.0, -1.0]), ([-1.5, 0.4, -0.04], [-0.2, 0.8, -0.6], [0.0, 0.0, 0.5])] {
+        let (qv, vv) = (nalgebra::DVector::from_row_slice(&q), nalgebra::DVector::from_row_slice(&v));
+        let q_full: Vec<f64> = (&g * &qv + &offset).iter().copied().collect();
+        let v_full: Vec<f64> = (&g * &vv).iter().copied().collect();
+        let m_full = crba(&full, &mut df, &q_full).clone();
+        let m_want = g.transpose() * &m_full * &g;
+        let m_got = crba(&coupled, &mut dc, &q).clone();
+        assert!((&m_got - &m_want).amax() <= 1e-14 * m_want.amax(), "M\n{m_got}\n{m_want}");
+        let tg_want = g.transpose() * nalgebra::DVector::from_column_slice(gravity_forces(&full, &mut df, &q_full));
+        let tg_got = nalgebra::DVector::from_column_slice(gravity_forces(&coupled, &mut dc, &q));
+        assert!((&tg_got - &tg_want).amax() <= 1e-14 * tg_want.amax(), "τ_g {tg_got} {tg_want}");
+        let cv_want = g.transpose() * nalgebra::DVector::from_column_slice(bias_forces(&full, &mut df, &q_full, &v_full));
+        let cv_got = nalgebra::DVector::from_column_slice(bias_forces(&coupled, &mut dc, &q, &v));
+        assert!((&cv_got - &cv_want).amax() <= 1e-13 * cv_want.amax().max(1e-3), "C·v {cv_got} {cv_want}");
+        let rhs = nalgebra::DVector::from_row_slice(&tau) + &tg_want - &cv_want;
+        let qdd_want = m_want.clone().cholesky().unwrap().solve(&rhs);
+        let qdd_got = nalgebra::DVector::from_column_slice(aba(&coupled, &mut dc, &q, &v, &tau));
+        assert!((&qdd_got - &qdd_want).amax() <= 1e-10 * qdd_want.amax(), "q̈ {qdd_got} {qdd_want}");
+        // every link is drawn where the full tree puts it
+        forward_kinematics(&coupled, &mut dc, &q);
+        forward_kinematics(&full, &mut df, &q_full);
+        for f in 0..coupled.frames.len() {
+            let (a, b) = (frame_pose(&coupled, &dc, f), frame_pose(&full, &df, f));
+            assert!((a.translation - b.translation).amax() < 1e-15 && (a.rotation - b.rotation).amax() < 1e-15, "link {}", coupled.frames[f].name);
+        }
+    }
+}
+
+#[test]
+fn a_mimic_robot_runs_by_default_without_chatter_with_one_column_per_coordinate() {
+    let (code, summary, stderr) = run_summary(&gripper_arm(), &["--duration", "3"]);
+    assert_eq!(code, 0, "{stderr}");
+    let chatter = summary["summary"]["chatter_percent"].as_array().unwrap();
+    assert_eq!(chatter.len(), 3, "one column per coordinate");
+    assert!(chatter.iter().all(|c| c.as_f64().unwrap() < 5.0), "{chatter:?}");
 }
 
 #[test]

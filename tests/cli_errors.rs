@@ -129,13 +129,27 @@ fn zero_axis() {
 }
 
 #[test]
-fn floating_planar_and_mimic_are_not_supported() {
+fn floating_and_planar_are_not_supported() {
     for kind in ["floating", "planar"] {
         let j = revolute("").replace(r#"type="revolute""#, &format!(r#"type="{kind}""#));
         assert_error(run_with_urdf(&arm(GOOD_LINK, &j), &[]), 2, &["joint 'J1'", kind, "not supported"]);
     }
-    let j = format!("{}{}", revolute(""), r#"<link name="c">GOOD</link><joint name="M" type="revolute"><parent link="b"/><child link="c"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="5" velocity="1"/><mimic joint="J1"/></joint>"#.replace("GOOD", GOOD_LINK));
-    assert_error(run_with_urdf(&arm(GOOD_LINK, &j), &[]), 2, &["joint 'M'", "mimic", "not supported"]);
+}
+
+#[test]
+fn a_mimic_of_a_missing_or_fixed_joint_or_a_cycle_is_an_error_naming_both_joints() {
+    let mimic = |name: &str, child: &str, target: &str| {
+        format!(
+            r#"<link name="{child}">{GOOD_LINK}</link><joint name="{name}" type="revolute"><parent link="b"/><child link="{child}"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="5" velocity="1"/><mimic joint="{target}"/></joint>"#
+        )
+    };
+    let j = format!("{}{}", revolute(""), mimic("M", "c", "J9"));
+    assert_error(run_with_urdf(&arm(GOOD_LINK, &j), &[]), 2, &["joint 'M'", "<mimic joint='J9'>", "does not have"]);
+    let fixed = r#"<link name="f"/><joint name="F" type="fixed"><parent link="b"/><child link="f"/></joint>"#;
+    let j = format!("{}{}{fixed}", revolute(""), mimic("M", "c", "F"));
+    assert_error(run_with_urdf(&arm(GOOD_LINK, &j), &[]), 2, &["joint 'M'", "<mimic joint='F'>", "fixed joint"]);
+    let j = format!("{}{}{}", revolute(""), mimic("M", "c", "N"), mimic("N", "d", "M"));
+    assert_error(run_with_urdf(&arm(GOOD_LINK, &j), &[]), 2, &["<mimic joint=", "cycle of mimic joints"]);
 }
 
 #[test]

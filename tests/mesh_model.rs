@@ -78,22 +78,29 @@ fn relative_and_missing_mesh_paths() {
 
 #[test]
 fn transmissions_define_the_actuators_and_bad_ones_are_named() {
-    let model = |extra: &str| {
+    // A: effort 7 (driven directly when B has a transmission); with effort 0, passive
+    let model_with_a_effort = |extra: &str, a_effort: &str| {
         format!(
             r#"<robot name="t"><link name="world"/><link name="a"><inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>
 <link name="b"><inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>
-<joint name="A" type="revolute"><parent link="world"/><child link="a"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="7" velocity="1"/></joint>
+<joint name="A" type="revolute"><parent link="world"/><child link="a"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="{a_effort}" velocity="1"/></joint>
 <joint name="B" type="revolute"><parent link="a"/><child link="b"/><axis xyz="0 1 0"/><limit lower="-1" upper="1" effort="3" velocity="1"/></joint>
 {extra}</robot>"#
         )
     };
+    let model = |extra: &str| model_with_a_effort(extra, "7");
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("t.urdf");
     std::fs::write(&path, model(r#"<transmission name="tb"><joint name="B"/><actuator name="mb"><mechanicalReduction>3.5</mechanicalReduction></actuator></transmission>"#)).unwrap();
     let m = load_urdf(&path).unwrap();
-    assert_eq!(m.actuators.len(), 1);
-    assert_eq!((m.actuators[0].name.as_str(), m.actuators[0].joint, m.actuators[0].effort, m.actuators[0].gear_ratio), ("mb", 1, 3.0, 3.5));
-    assert_eq!(m.effort_limits(), [0.0, 3.0], "A has no motor");
+    assert_eq!(m.actuators.len(), 2);
+    assert_eq!((m.actuators[1].name.as_str(), m.actuators[1].joint, m.actuators[1].effort, m.actuators[1].gear_ratio), ("mb", 1, 3.0, 3.5));
+    assert_eq!(m.effort_limits(), [7.0, 3.0], "A, without a transmission, is driven directly with its URDF effort");
+    assert!(m.notices.iter().any(|n| n.contains("joints 'A' have no <transmission>: each is driven directly")), "{:?}", m.notices);
+    std::fs::write(&path, model_with_a_effort(r#"<transmission name="tb"><joint name="B"/><actuator name="mb"/></transmission>"#, "0")).unwrap();
+    let m = load_urdf(&path).unwrap();
+    assert_eq!(m.effort_limits(), [0.0, 3.0], "A, with neither a transmission nor an effort limit, is passive");
+    assert!(m.notices.iter().any(|n| n.contains("joints 'A' have neither a <transmission> nor an effort limit: passive")), "{:?}", m.notices);
     std::fs::write(&path, model("")).unwrap();
     assert_eq!(load_urdf(&path).unwrap().actuators.len(), 2, "no transmissions: one actuator per joint");
     // a transmission on a joint the URDF does not have: named in a notice, and ignored

@@ -1,8 +1,9 @@
 use super::{Data, forward_kinematics};
 use crate::model::Model;
 
-/// The joint-space mass matrix M(q), into `data.mass_matrix` (both triangles). Entries of joints on
-/// different branches are never written and stay zero.
+/// The joint-space mass matrix M(q), into `data.mass_matrix` (both triangles). With `<mimic>`
+/// joints, the matrix of the coordinates: GᵀM_bodies G, each body's entries added into its
+/// coordinate's row and column.
 pub fn crba<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> &'d nalgebra::DMatrix<f64> {
     forward_kinematics(model, data, q);
     crba_from_kinematics(model, data);
@@ -11,21 +12,25 @@ pub fn crba<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> &'d nalgebra::D
 
 /// CRBA assuming `forward_kinematics` was run for the current q.
 pub fn crba_from_kinematics(model: &Model, data: &mut Data) {
-    let n = model.dof();
-    data.composite_inertia[..n].copy_from_slice(&data.body_inertia[..n]);
+    let b = model.bodies.len();
+    data.composite_inertia[..b].copy_from_slice(&data.body_inertia[..b]);
+    data.mass_matrix.fill(0.0);
+    let coordinate = |i: usize| model.couplings[i].coordinate;
     // Children have larger indices, so a body's composite inertia is complete when the reverse
     // sweep reaches it.
-    for i in (0..n).rev() {
+    for i in (0..b).rev() {
         let force = data.composite_inertia[i] * data.motion_subspace[i];
-        data.mass_matrix[(i, i)] = data.motion_subspace[i].dot(&force);
-        let mut ancestor = model.joints[i].parent;
+        let ci = coordinate(i);
+        data.mass_matrix[(ci, ci)] += data.motion_subspace[i].dot(&force);
+        let mut ancestor = model.bodies[i].parent;
         while let Some(j) = ancestor {
             let m = data.motion_subspace[j].dot(&force);
-            data.mass_matrix[(i, j)] = m;
-            data.mass_matrix[(j, i)] = m;
-            ancestor = model.joints[j].parent;
+            let cj = coordinate(j);
+            data.mass_matrix[(ci, cj)] += m;
+            data.mass_matrix[(cj, ci)] += m;
+            ancestor = model.bodies[j].parent;
         }
-        if let Some(p) = model.joints[i].parent {
+        if let Some(p) = model.bodies[i].parent {
             let c = data.composite_inertia[i];
             data.composite_inertia[p] += c;
         }

@@ -8,7 +8,8 @@ use nalgebra::{DMatrix, Matrix6, Vector6};
 pub struct Data {
     /// World pose of each body (set by `forward_kinematics`).
     pub body_pose: Vec<Pose>,
-    /// Joint motion subspace S_i in world coordinates (set by `forward_kinematics`).
+    /// Body i's motion per unit of its coordinate, multiplier_i·S_i, in world coordinates (set by
+    /// `forward_kinematics`); S_i itself for an independent joint.
     pub motion_subspace: Vec<Vector6<f64>>,
     /// Each body's spatial inertia in world coordinates (set by `forward_kinematics`).
     pub body_inertia: Vec<Matrix6<f64>>,
@@ -35,31 +36,34 @@ pub struct Data {
     pub gravity: Vec<f64>,
     /// C(q, q̇)·q̇.
     pub bias: Vec<f64>,
+    /// The Cholesky factor of M, for forward dynamics of models with `<mimic>` joints.
+    pub mass_factor: DMatrix<f64>,
 }
 
 impl Data {
     pub fn new(model: &Model) -> Self {
-        let n = model.dof();
+        let (n, b) = (model.dof(), model.bodies.len());
         Self {
-            body_pose: vec![Pose::identity(); n],
-            motion_subspace: vec![Vector6::zeros(); n],
-            body_inertia: vec![Matrix6::zeros(); n],
-            velocity: vec![Vector6::zeros(); n],
-            acceleration: vec![Vector6::zeros(); n],
-            force: vec![Vector6::zeros(); n],
-            gravity_force: vec![Vector6::zeros(); n],
-            composite_inertia: vec![Matrix6::zeros(); n],
-            bias_acceleration: vec![Vector6::zeros(); n],
-            articulated_inertia: vec![Matrix6::zeros(); n],
-            articulated_bias: vec![Vector6::zeros(); n],
-            aba_u: vec![Vector6::zeros(); n],
-            aba_d: vec![0.0; n],
-            aba_torque: vec![0.0; n],
+            body_pose: vec![Pose::identity(); b],
+            motion_subspace: vec![Vector6::zeros(); b],
+            body_inertia: vec![Matrix6::zeros(); b],
+            velocity: vec![Vector6::zeros(); b],
+            acceleration: vec![Vector6::zeros(); b],
+            force: vec![Vector6::zeros(); b],
+            gravity_force: vec![Vector6::zeros(); b],
+            composite_inertia: vec![Matrix6::zeros(); b],
+            bias_acceleration: vec![Vector6::zeros(); b],
+            articulated_inertia: vec![Matrix6::zeros(); b],
+            articulated_bias: vec![Vector6::zeros(); b],
+            aba_u: vec![Vector6::zeros(); b],
+            aba_d: vec![0.0; b],
+            aba_torque: vec![0.0; b],
             mass_matrix: DMatrix::zeros(n, n),
             tau: vec![0.0; n],
             qdd: vec![0.0; n],
             gravity: vec![0.0; n],
             bias: vec![0.0; n],
+            mass_factor: if model.has_mimic() { DMatrix::zeros(n, n) } else { DMatrix::zeros(0, 0) },
         }
     }
 }

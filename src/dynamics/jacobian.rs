@@ -14,10 +14,12 @@ pub fn frame_jacobian(model: &Model, data: &Data, frame: usize, out: &mut DMatri
         let w = angular(s);
         // S is referred to the world origin; shift its linear part to the frame origin.
         let v = linear(s) + w.cross(&origin);
+        // a mimic joint's motion adds to its coordinate's column
+        let c = model.couplings[j].coordinate;
         for r in 0..3 {
-            out[(r, j)] = w[r];
-            out[(r + 3, j)] = v[r];
+            out[(r, c)] += w[r];
+            out[(r + 3, c)] += v[r];
         }
-        body = model.joints[j].parent;
+        body = model.bodies[j].parent;
     }
 }

@@ -18,16 +18,18 @@ fn body_pose(joint: &Joint, parent: &Pose, q: f64) -> (Pose, Vector3<f64>) {
     (pose, axis_world)
 }
 
-/// Body poses, joint motion subspaces and body inertias in world coordinates at `q`.
+/// Body poses, joint motion subspaces (scaled by each body's coupling multiplier: a mimic joint
+/// moves multiplier × its coordinate's velocity) and body inertias in world coordinates at `q`.
 pub fn forward_kinematics(model: &Model, data: &mut Data, q: &[f64]) {
     debug_assert_eq!(q.len(), model.dof());
-    for (i, joint) in model.joints.iter().enumerate() {
+    for (i, (joint, coupling)) in model.bodies.iter().zip(&model.couplings).enumerate() {
         let parent = joint.parent.map_or(Pose::identity(), |p| data.body_pose[p]);
-        let (pose, axis_world) = body_pose(joint, &parent, q[i]);
-        data.motion_subspace[i] = match joint.kind {
+        let (pose, axis_world) = body_pose(joint, &parent, coupling.position(q));
+        let subspace = match joint.kind {
             JointKind::Revolute | JointKind::Continuous => spatial(axis_world, pose.translation.cross(&axis_world)),
             JointKind::Prismatic => spatial(Vector3::zeros(), axis_world),
         };
+        data.motion_subspace[i] = subspace * coupling.multiplier;
         let inertia = &joint.inertia;
         let world = crate::spatial::RigidInertia {
             mass: inertia.mass,
@@ -40,11 +42,12 @@ pub fn forward_kinematics(model: &Model, data: &mut Data, q: &[f64]) {
 }
 
 /// Only the body poses at `q` (no motion subspaces or inertias): where a command puts the arm.
+/// `poses` has one entry per body (`model.bodies`).
 pub fn body_poses(model: &Model, q: &[f64], poses: &mut [Pose]) {
     debug_assert_eq!(q.len(), model.dof());
-    for (i, joint) in model.joints.iter().enumerate() {
+    for (i, (joint, coupling)) in model.bodies.iter().zip(&model.couplings).enumerate() {
         let parent = joint.parent.map_or(Pose::identity(), |p| poses[p]);
-        poses[i] = body_pose(joint, &parent, q[i]).0;
+        poses[i] = body_pose(joint, &parent, coupling.position(q)).0;
     }
 }
 

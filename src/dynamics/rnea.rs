@@ -19,21 +19,23 @@ pub fn rnea<'d>(model: &Model, data: &'d mut Data, q: &[f64], v: &[f64], a: &[f6
 /// RNEA assuming `forward_kinematics` was run for the current q.
 pub fn rnea_from_kinematics(model: &Model, data: &mut Data, v: &[f64], a: &[f64]) {
     let a0 = base_acceleration(model);
-    for (i, joint) in model.joints.iter().enumerate() {
+    for (i, (joint, coupling)) in model.bodies.iter().zip(&model.couplings).enumerate() {
         let s = data.motion_subspace[i];
         let (v_parent, a_parent) = match joint.parent {
             Some(p) => (data.velocity[p], data.acceleration[p]),
             None => (Vector6::zeros(), a0),
         };
-        let vel = v_parent + s * v[i];
-        let acc = a_parent + s * a[i] + cross_motion(&vel, &(s * v[i]));
+        let c = coupling.coordinate;
+        let vel = v_parent + s * v[c];
+        let acc = a_parent + s * a[c] + cross_motion(&vel, &(s * v[c]));
         let inertia = &data.body_inertia[i];
         data.force[i] = inertia * acc + cross_force(&vel, &(inertia * vel));
         data.velocity[i] = vel;
         data.acceleration[i] = acc;
     }
-    for (i, joint) in model.joints.iter().enumerate().rev() {
-        data.tau[i] = data.motion_subspace[i].dot(&data.force[i]);
+    data.tau.fill(0.0);
+    for (i, (joint, coupling)) in model.bodies.iter().zip(&model.couplings).enumerate().rev() {
+        data.tau[coupling.coordinate] += data.motion_subspace[i].dot(&data.force[i]);
         if let Some(p) = joint.parent {
             let f = data.force[i];
             data.force[p] += f;
@@ -46,24 +48,27 @@ pub fn rnea_from_kinematics(model: &Model, data: &mut Data, v: &[f64], a: &[f64]
 pub fn gravity_and_bias_from_kinematics(model: &Model, data: &mut Data, v: &[f64]) {
     // With q̈ = 0 and no gravity RNEA gives C q̇; gravity alone accelerates every body by −a₀.
     let g = -base_acceleration(model);
-    for (i, joint) in model.joints.iter().enumerate() {
+    for (i, (joint, coupling)) in model.bodies.iter().zip(&model.couplings).enumerate() {
         let s = data.motion_subspace[i];
         let (v_parent, a_parent) = match joint.parent {
             Some(p) => (data.velocity[p], data.acceleration[p]),
             None => (Vector6::zeros(), Vector6::zeros()),
         };
-        let vel = v_parent + s * v[i];
-        let acc = a_parent + cross_motion(&vel, &(s * v[i]));
+        let joint_velocity = s * v[coupling.coordinate];
+        let vel = v_parent + joint_velocity;
+        let acc = a_parent + cross_motion(&vel, &joint_velocity);
         let inertia = &data.body_inertia[i];
         data.force[i] = inertia * acc + cross_force(&vel, &(inertia * vel));
         data.gravity_force[i] = inertia * g;
         data.velocity[i] = vel;
         data.acceleration[i] = acc;
     }
-    for (i, joint) in model.joints.iter().enumerate().rev() {
+    data.bias.fill(0.0);
+    data.gravity.fill(0.0);
+    for (i, (joint, coupling)) in model.bodies.iter().zip(&model.couplings).enumerate().rev() {
         let s = data.motion_subspace[i];
-        data.bias[i] = s.dot(&data.force[i]);
-        data.gravity[i] = s.dot(&data.gravity_force[i]);
+        data.bias[coupling.coordinate] += s.dot(&data.force[i]);
+        data.gravity[coupling.coordinate] += s.dot(&data.gravity_force[i]);
         if let Some(p) = joint.parent {
             let (f, fg) = (data.force[i], data.gravity_force[i]);
             data.force[p] += f;
@@ -82,11 +87,12 @@ pub fn gravity_forces<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> &'d [
 /// τ_g into `data.gravity`, assuming `forward_kinematics` was run for the current q.
 pub fn gravity_from_kinematics(model: &Model, data: &mut Data) {
     let g = -base_acceleration(model);
-    for i in 0..model.dof() {
+    for i in 0..model.bodies.len() {
         data.gravity_force[i] = data.body_inertia[i] * g;
     }
-    for (i, joint) in model.joints.iter().enumerate().rev() {
-        data.gravity[i] = data.motion_subspace[i].dot(&data.gravity_force[i]);
+    data.gravity.fill(0.0);
+    for (i, (joint, coupling)) in model.bodies.iter().zip(&model.couplings).enumerate().rev() {
+        data.gravity[coupling.coordinate] += data.motion_subspace[i].dot(&data.gravity_force[i]);
         if let Some(p) = joint.parent {
             let fg = data.gravity_force[i];
             data.gravity_force[p] += fg;

@@ -34,8 +34,8 @@ pub enum ModelErrorKind {
     NoMovingJoints,
     #[error("joint '{joint}': {kind} joints are not supported")]
     UnsupportedJoint { joint: String, kind: String },
-    #[error("joint '{0}': mimic joints are not supported")]
-    Mimic(String),
+    #[error("joint '{joint}': <mimic joint='{target}'> {what}")]
+    Mimic { joint: String, target: String, what: &'static str },
     #[error("{element}: {field} is {value}, not a finite number")]
     NonFinite { element: String, field: &'static str, value: f64 },
     #[error("joint '{0}': axis is zero")]

@@ -18,13 +18,13 @@ pub enum JointKind {
     Prismatic,
 }
 
-/// One moving joint and the rigid body it moves (fixed children merged in).
-/// Joint `i` moves body `i`, and every joint's parent has a smaller index.
+/// One moving joint and the rigid body it moves (fixed children merged in). In
+/// [`Model::bodies`], joint `i` moves body `i`, and every joint's parent has a smaller index.
 #[derive(Clone, Debug)]
 pub struct Joint {
     pub name: String,
     pub kind: JointKind,
-    /// The body this joint hangs from; `None` is the world.
+    /// The body (index into [`Model::bodies`]) this joint hangs from; `None` is the world.
     pub parent: Option<usize>,
     /// The joint frame in the parent body's frame (at q = 0).
     pub placement: Pose,
@@ -39,7 +39,8 @@ pub struct Joint {
     pub effort: f64,
     /// URDF `<limit velocity>` (informational: like Drake, not enforced).
     pub velocity: f64,
-    /// Viscous damping, N·m·s/rad.
+    /// Viscous damping, N·m·s/rad. In [`Model::joints`], a coordinate's: its own plus, for each
+    /// joint that mimics it, multiplier² × that joint's (D_r = GᵀDG, which stays diagonal).
     pub damping: f64,
     /// The URDF link this joint moves.
     pub child_link: String,
@@ -103,7 +104,14 @@ pub struct Model {
     /// The URDF text, kept for recordings (`/robot_description`).
     pub urdf_text: String,
     pub gravity: Vector3<f64>,
+    /// The independent moving joints: the model's coordinates, which q, q̇, τ and everything per
+    /// joint (limits, motors, gains, recordings) are indexed by. A `<mimic>` joint is not one of them.
     pub joints: Vec<Joint>,
+    /// Every moving joint with the body it moves: the tree the dynamics walk (parents first).
+    /// Without `<mimic>` joints, the same list as `joints`.
+    pub bodies: Vec<Joint>,
+    /// Per body, the coordinate its joint follows: q_joint = multiplier·q[coordinate] + offset.
+    pub couplings: Vec<Coupling>,
     pub frames: Vec<Frame>,
     pub actuators: Vec<Actuator>,
     /// The frame whose origin is the tool tip: the deepest leaf link unless chosen otherwise.
@@ -112,8 +120,47 @@ pub struct Model {
     pub notices: Vec<String>,
 }
 
+/// How a body's joint follows the model's coordinates, as a URDF `<mimic>` says (Pinocchio's
+/// `mimic=True`, Drake's coupler constraint): q_joint = multiplier·q[coordinate] + offset; an
+/// independent joint is its own coordinate with multiplier 1 and offset 0.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Coupling {
+    pub coordinate: usize,
+    pub multiplier: f64,
+    pub offset: f64,
+}
+
+impl Coupling {
+    pub fn independent(coordinate: usize) -> Self {
+        Self { coordinate, multiplier: 1.0, offset: 0.0 }
+    }
+
+    /// The body joint's position (or velocity, with `offset` left out) from the coordinates.
+    #[inline]
+    pub fn position(&self, q: &[f64]) -> f64 {
+        self.multiplier * q[self.coordinate] + self.offset
+    }
+}
+
 impl Model {
-    /// Number of degrees of freedom (one per moving joint).
+    /// Whether some joint follows another (`<mimic>`): the bodies are then more than the coordinates.
+    pub fn has_mimic(&self) -> bool {
+        self.bodies.len() != self.joints.len()
+    }
+
+    /// The bodies whose joint mimics another, with the coordinate it follows.
+    pub fn mimic_bodies(&self) -> impl Iterator<Item = (usize, &Joint, &Coupling)> {
+        self.bodies.iter().zip(&self.couplings).enumerate().filter(|(_, (b, c))| self.joints[c.coordinate].name != b.name).map(|(i, (b, c))| (i, b, c))
+    }
+
+    /// Every body joint's position at the coordinates `q` (for drawing and recording).
+    pub fn body_positions(&self, q: &[f64], out: &mut [f64]) {
+        for (o, c) in out.iter_mut().zip(&self.couplings) {
+            *o = c.position(q);
+        }
+    }
+
+    /// Number of degrees of freedom (one per independent moving joint).
     pub fn dof(&self) -> usize {
         self.joints.len()
     }
@@ -159,15 +206,4 @@ impl Model {
         }
     }
 
-    /// The chain of joints from the root to `body`, as a boolean mask (for Jacobians).
-    pub fn supports(&self, body: Option<usize>, joint: usize) -> bool {
-        let mut b = body;
-        while let Some(i) = b {
-            if i == joint {
-                return true;
-            }
-            b = self.joints[i].parent;
-        }
-        false
-    }
 }

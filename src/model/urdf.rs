@@ -1,7 +1,7 @@
 //! URDF → [`Model`]: parsing (urdf-rs, plus roxmltree for `<transmission>`, which urdf-rs drops),
 //! validation with one-line errors, fixed-joint merging and welding of a free root.
 
-use super::{Actuator, Frame, Geometry, Joint, JointKind, Model, ModelError, ModelErrorKind as K, Visual};
+use super::{Actuator, Coupling, Frame, Geometry, Joint, JointKind, Model, ModelError, ModelErrorKind as K, Visual};
 use crate::spatial::{Pose, RigidInertia};
 use nalgebra::{Matrix3, SymmetricEigen, Vector3};
 use std::collections::HashMap;
@@ -121,7 +121,9 @@ fn build(text: &str, source: &Path, options: LoadOptions) -> Result<Model, K> {
     let mut frames: Vec<Frame> = Vec::with_capacity(robot.links.len());
     let mut frame_of_link: Vec<Option<usize>> = vec![None; robot.links.len()];
     let mut depth: Vec<usize> = Vec::with_capacity(robot.links.len());
-    let mut joints: Vec<Joint> = Vec::new();
+    let mut bodies: Vec<Joint> = Vec::new();
+    // the URDF joint of each body
+    let mut body_urdf_joint: Vec<usize> = Vec::new();
     let mut body_inertia: Vec<RigidInertia> = Vec::new();
     let base_dir = source.parent().unwrap_or(Path::new("."));
 
@@ -136,9 +138,10 @@ fn build(text: &str, source: &Path, options: LoadOptions) -> Result<Model, K> {
                 match joint_kind(uj)? {
                     None => (frames[pf].body, joint_frame, Some(pf), depth[pf] + 1),
                     Some(kind) => {
-                        joints.push(make_joint(uj, kind, frames[pf].body, joint_frame, &mut notices));
+                        bodies.push(make_joint(uj, kind, frames[pf].body, joint_frame, &mut notices));
+                        body_urdf_joint.push(j);
                         body_inertia.push(RigidInertia::zero());
-                        (Some(joints.len() - 1), Pose::identity(), Some(pf), depth[pf] + 1)
+                        (Some(bodies.len() - 1), Pose::identity(), Some(pf), depth[pf] + 1)
                     }
                 }
             }
@@ -165,32 +168,24 @@ fn build(text: &str, source: &Path, options: LoadOptions) -> Result<Model, K> {
     if let Some(unreached) = frame_of_link.iter().position(|f| f.is_none()) {
         return Err(K::Cycle(robot.links[unreached].name.clone()));
     }
-    if joints.is_empty() {
+    if bodies.is_empty() {
         return Err(K::NoMovingJoints);
     }
 
-    for (joint, inertia) in joints.iter_mut().zip(body_inertia) {
-        joint.inertia = inertia;
+    for (body, inertia) in bodies.iter_mut().zip(body_inertia) {
+        body.inertia = inertia;
     }
-    // Massless links are fine (frames, sensors, tools) as long as every moving joint moves
+    let (joints, couplings) = couple(&bodies, &body_urdf_joint, &robot, &mut notices)?;
+    // Massless links are fine (frames, sensors, tools) as long as every coordinate moves
     // something: the mass matrix is then positive definite.
-    match joint_moving_nothing(&joints) {
+    match coordinate_moving_nothing(&bodies, &couplings, joints.len()) {
         Some(Ok(j)) => return Err(K::MovesNothing { joint: joints[j].name.clone(), link: joints[j].child_link.clone() }),
         // finite numbers whose sums overflow (1e308 in a URDF)
         Some(Err(j)) => return Err(K::NonFinite { element: format!("link '{}'", joints[j].child_link), field: "inertia of the links it carries", value: f64::INFINITY }),
         None => {}
     }
 
-    let actuators = actuators_from_transmissions(&doc, &robot, &joints, &mut notices)?;
-    let actuators = if actuators.is_empty() {
-        joints
-            .iter()
-            .enumerate()
-            .map(|(i, j)| Actuator { name: j.name.clone(), joint: i, effort: j.effort, gear_ratio: 1.0 })
-            .collect()
-    } else {
-        actuators
-    };
+    let actuators = motors(&doc, &robot, &joints, &mut notices)?;
 
     // Tool: the deepest leaf link (first one in tree order on a tie).
     let is_leaf = |f: usize| !frames.iter().any(|g| g.parent_frame == Some(f));
@@ -202,6 +197,8 @@ fn build(text: &str, source: &Path, options: LoadOptions) -> Result<Model, K> {
         urdf_text: text.to_string(),
         gravity: Vector3::from(STANDARD_GRAVITY),
         joints,
+        bodies,
+        couplings,
         frames,
         actuators,
         tool_frame,
@@ -223,9 +220,6 @@ fn pose(p: &urdf_rs::Pose) -> Pose {
 
 fn joint_kind(joint: &urdf_rs::Joint) -> Result<Option<JointKind>, K> {
     use urdf_rs::JointType as T;
-    if joint.mimic.is_some() && joint.joint_type != T::Fixed {
-        return Err(K::Mimic(joint.name.clone()));
-    }
     match joint.joint_type {
         T::Fixed => Ok(None),
         T::Revolute => Ok(Some(JointKind::Revolute)),
@@ -248,12 +242,8 @@ fn make_joint(uj: &urdf_rs::Joint, kind: JointKind, parent: Option<usize>, place
         }
         _ => (uj.limit.lower, uj.limit.upper),
     };
-    let effort = if uj.limit.effort > 0.0 {
-        uj.limit.effort
-    } else {
-        notices.push(format!("joint '{}' has no effort limit; its motor is treated as unlimited", uj.name));
-        f64::INFINITY
-    };
+    // no effort limit (0, as exporters write it): an unlimited motor, or passive (see `motors`)
+    let effort = if uj.limit.effort > 0.0 { uj.limit.effort } else { f64::INFINITY };
     Joint {
         name: uj.name.clone(),
         kind,
@@ -323,32 +313,86 @@ fn check_link(link: &urdf_rs::Link, options: LoadOptions, notices: &mut Vec<Stri
 /// inertia about a revolute axis, no mass along a prismatic one) at the zero pose: the mass
 /// matrix's diagonal entry, from the composite inertias of the subtrees. `Err(joint)`: that
 /// joint's subtree inertia is not finite.
-fn joint_moving_nothing(joints: &[Joint]) -> Option<Result<usize, usize>> {
-    let mut composite: Vec<RigidInertia> = joints.iter().map(|j| j.inertia).collect();
-    for i in (0..joints.len()).rev() {
-        if let Some(p) = joints[i].parent {
-            composite[p] = composite[p].combined(&composite[i].transformed(&joints[i].placement));
+/// The coordinates of the model from its bodies' URDF joints: every joint without a `<mimic>` is one
+/// (in body order); a `<mimic>` joint follows its master's coordinate, through chains of mimics. The
+/// coordinates' joints carry the damping of the joints that follow them (D_r = GᵀDG).
+fn couple(bodies: &[Joint], body_urdf_joint: &[usize], robot: &urdf_rs::Robot, notices: &mut Vec<String>) -> Result<(Vec<Joint>, Vec<Coupling>), K> {
+    let mimic = |b: usize| robot.joints[body_urdf_joint[b]].mimic.as_ref();
+    let mut coordinate_of_body: Vec<Option<usize>> = vec![None; bodies.len()];
+    let mut joints: Vec<Joint> = Vec::new();
+    for (b, body) in bodies.iter().enumerate() {
+        if mimic(b).is_none() {
+            coordinate_of_body[b] = Some(joints.len());
+            joints.push(body.clone());
         }
     }
-    (0..joints.len()).find_map(|i| {
-        let (c, a) = (&composite[i], &joints[i].axis);
-        let about_motion = match joints[i].kind {
-            JointKind::Prismatic => c.mass,
+    let mut couplings = Vec::with_capacity(bodies.len());
+    for (b, body) in bodies.iter().enumerate() {
+        if let Some(c) = coordinate_of_body[b] {
+            couplings.push(Coupling::independent(c));
+            continue;
+        }
+        // follow the chain: q_b = m·q_master + o, the master possibly a mimic itself
+        let (mut multiplier, mut offset, mut current, mut steps) = (1.0, 0.0, b, 0);
+        let coupling = loop {
+            let Some(m) = mimic(current) else { break Coupling { coordinate: coordinate_of_body[current].expect("an independent body"), multiplier, offset } };
+            let fail = |what: &'static str| K::Mimic { joint: robot.joints[body_urdf_joint[current]].name.clone(), target: m.joint.clone(), what };
+            let (k, o) = (m.multiplier.unwrap_or(1.0), m.offset.unwrap_or(0.0));
+            if !k.is_finite() || !o.is_finite() {
+                return Err(fail("has a multiplier or offset that is not a finite number"));
+            }
+            offset += multiplier * o;
+            multiplier *= k;
+            steps += 1;
+            current = match bodies.iter().position(|j| j.name == m.joint) {
+                Some(_) if steps > bodies.len() => return Err(fail("is part of a cycle of mimic joints")),
+                Some(master) => master,
+                None if robot.joints.iter().any(|j| j.name == m.joint) => return Err(fail("names a fixed joint; a mimic joint must follow a moving one")),
+                None => return Err(fail("names a joint this URDF does not have")),
+            };
+        };
+        let master = &joints[coupling.coordinate];
+        notices.push(format!(
+            "joint '{}' mimics '{}' (q = {}·q + {}): it moves with it, its own limits and motor are not used",
+            body.name, master.name, coupling.multiplier, coupling.offset
+        ));
+        couplings.push(coupling);
+    }
+    for (body, c) in bodies.iter().zip(&couplings) {
+        if joints[c.coordinate].name != body.name {
+            joints[c.coordinate].damping += c.multiplier * c.multiplier * body.damping;
+        }
+    }
+    Ok((joints, couplings))
+}
+
+/// The first coordinate whose bodies' subtrees all have no inertia about their joints' motion
+/// (`Ok`), or whose sums are not finite (`Err`).
+fn coordinate_moving_nothing(bodies: &[Joint], couplings: &[Coupling], coordinates: usize) -> Option<Result<usize, usize>> {
+    let mut composite: Vec<RigidInertia> = bodies.iter().map(|j| j.inertia).collect();
+    for i in (0..bodies.len()).rev() {
+        if let Some(p) = bodies[i].parent {
+            composite[p] = composite[p].combined(&composite[i].transformed(&bodies[i].placement));
+        }
+    }
+    let mut moves = vec![0.0; coordinates];
+    for (i, c) in couplings.iter().enumerate() {
+        let (ci, a) = (&composite[i], &bodies[i].axis);
+        let about_motion = match bodies[i].kind {
+            JointKind::Prismatic => ci.mass,
             JointKind::Revolute | JointKind::Continuous => {
-                let about_origin = c.inertia_com + (Matrix3::identity() * c.com.norm_squared() - c.com * c.com.transpose()) * c.mass;
+                let about_origin = ci.inertia_com + (Matrix3::identity() * ci.com.norm_squared() - ci.com * ci.com.transpose()) * ci.mass;
                 a.dot(&(about_origin * a))
             }
         };
         if !about_motion.is_finite() {
-            Some(Err(i))
-        } else {
-            (about_motion <= 0.0).then_some(Ok(i))
+            return Some(Err(c.coordinate));
         }
-    })
+        moves[c.coordinate] += c.multiplier * c.multiplier * about_motion;
+    }
+    moves.iter().position(|&m| m <= 0.0).map(Ok)
 }
 
-/// A rotational inertia a rigid body can have: positive definite, and each principal moment at most
-/// the sum of the other two (up to the rounding of six-digit URDF numbers).
 fn check_inertia(link: &str, tensor: &Matrix3<f64>) -> Result<(), K> {
     if tensor.iter().any(|x| !x.is_finite()) {
         return Err(K::NonFinite { element: format!("link '{link}'"), field: "combined inertia", value: f64::INFINITY });
@@ -503,6 +547,45 @@ fn resolve_mesh(filename: &str, base_dir: &Path) -> Result<PathBuf, String> {
 
 /// One actuator per `<transmission>`; empty when the URDF declares none. A transmission on a joint
 /// that does not move (fixed) or that the URDF does not have is a notice and is ignored.
+/// The motors: one per `<transmission>`; a moving joint without one is driven directly with its
+/// URDF effort limit (as ros_control clamps to it), except, in a URDF whose transmissions leave it
+/// out, a joint with no effort limit either: that one is passive. Drake makes motors from
+/// transmissions only, which would leave e.g. Baxter's arms (transmissions on its grippers only)
+/// hanging; each assumption is a notice.
+fn motors(doc: &roxmltree::Document, robot: &urdf_rs::Robot, joints: &[Joint], notices: &mut Vec<String>) -> Result<Vec<Actuator>, K> {
+    let mut actuators = actuators_from_transmissions(doc, robot, joints, notices)?;
+    let has_transmissions = !actuators.is_empty();
+    let urdf_effort = |j: &Joint| robot.joints.iter().find(|u| u.name == j.name).map_or(0.0, |u| u.limit.effort);
+    let (mut direct, mut passive) = (Vec::new(), Vec::new());
+    for (i, joint) in joints.iter().enumerate() {
+        if actuators.iter().any(|a| a.joint == i) {
+            continue;
+        }
+        if has_transmissions && urdf_effort(joint) <= 0.0 {
+            passive.push(joint.name.as_str());
+            continue;
+        }
+        if has_transmissions {
+            direct.push(joint.name.as_str());
+        }
+        actuators.push(Actuator { name: joint.name.clone(), joint: i, effort: joint.effort, gear_ratio: 1.0 });
+    }
+    let list = |names: &[&str]| names.iter().map(|n| format!("'{n}'")).collect::<Vec<_>>().join(", ");
+    if !direct.is_empty() {
+        notices.push(format!("joints {} have no <transmission>: each is driven directly by a motor with its URDF effort limit", list(&direct)));
+    }
+    if !passive.is_empty() {
+        notices.push(format!("joints {} have neither a <transmission> nor an effort limit: passive", list(&passive)));
+    }
+    actuators.sort_by_key(|a| a.joint);
+    for a in &actuators {
+        if a.effort.is_infinite() {
+            notices.push(format!("joint '{}' has no effort limit; its motor is treated as unlimited", joints[a.joint].name));
+        }
+    }
+    Ok(actuators)
+}
+
 fn actuators_from_transmissions(doc: &roxmltree::Document, robot: &urdf_rs::Robot, joints: &[Joint], notices: &mut Vec<String>) -> Result<Vec<Actuator>, K> {
     let mut actuators: Vec<Actuator> = Vec::new();
     let mut directly_driven: Vec<usize> = Vec::new();
@@ -511,6 +594,12 @@ fn actuators_from_transmissions(doc: &roxmltree::Document, robot: &urdf_rs::Robo
         let fail = |what: String| K::Transmission { transmission: name.clone(), what };
         let joint_nodes: Vec<_> = t.children().filter(|n| n.has_tag_name("joint")).collect();
         let actuator_nodes: Vec<_> = t.children().filter(|n| n.has_tag_name("actuator")).collect();
+        if joint_nodes.is_empty() {
+            // e.g. PR2's pr2_mechanism_model transmissions (<flexJoint>, <gap_joint>, …)
+            let kind = t.children().find(|n| n.has_tag_name("type")).and_then(|n| n.text()).or(t.attribute("type")).unwrap_or("unknown");
+            notices.push(format!("transmission '{name}' (type '{}') has no <joint> element; ignoring it", kind.trim()));
+            continue;
+        }
         if joint_nodes.len() != 1 || actuator_nodes.len() > 1 {
             // e.g. a differential wrist: its joints are driven directly, with their URDF effort limits
             notices.push(format!(
@@ -523,7 +612,11 @@ fn actuators_from_transmissions(doc: &roxmltree::Document, robot: &urdf_rs::Robo
         }
         let joint_name = joint_nodes[0].attribute("name").ok_or_else(|| fail("<joint> has no name".into()))?;
         let Some(joint) = joints.iter().position(|j| j.name == joint_name) else {
-            let what = if robot.joints.iter().any(|j| j.name == joint_name) { "a fixed joint" } else { "a joint this URDF does not have" };
+            let what = match robot.joints.iter().find(|j| j.name == joint_name) {
+                Some(j) if j.mimic.is_some() && j.joint_type != urdf_rs::JointType::Fixed => "a mimic joint (it follows the joint it mimics)",
+                Some(_) => "a fixed joint",
+                None => "a joint this URDF does not have",
+            };
             notices.push(format!("transmission '{name}' drives joint '{joint_name}', {what}; ignoring the transmission"));
             continue;
         };

@@ -29,7 +29,7 @@ fn series(path: String, label: String) -> Value {
 /// Where the camera looks and from how far: the middle of the links at `q`, from 4× their spread
 /// (at least 0.6 m).
 fn camera(model: &Model, q: &[f64]) -> ([f64; 3], f64) {
-    let mut poses = vec![Pose::identity(); model.joints.len()];
+    let mut poses = vec![Pose::identity(); model.bodies.len()];
     body_poses(model, q, &mut poses);
     let points: Vec<_> = (0..model.frames.len()).map(|f| frame_pose_in(model, &poses, f).translation).collect();
     let (mut lo, mut hi) = (points[0], points[0]);

@@ -554,7 +554,7 @@ impl Recorder for McapRecorder {
             .iter()
             .map(|(_, f)| {
                 let joint = f.body.expect("a moving link has a body");
-                JointTransform { joint, before: placement_of(f.parent_frame).inverse().compose(&model.joints[joint].placement), after: f.placement }
+                JointTransform { joint, before: placement_of(f.parent_frame).inverse().compose(&model.bodies[joint].placement), after: f.placement }
             })
             .collect();
         // links on the same body (or on the world) keep their relative pose: P_parent⁻¹ ∘ P_child
@@ -569,7 +569,8 @@ impl Recorder for McapRecorder {
                 .collect(),
         };
         self.model = Some(run.experiment.model.clone());
-        let names: Vec<String> = model.joints.iter().map(|j| j.name.clone()).collect();
+        // the coordinates, then the joints that mimic them (position and velocity only)
+        let names: Vec<String> = model.joints.iter().map(|j| j.name.clone()).chain(model.mimic_bodies().map(|(_, b, _)| b.name.clone())).collect();
         self.joints_msg = JointStates {
             timestamp: None,
             joints: names.iter().map(|n| JointState { name: n.clone(), ..Default::default() }).collect(),
@@ -616,14 +617,19 @@ impl Recorder for McapRecorder {
         let pose_step = s.k.is_multiple_of(self.steps_per_tf) || s.is_final;
         if pose_step {
             for (m, tf) in self.tf_msg.transforms.iter_mut().zip(&self.joint_tfs) {
-                set_transform(m, &tf.pose(&model.joints[tf.joint], s.q[tf.joint]), ts);
+                set_transform(m, &tf.pose(&model.bodies[tf.joint], model.couplings[tf.joint].position(s.q)), ts);
             }
         }
         self.joints_msg.timestamp = ts;
-        for (j, state) in self.joints_msg.joints.iter_mut().enumerate() {
+        let (coordinates, mimics) = self.joints_msg.joints.split_at_mut(s.q.len());
+        for (j, state) in coordinates.iter_mut().enumerate() {
             state.position = Some(s.q[j]);
             state.velocity = Some(s.v[j]);
             state.effort = Some(s.u[j]);
+        }
+        for (state, (_, _, coupling)) in mimics.iter_mut().zip(model.mimic_bodies()) {
+            state.position = Some(coupling.position(s.q));
+            state.velocity = Some(coupling.multiplier * s.v[coupling.coordinate]);
         }
         let tel = &mut self.telemetry;
         tel.time = s.t;

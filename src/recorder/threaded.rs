@@ -167,7 +167,7 @@ impl<R: Recorder + Send + 'static> Recorder for Threaded<R> {
         let mut inner = self.inner.take().expect("started once");
         inner.start(run)?;
         let model = &run.experiment.model;
-        self.block = SampleBlock::new(model.dof(), model.dof(), self.block_samples);
+        self.block = SampleBlock::new(model.dof(), model.bodies.len(), self.block_samples);
         // named after the recorder, so profiles and debuggers tell the threads apart
         let name = std::any::type_name::<R>().rsplit("::").next().unwrap_or("recorder").to_string();
         let worker = BatchWorker::spawn(&name, inner, |inner: &mut R, block: &SampleBlock| (0..block.len()).try_for_each(|i| inner.record(&block.sample(i))));
