@@ -63,5 +63,44 @@ fn whole_run(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, algorithms, discrete_step, whole_run);
+/// Larger trees (tests/fixtures/robots/, from example-robot-data 6.0.0): Baxter (17 coordinates, 19
+/// moving joints with its mimic fingers), the Allegro hand (16), Tiago (48). Reference: Pinocchio
+/// in C++ on the same URDFs (.ci/bench-reference), MuJoCo's rollout.
+fn large_trees(c: &mut Criterion) {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/robots");
+    for file in ["baxter.urdf", "allegro_right_hand.urdf", "tiago.urdf"] {
+        let experiment = Experiment::prepare(RunConfig { urdf: dir.join(file), ..RunConfig::default() }).unwrap();
+        let model = &*experiment.model;
+        let n = model.dof();
+        let mut data = Data::new(model);
+        // a state away from every limit: each joint at 0.3 of its range, or 0.3 rad
+        let q: Vec<f64> = model.joints.iter().map(|j| if j.lower.is_finite() && j.upper.is_finite() { j.lower + 0.3 * (j.upper - j.lower) } else { 0.3 }).collect();
+        let v: Vec<f64> = (0..n).map(|i| -1.0 + 2.0 * i as f64 / n as f64).collect();
+        let tau: Vec<f64> = v.iter().map(|x| -x).collect();
+        let name = file.trim_end_matches(".urdf");
+        let mut group = c.benchmark_group(format!("{name}_{n}dof"));
+        if !model.has_mimic() {
+            group.bench_function("aba", |b| b.iter(|| black_box(aba(model, &mut data, black_box(&q), black_box(&v), black_box(&tau))[0])));
+        }
+        group.bench_function("rnea", |b| b.iter(|| black_box(rnea(model, &mut data, black_box(&q), black_box(&v), black_box(&tau))[0])));
+        group.bench_function("crba", |b| b.iter(|| black_box(crba(model, &mut data, black_box(&q))[(0, 0)])));
+        let mut plant = experiment.make_plant();
+        let u = vec![0.0; n];
+        group.bench_function("discrete_step", |b| {
+            b.iter_batched_ref(
+                || (q.clone(), v.clone()),
+                |(q, v)| {
+                    forward_kinematics(model, &mut data, q);
+                    gravity_and_bias_from_kinematics(model, &mut data, v);
+                    plant.advance(model, &mut data, &u, q, v);
+                    black_box(q[0])
+                },
+                criterion::BatchSize::SmallInput,
+            )
+        });
+        group.finish();
+    }
+}
+
+criterion_group!(benches, algorithms, discrete_step, whole_run, large_trees);
 criterion_main!(benches);
