@@ -236,6 +236,8 @@ pub struct McapRecorder {
     steps_per_tf: usize,
     tool_path: ToolPath,
     last_scene_second: i64,
+    /// Simulated seconds between republished geometries: 1 for small scenes, longer for big meshes.
+    scene_interval_s: i64,
 }
 
 /// Points of the tool path at most in one piece (a piece every half simulated second at 20 Hz).
@@ -325,6 +327,7 @@ impl McapRecorder {
             steps_per_tf: 10,
             tool_path: ToolPath::default(),
             last_scene_second: -1,
+            scene_interval_s: 1,
         }
     }
 
@@ -411,6 +414,16 @@ fn media_type(path: &std::path::Path) -> &'static str {
         _ => "model/gltf+json",
     }
 }
+
+/// How often the geometry is republished: once a simulated second, but at most
+/// [`SCENE_BYTES_PER_SECOND`] on average — a robot drawn from meshes (a Panda's are 7 MB) is
+/// republished every few minutes instead of every second, which would have been most of its file.
+fn scene_interval_s(scene_bytes: usize) -> i64 {
+    (scene_bytes as f64 / SCENE_BYTES_PER_SECOND).ceil().max(1.0) as i64
+}
+
+/// The geometry's share of the MCAP, bytes per simulated second (the whole file is ~450 kB/s).
+pub const SCENE_BYTES_PER_SECOND: f64 = 20_000.0;
 
 /// One scene entity per link with visuals, locked to the link's frame.
 fn scene_from_model(model: &Model) -> Result<SceneUpdate, (PathBuf, std::io::Error)> {
@@ -588,6 +601,8 @@ impl Recorder for McapRecorder {
             tool_position: Vec::with_capacity(3),
         };
         self.scene = scene_from_model(model).map_err(|(path, err)| Error::output(&path, err))?;
+        let scene_bytes = foxglove::Encode::encoded_len(&self.scene).unwrap_or(0);
+        self.scene_interval_s = scene_interval_s(scene_bytes);
 
         let t0 = self.stamp(0.0);
         let path = self.path.clone();
@@ -658,9 +673,9 @@ impl Recorder for McapRecorder {
             let tool = frame_pose_in(model, s.body_pose, model.tool_frame);
             out.log(&mut ch.tool_pose, &PoseInFrame { timestamp: ts, frame_id: "world".into(), pose: Some(fox_pose(&tool)) }, stamp).map_err(fail)?;
         }
-        // geometry once a simulated second, so a viewer that seeks always has it
+        // the geometry again every few simulated seconds, so a viewer that seeks always has it
         let second = s.t.floor() as i64;
-        if second > self.last_scene_second {
+        if self.last_scene_second < 0 || second >= self.last_scene_second + self.scene_interval_s {
             self.last_scene_second = second;
             for entity in &mut self.scene.entities {
                 entity.timestamp = ts;
@@ -707,6 +722,18 @@ impl Recorder for McapRecorder {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Primitive shapes (a few kB) once a simulated second; a 7 MB mesh scene (a Panda) every 350 s,
+    /// so the geometry stays at most 20 kB per simulated second of the file.
+    #[test]
+    fn geometry_is_republished_at_a_bounded_byte_rate() {
+        assert_eq!(scene_interval_s(0), 1);
+        assert_eq!(scene_interval_s(3_000), 1);
+        assert_eq!(scene_interval_s(7_000_000), 350);
+        for bytes in [25_000, 1_000_000, 7_000_000] {
+            assert!(bytes as f64 / scene_interval_s(bytes) as f64 <= SCENE_BYTES_PER_SECOND);
+        }
+    }
 
     /// The same telemetry-like messages, written with zstd at `level`: the file's size.
     fn mcap_size(level: u32) -> usize {
