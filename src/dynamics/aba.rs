@@ -5,7 +5,7 @@ use crate::spatial::{cross_force, cross_motion};
 use nalgebra::Vector6;
 
 /// Forward dynamics q̈ = M⁻¹(τ + τ_g − C q̇) by the articulated-body algorithm, into `data.qdd`.
-/// Joint damping is not included: pass τ − D q̇ for it.
+/// Joint damping is not included: pass τ − D q̇ for it. The motors' reflected inertias are.
 pub fn aba<'d>(model: &Model, data: &'d mut Data, q: &[f64], v: &[f64], tau: &[f64]) -> &'d [f64] {
     forward_kinematics(model, data, q);
     aba_from_kinematics(model, data, v, tau);
@@ -35,7 +35,8 @@ pub fn aba_from_kinematics(model: &Model, data: &mut Data, v: &[f64], tau: &[f64
         let s = data.motion_subspace[i];
         let ia = data.articulated_inertia[i];
         let u_vec = ia * s;
-        let d = s.dot(&u_vec);
+        // a rotor's reflected inertia acts on the joint alone (Featherstone's armature; Pinocchio's D_i)
+        let d = s.dot(&u_vec) + model.armature[i];
         let u = tau[i] - s.dot(&data.articulated_bias[i]);
         data.aba_u[i] = u_vec;
         data.aba_d[i] = d;

@@ -3,7 +3,7 @@ use crate::model::Model;
 
 /// The joint-space mass matrix M(q), into `data.mass_matrix` (both triangles). With `<mimic>`
 /// joints, the matrix of the coordinates: GᵀM_bodies G, each body's entries added into its
-/// coordinate's row and column.
+/// coordinate's row and column. The motors' reflected inertias are on its diagonal.
 pub fn crba<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> &'d nalgebra::DMatrix<f64> {
     forward_kinematics(model, data, q);
     crba_from_kinematics(model, data);
@@ -34,5 +34,9 @@ pub fn crba_from_kinematics(model: &Model, data: &mut Data) {
             let c = data.composite_inertia[i];
             data.composite_inertia[p] += c;
         }
+    }
+    // the motors' rotors, J_r·N² on the diagonal (Drake: M.diagonal() += reflected_inertia)
+    for (c, a) in model.armature.iter().enumerate() {
+        data.mass_matrix[(c, c)] += a;
     }
 }

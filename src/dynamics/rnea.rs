@@ -9,7 +9,8 @@ pub(crate) fn base_acceleration(model: &Model) -> Vector6<f64> {
     spatial(Vector3::zeros(), -model.gravity)
 }
 
-/// Inverse dynamics: τ = M(q) q̈ + C(q,q̇) q̇ − τ_g(q), into `data.tau`.
+/// Inverse dynamics: τ = M(q) q̈ + C(q,q̇) q̇ − τ_g(q), into `data.tau` (M with the motors'
+/// reflected inertias).
 pub fn rnea<'d>(model: &Model, data: &'d mut Data, q: &[f64], v: &[f64], a: &[f64]) -> &'d [f64] {
     forward_kinematics(model, data, q);
     rnea_from_kinematics(model, data, v, a);
@@ -40,6 +41,10 @@ pub fn rnea_from_kinematics(model: &Model, data: &mut Data, v: &[f64], a: &[f64]
             let f = data.force[i];
             data.force[p] += f;
         }
+    }
+    // the motors' rotors: J_r·N²·q̈ (as in CRBA and ABA)
+    for (c, armature) in model.armature.iter().enumerate() {
+        data.tau[c] += armature * a[c];
     }
 }
 

@@ -92,8 +92,18 @@ pub struct Actuator {
     pub joint: usize,
     /// Torque (force) limit at the joint.
     pub effort: f64,
-    /// `<mechanicalReduction>`; 1 when the URDF gives none.
+    /// The gear ratio N: `<drake:gear_ratio>`, else `<mechanicalReduction>`, else 1.
     pub gear_ratio: f64,
+    /// The motor's rotor inertia J_r (kg·m²), `<drake:rotor_inertia>`; 0 when not given.
+    pub rotor_inertia: f64,
+}
+
+impl Actuator {
+    /// The rotor's inertia seen at the joint, J_r·N² (Drake's reflected inertia, MuJoCo's and
+    /// Pinocchio's armature).
+    pub fn reflected_inertia(&self) -> f64 {
+        self.rotor_inertia * self.gear_ratio * self.gear_ratio
+    }
 }
 
 #[derive(Clone, Debug)]
@@ -114,6 +124,9 @@ pub struct Model {
     pub couplings: Vec<Coupling>,
     pub frames: Vec<Frame>,
     pub actuators: Vec<Actuator>,
+    /// Per coordinate, the reflected inertia of its motor's rotor, J_r·N², added to M's diagonal by
+    /// every algorithm (CRBA, ABA), as Drake does. Zero without rotor inertias.
+    pub armature: Vec<f64>,
     /// The frame whose origin is the tool tip: the deepest leaf link unless chosen otherwise.
     pub tool_frame: usize,
     /// Things the loader did on the user's behalf (e.g. welding a free root to the world).

@@ -186,6 +186,10 @@ fn build(text: &str, source: &Path, options: LoadOptions) -> Result<Model, K> {
     }
 
     let actuators = motors(&doc, &robot, &joints, &mut notices)?;
+    let mut armature = vec![0.0; joints.len()];
+    for a in &actuators {
+        armature[a.joint] += a.reflected_inertia();
+    }
 
     // Tool: the deepest leaf link (first one in tree order on a tie).
     let is_leaf = |f: usize| !frames.iter().any(|g| g.parent_frame == Some(f));
@@ -201,6 +205,7 @@ fn build(text: &str, source: &Path, options: LoadOptions) -> Result<Model, K> {
         couplings,
         frames,
         actuators,
+        armature,
         tool_frame,
         notices,
     };
@@ -568,7 +573,7 @@ fn motors(doc: &roxmltree::Document, robot: &urdf_rs::Robot, joints: &[Joint], n
         if has_transmissions {
             direct.push(joint.name.as_str());
         }
-        actuators.push(Actuator { name: joint.name.clone(), joint: i, effort: joint.effort, gear_ratio: 1.0 });
+        actuators.push(Actuator { name: joint.name.clone(), joint: i, effort: joint.effort, gear_ratio: 1.0, rotor_inertia: 0.0 });
     }
     let list = |names: &[&str]| names.iter().map(|n| format!("'{n}'")).collect::<Vec<_>>().join(", ");
     if !direct.is_empty() {
@@ -628,18 +633,29 @@ fn actuators_from_transmissions(doc: &roxmltree::Document, robot: &urdf_rs::Robo
             .first()
             .and_then(|a| a.children().find(|n| n.has_tag_name("mechanicalReduction")))
             .or_else(|| t.children().find(|n| n.has_tag_name("mechanicalReduction")));
-        let gear_ratio = match reduction_node.and_then(|n| n.text()) {
-            None => 1.0,
+        let reduction = match reduction_node.and_then(|n| n.text()) {
+            None => None,
             Some(text) => match text.trim().parse::<f64>() {
-                Ok(r) if r.is_finite() && r != 0.0 => r,
+                Ok(r) if r.is_finite() && r != 0.0 => Some(r),
                 _ => return Err(fail(format!("mechanicalReduction '{}' is not a finite non-zero number", text.trim()))),
             },
         };
-        actuators.push(Actuator { name: actuator_name, joint, effort: joints[joint].effort, gear_ratio });
+        // Drake's own tags (xmlns:drake="http://drake.mit.edu"), matched by local name
+        let drake_value = |tag: &str, positive: bool| -> Result<Option<f64>, K> {
+            let Some(node) = actuator_nodes.first().and_then(|a| a.children().find(|n| n.is_element() && n.tag_name().name() == tag)) else { return Ok(None) };
+            let text = node.attribute("value").ok_or_else(|| fail(format!("<drake:{tag}> has no value attribute")))?;
+            match text.trim().parse::<f64>() {
+                Ok(x) if x.is_finite() && (if positive { x > 0.0 } else { x >= 0.0 }) => Ok(Some(x)),
+                _ => Err(fail(format!("<drake:{tag} value='{}'> must be a finite {} number", text.trim(), if positive { "positive" } else { "non-negative" }))),
+            }
+        };
+        let gear_ratio = drake_value("gear_ratio", true)?.or(reduction).unwrap_or(1.0);
+        let rotor_inertia = drake_value("rotor_inertia", false)?.unwrap_or(0.0);
+        actuators.push(Actuator { name: actuator_name, joint, effort: joints[joint].effort, gear_ratio, rotor_inertia });
     }
     for joint in directly_driven {
         if !actuators.iter().any(|a| a.joint == joint) {
-            actuators.push(Actuator { name: joints[joint].name.clone(), joint, effort: joints[joint].effort, gear_ratio: 1.0 });
+            actuators.push(Actuator { name: joints[joint].name.clone(), joint, effort: joints[joint].effort, gear_ratio: 1.0, rotor_inertia: 0.0 });
         }
     }
     Ok(actuators)
