@@ -1,5 +1,5 @@
 //! Files built into the binary, so that `cargo install` gives a tool that runs its own defaults in
-//! any folder: the tutorial's box model and its batch manifest. A default path that exists on disk
+//! any folder: the tutorial's box model, its batch manifest, the motor catalogue and motor files. A default path that exists on disk
 //! (the repository's own `assets/`) is read from disk; where it does not, the built-in copy is used.
 
 use std::path::Path;
@@ -7,9 +7,12 @@ use std::path::Path;
 pub const DEFAULT_URDF: &str = "assets/smallrobot_arm.urdf";
 pub const DEFAULT_MANIFEST: &str = "assets/experiments/tutorial.toml";
 
-const FILES: [(&str, &str); 2] = [
+const FILES: [(&str, &str); 5] = [
     (DEFAULT_URDF, include_str!("../assets/smallrobot_arm.urdf")),
     (DEFAULT_MANIFEST, include_str!("../assets/experiments/tutorial.toml")),
+    (crate::actuator::catalogue::DEFAULT_CATALOGUE, include_str!("../assets/motors/catalogue.toml")),
+    ("assets/motors/tutorial.toml", include_str!("../assets/motors/tutorial.toml")),
+    ("assets/motors/smallrobotarm.toml", include_str!("../assets/motors/smallrobotarm.toml")),
 ];
 
 /// The text of `path`: the file's, or the built-in copy when `path` is a default that is not on disk.

@@ -270,6 +270,11 @@ pub struct RunArgs {
     /// (default: each joint's 0 clamped into its range). The default wave swings around them.
     #[arg(long, value_name = "LIST", allow_hyphen_values = true)]
     pub q0: Option<String>,
+    /// A motor file (TOML): each joint's motor from the catalogue (assets/motors/catalogue.toml, built
+    /// in) and its gearbox (ratio, efficiency, rated torque); the torque a joint can get then falls
+    /// with its speed. E.g. assets/motors/tutorial.toml.
+    #[arg(long, value_name = "FILE")]
+    pub motors: Option<PathBuf>,
 
     /// Write the tutorial's CSV (t, q, tool xyz every --print-every).
     #[arg(long, value_name = "PATH")]
@@ -387,6 +392,7 @@ impl RunArgs {
             divergence_speed: self.divergence_speed,
             strict_inertia: self.strict_inertia,
             q0: self.q0.clone(),
+            motors: self.motors.clone(),
         }
     }
 }

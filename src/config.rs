@@ -56,6 +56,8 @@ pub struct RunConfig {
     /// Initial joint positions: a comma list in joint order, or NAME=VALUE pairs (others: 0
     /// clamped into the joint's range).
     pub q0: Option<String>,
+    /// A motor file: each named joint's motor and drive train (its torque falls with speed).
+    pub motors: Option<PathBuf>,
 }
 
 pub use crate::builtin::DEFAULT_URDF;
@@ -88,6 +90,7 @@ impl Default for RunConfig {
             divergence_speed: 1e4,
             strict_inertia: false,
             q0: None,
+            motors: None,
         }
     }
 }

@@ -1,7 +1,8 @@
 //! The tutorial's joint controller: PD on the command plus gravity feed-forward, clipped to the
 //! motors' limits.
 
-/// u = kp∘(cmd − q) + kd∘(cmd_dot − q̇) − τ_g(q), clipped to ±effort; zero on unactuated joints.
+/// u = kp∘(cmd − q) + kd∘(cmd_dot − q̇) − τ_g(q), clipped to ±effort (with `--motors`, to what the
+/// motor gives at the joint's speed through its gearbox); zero on unactuated joints.
 #[derive(Clone, Debug)]
 pub struct PdGravityController {
     pub kp: Vec<f64>,
@@ -11,6 +12,8 @@ pub struct PdGravityController {
     pub actuated: Vec<bool>,
     /// Gravity feed-forward (off with `--no-ff`).
     pub feed_forward: bool,
+    /// Motors whose torque falls with speed (`--motors`); `effort` elsewhere.
+    pub motors: Option<std::sync::Arc<crate::actuator::MotorSet>>,
 }
 
 /// One controller output.
@@ -19,6 +22,8 @@ pub struct ControlOutput<'a> {
     pub u: &'a mut [f64],
     /// Whether the unclipped torque exceeded the limit.
     pub saturated: &'a mut [bool],
+    /// The limit at this step (the motor's torque at the joint's speed, through its gearbox).
+    pub limit: &'a mut [f64],
 }
 
 impl PdGravityController {
@@ -30,17 +35,22 @@ impl PdGravityController {
 
     #[allow(clippy::too_many_arguments)]
     pub fn compute(&self, q: &[f64], v: &[f64], cmd: &[f64], cmd_dot: &[f64], tau_g: &[f64], out: ControlOutput) {
+        match &self.motors {
+            Some(m) => m.torque_limits(v, &self.effort, out.limit),
+            None => out.limit.copy_from_slice(&self.effort),
+        }
         for i in 0..q.len() {
             if !self.actuated[i] {
                 out.u[i] = 0.0;
                 out.saturated[i] = false;
+                out.limit[i] = 0.0;
                 continue;
             }
             let mut u = self.kp[i] * (cmd[i] - q[i]) + self.kd[i] * (cmd_dot[i] - v[i]);
             if self.feed_forward {
                 u -= tau_g[i];
             }
-            let limit = self.effort[i];
+            let limit = out.limit[i];
             out.saturated[i] = u.abs() > limit;
             out.u[i] = u.clamp(-limit, limit);
         }

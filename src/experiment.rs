@@ -5,7 +5,8 @@ use crate::controller::PdGravityController;
 use crate::error::Error;
 use crate::gains::{Gains, TUTORIAL_KD, TUTORIAL_KP, auto_tune, is_tutorial_model};
 use crate::integrator::{ContinuousPlant, DiscretePlant, Plant, Tolerances};
-use crate::model::{LoadOptions, Model, load_urdf_with};
+use crate::actuator::{MotorSet, load_motor_file};
+use crate::model::{Actuator, LoadOptions, Model, load_urdf_with};
 use crate::analysis::LoopPlant;
 use crate::trajectory::{Hold, JointSchedule, JointStep, JointWave, Trajectory, Wave};
 use nalgebra::Vector3;
@@ -29,6 +30,8 @@ pub struct Experiment {
     pub steps: usize,
     /// The start pose (`--q0`, or 0 clamped into each joint's range).
     pub start: Vec<f64>,
+    /// The motors of `--motors`: each named joint's torque limit at its speed.
+    pub motors: Option<Arc<MotorSet>>,
 }
 
 impl Experiment {
@@ -59,12 +62,16 @@ impl Experiment {
         if let Some(tool) = &config.tool {
             model.set_tool_frame(tool).map_err(|m| Error::flag("--tool", m))?;
         }
+        let motors = match &config.motors {
+            Some(path) => Some(Arc::new(apply_motor_file(path, &mut model)?)),
+            None => None,
+        };
         let plant = plant_spec(&config)?;
         let start = start_pose(&config, &model)?;
         let trajectory = trajectory(&config, &model, &start)?;
         let gains = gains(&config, &model, &start, trajectory.as_ref(), &plant)?;
         let steps = (config.duration / config.dt - 1e-9).ceil() as usize;
-        Ok(Self { config, model: Arc::new(model), gains, plant, trajectory, steps, start })
+        Ok(Self { config, model: Arc::new(model), gains, plant, trajectory, steps, start, motors })
     }
 
     pub fn controller(&self) -> PdGravityController {
@@ -75,6 +82,7 @@ impl Experiment {
             effort: self.model.effort_limits(),
             actuated: (0..n).map(|i| self.model.is_actuated(i)).collect(),
             feed_forward: !self.config.no_ff,
+            motors: self.motors.clone(),
         }
     }
 
@@ -261,4 +269,22 @@ fn gains(config: &RunConfig, model: &Model, start: &[f64], trajectory: &dyn Traj
         (false, true) => format!("kp {}, kd from flags", base.source),
     };
     Ok(Gains { kp, kd, source, effective_inertia: base.effective_inertia, spectral_radius: base.spectral_radius })
+}
+
+/// Load a motor file and give each joint it names that motor: an actuator whose effort is the torque
+/// the drive train gives at rest, its gear ratio, and the rotor's inertia (so J_r·N² joins M).
+fn apply_motor_file(path: &std::path::Path, model: &mut Model) -> Result<MotorSet, Error> {
+    let set = load_motor_file(path, model)?;
+    for (joint, drive) in set.joints.iter().enumerate() {
+        let Some(drive) = drive else { continue };
+        let actuator = Actuator { name: drive.motor.name().to_string(), joint, effort: drive.torque_limit(0.0), gear_ratio: drive.gear_ratio, rotor_inertia: drive.motor.rotor_inertia() };
+        model.actuators.retain(|a| a.joint != joint);
+        model.actuators.push(actuator);
+    }
+    model.actuators.sort_by_key(|a| a.joint);
+    model.armature = vec![0.0; model.dof()];
+    for a in &model.actuators {
+        model.armature[a.joint] += a.reflected_inertia();
+    }
+    Ok(set)
 }

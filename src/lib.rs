@@ -3,6 +3,7 @@
 //! Data flows one way: [`config::RunConfig`] → [`model::Model`] → [`sim::simulate`] →
 //! [`sample::Sample`]s → [`recorder::Recorder`]s (console, CSV, trace, JSON, …).
 
+pub mod actuator;
 pub mod analysis;
 pub mod batch;
 pub mod builtin;

@@ -20,6 +20,9 @@ pub struct Sample<'a> {
     pub tau_g: &'a [f64],
     /// The controller asked for more than the motor's limit.
     pub saturated: &'a [bool],
+    /// The torque limit at this step: the URDF's effort, or with `--motors` what the motor gives at
+    /// the joint's speed through its gearbox (0 on a passive joint).
+    pub torque_limit: &'a [f64],
     /// Chatter: the torque flipped sign since the previous step while at least one of the two was
     /// saturated (the signature of an unstable sampled loop, not of torque demand).
     pub chatter: &'a [bool],

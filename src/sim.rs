@@ -35,6 +35,7 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
     let (mut q, mut v) = experiment.initial_state();
     let (mut cmd, mut cmd_dot, mut u) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
     let mut saturated = vec![false; n];
+    let mut torque_limit = vec![0.0; n];
     let (mut chatter, mut previous_u, mut previous_saturated) = (vec![false; n], vec![0.0; n], vec![false; n]);
     let mut at_limit = vec![false; n];
     let joint_names: Vec<String> = model.joints.iter().map(|j| j.name.clone()).collect();
@@ -48,7 +49,7 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
         forward_kinematics(model, &mut data, &q);
         gravity_and_bias_from_kinematics(model, &mut data, &v);
         experiment.trajectory.sample(t, &mut cmd, &mut cmd_dot);
-        controller.compute(&q, &v, &cmd, &cmd_dot, &data.gravity, ControlOutput { u: &mut u, saturated: &mut saturated });
+        controller.compute(&q, &v, &cmd, &cmd_dot, &data.gravity, ControlOutput { u: &mut u, saturated: &mut saturated, limit: &mut torque_limit });
         for i in 0..n {
             chatter[i] = k > 0 && u[i] * previous_u[i] < 0.0 && (saturated[i] || previous_saturated[i]);
             previous_u[i] = u[i];
@@ -67,6 +68,7 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
             u: &u,
             tau_g: &data.gravity,
             saturated: &saturated,
+            torque_limit: &torque_limit,
             chatter: &chatter,
             at_limit: &at_limit,
             tool_position: frame_pose(model, &data, model.tool_frame).translation,

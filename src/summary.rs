@@ -47,6 +47,10 @@ pub struct Summary {
     pub chatter_percent: Vec<f64>,
     pub peak_abs_torque: Vec<f64>,
     pub effort_limit: Vec<f64>,
+    /// The lowest torque limit over the run's control steps: with `--motors`, what the motor gave at
+    /// the joint's fastest; the effort limit otherwise.
+    #[serde(default)]
+    pub lowest_torque_limit: Vec<f64>,
     /// Steps at which the joint was stopped at a position limit.
     pub limit_hits: Vec<u64>,
     pub tool_range: ToolRange,
@@ -67,6 +71,7 @@ pub struct SummaryBuilder {
     control_steps: u64,
     peak_torque: Vec<f64>,
     effort: Vec<f64>,
+    lowest_limit: Vec<f64>,
     limit_hits: Vec<u64>,
     tool_min: [f64; 3],
     tool_max: [f64; 3],
@@ -88,6 +93,7 @@ impl SummaryBuilder {
             chatter_steps: vec![0; n],
             control_steps: 0,
             peak_torque: vec![0.0; n],
+            lowest_limit: effort.clone(),
             effort,
             limit_hits: vec![0; n],
             tool_min: [f64::INFINITY; 3],
@@ -112,6 +118,7 @@ impl SummaryBuilder {
                 self.saturated_steps[i] += s.saturated[i] as u64;
                 self.chatter_steps[i] += s.chatter[i] as u64;
                 self.peak_torque[i] = self.peak_torque[i].max(s.u[i].abs());
+                self.lowest_limit[i] = self.lowest_limit[i].min(s.torque_limit[i]);
             }
         }
         for i in 0..n {
@@ -147,6 +154,7 @@ impl SummaryBuilder {
             chatter_percent: share_of_control_steps(&self.chatter_steps),
             peak_abs_torque: self.peak_torque.clone(),
             effort_limit: self.effort.clone(),
+            lowest_torque_limit: self.lowest_limit.clone(),
             limit_hits: self.limit_hits.clone(),
             tool_range: ToolRange { x: range(0), y: range(1), z: range(2) },
             wall_time,

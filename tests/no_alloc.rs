@@ -44,12 +44,12 @@ fn allocations_in_steps(config: RunConfig) -> usize {
     let mut plant = experiment.make_plant();
     let controller = experiment.controller();
     let (mut q, mut v) = experiment.initial_state();
-    let (mut cmd, mut cmd_dot, mut u, mut sat) = (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![false; n]);
+    let (mut cmd, mut cmd_dot, mut u, mut sat, mut limit) = (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![false; n], vec![0.0; n]);
     let mut step = |k: usize, q: &mut Vec<f64>, v: &mut Vec<f64>| {
         forward_kinematics(model, &mut data, q);
         gravity_and_bias_from_kinematics(model, &mut data, v);
         experiment.trajectory.sample(k as f64 * 0.001, &mut cmd, &mut cmd_dot);
-        controller.compute(q, v, &cmd, &cmd_dot, &data.gravity, ControlOutput { u: &mut u, saturated: &mut sat });
+        controller.compute(q, v, &cmd, &cmd_dot, &data.gravity, ControlOutput { u: &mut u, saturated: &mut sat, limit: &mut limit });
         std::hint::black_box(frame_pose(model, &data, model.tool_frame));
         plant.advance(model, &mut data, &u, q, v);
     };

@@ -82,6 +82,11 @@ impl Console {
         )
         .map_err(io)?;
         writeln!(self.out, "  plant: {}", run.plant).map_err(io)?;
+        if let Some(motors) = &e.motors {
+            let names: Vec<String> = m.joints.iter().map(|j| j.name.clone()).collect();
+            writeln!(self.out, "  motors ({}): the torque limit falls with the joint's speed", motors.source.display()).map_err(io)?;
+            write!(self.out, "{}", motors.table(&names)).map_err(io)?;
+        }
         writeln!(self.out, "  command: {}", run.trajectory).map_err(io)?;
         writeln!(
             self.out,
@@ -151,7 +156,10 @@ pub fn write_summary(out: &mut dyn Write, s: &Summary) -> std::io::Result<()> {
     writeln!(out, "{}", row("saturation (%)", s.saturation_percent.iter().map(|p| format!("{p:.1}")).collect()))?;
     writeln!(out, "{}", row("chatter (%)", s.chatter_percent.iter().map(|p| format!("{p:.1}")).collect()))?;
     writeln!(out, "{}", row("peak |u| (N·m)", s.peak_abs_torque.iter().map(|p| format!("{p:.3}")).collect()))?;
-    writeln!(out, "{}", row("effort limit (N·m)", s.effort_limit.iter().map(|p| format!("{p}")).collect()))?;
+    writeln!(out, "{}", row("effort limit (N·m)", s.effort_limit.iter().map(|p| format!("{}", (p * 1e3).round() / 1e3)).collect()))?;
+    if s.lowest_torque_limit.iter().zip(&s.effort_limit).any(|(a, b)| a != b) {
+        writeln!(out, "{}", row("lowest limit (N·m)", s.lowest_torque_limit.iter().map(|p| format!("{p:.3}")).collect()))?;
+    }
     writeln!(out, "{}", row("limit hits (steps)", s.limit_hits.iter().map(|p| format!("{p}")).collect()))?;
     let r = &s.tool_range;
     writeln!(

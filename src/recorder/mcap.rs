@@ -599,6 +599,7 @@ impl Recorder for McapRecorder {
             chatter: vec![0; n],
             tool_error: 0.0,
             tool_position: Vec::with_capacity(3),
+            torque_limit: vec![0.0; n],
         };
         self.scene = scene_from_model(model).map_err(|(path, err)| Error::output(&path, err))?;
         let scene_bytes = foxglove::Encode::encoded_len(&self.scene).unwrap_or(0);
@@ -658,6 +659,7 @@ impl Recorder for McapRecorder {
             tel.tau_g[j] = s.tau_g[j];
             tel.saturated[j] = s.saturated[j] as u32;
             tel.chatter[j] = s.chatter[j] as u32;
+            tel.torque_limit[j] = s.torque_limit[j];
         }
         let path = &self.path;
         let fail = |e: String| Error::output(path, e);

@@ -52,6 +52,9 @@ struct JointColumns {
     status: Vec<f64>,
     saturated_times: Vec<f64>,
     saturated_torque: Vec<f64>,
+    /// `joints/<joint>/torque_limit` per step, [+limit, −limit], when the limit falls with speed
+    /// (`--motors`); otherwise two lines spanning each block.
+    limit: Vec<f64>,
 }
 
 impl JointColumns {
@@ -62,11 +65,12 @@ impl JointColumns {
             status: Vec::with_capacity(3 * n),
             saturated_times: Vec::new(),
             saturated_torque: Vec::new(),
+            limit: Vec::new(),
         }
     }
 
     fn clear(&mut self) {
-        for c in [&mut self.position, &mut self.torque, &mut self.status, &mut self.saturated_times, &mut self.saturated_torque] {
+        for c in [&mut self.position, &mut self.torque, &mut self.status, &mut self.saturated_times, &mut self.saturated_torque, &mut self.limit] {
             c.clear();
         }
     }
@@ -89,6 +93,8 @@ pub struct RerunRecorder {
     model: Option<Arc<Model>>,
     joint_names: Vec<String>,
     effort: Vec<f64>,
+    /// The torque limit falls with speed (`--motors`): recorded at every step.
+    speed_dependent_limit: bool,
     times: Vec<f64>,
     joints: Vec<JointColumns>,
     /// [x, y, z] per step.
@@ -130,6 +136,7 @@ impl RerunRecorder {
             model: None,
             joint_names: Vec::new(),
             effort: Vec::new(),
+            speed_dependent_limit: false,
             times: Vec::new(),
             joints: Vec::new(),
             tool: Vec::new(),
@@ -325,9 +332,11 @@ impl RerunRecorder {
                 let times = TimeColumn::new_duration_secs(TIMELINE, c.saturated_times.iter().copied());
                 send(&format!("{base}/saturated_torque"), times, scalars(&c.saturated_torque, 1))?;
             }
-            // the limits as lines spanning the block: two points each
+            // the limits: at every step when they fall with speed, else as lines spanning the block
             let effort = self.effort[j];
-            if effort.is_finite() {
+            if self.speed_dependent_limit {
+                send(&format!("{base}/torque_limit"), time.clone(), scalars(&c.limit, 2))?;
+            } else if effort.is_finite() {
                 let ends = TimeColumn::new_duration_secs(TIMELINE, [self.times[0], self.times[steps - 1]]);
                 send(&format!("{base}/torque_limit"), ends, scalars(&[effort, -effort, effort, -effort], 2))?;
             }
@@ -551,6 +560,7 @@ impl Recorder for RerunRecorder {
         let rec = self.open_stream()?;
         self.joint_names = model.joints.iter().map(|j| j.name.clone()).collect();
         self.effort = e.controller().effort;
+        self.speed_dependent_limit = e.motors.is_some();
         let cap = FILE_BLOCK_STEPS + 1;
         self.times = Vec::with_capacity(cap);
         self.joints = (0..model.dof()).map(|_| JointColumns::with_capacity(cap)).collect();
@@ -599,6 +609,9 @@ impl Recorder for RerunRecorder {
             let flag = |b: bool| if b { 1.0 } else { 0.0 };
             c.position.extend_from_slice(&[s.q[j], s.cmd[j]]);
             c.torque.extend_from_slice(&[s.u[j], s.tau_g[j]]);
+            if self.speed_dependent_limit {
+                c.limit.extend_from_slice(&[s.torque_limit[j], -s.torque_limit[j]]);
+            }
             c.status.extend_from_slice(&[s.tracking_error(j), flag(s.saturated[j]), flag(s.chatter[j])]);
             if s.saturated[j] {
                 c.saturated_times.push(s.t);

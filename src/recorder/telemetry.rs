@@ -41,6 +41,10 @@ pub struct ControllerTelemetry {
     /// Tool tip position [x, y, z] in the world frame, m.
     #[prost(double, repeated, tag = "9")]
     pub tool_position: Vec<f64>,
+    /// The torque the joint could get at this step, N·m: the URDF's effort, or with `--motors` what
+    /// the motor gives at the joint's speed through its gearbox.
+    #[prost(double, repeated, tag = "10")]
+    pub torque_limit: Vec<f64>,
 }
 
 /// The schema as MCAP's protobuf profile wants it: a serialized FileDescriptorSet. Kept next to
@@ -66,6 +70,7 @@ pub fn file_descriptor_set() -> Vec<u8> {
             field("chatter", 7, true, Type::Uint32),
             field("tool_error", 8, false, Type::Double),
             field("tool_position", 9, true, Type::Double),
+            field("torque_limit", 10, true, Type::Double),
         ],
         ..Default::default()
     };

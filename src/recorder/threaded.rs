@@ -32,6 +32,7 @@ struct SampleBlock {
     cmd_dot: Vec<f64>,
     u: Vec<f64>,
     tau_g: Vec<f64>,
+    torque_limit: Vec<f64>,
     saturated: Vec<bool>,
     chatter: Vec<bool>,
     at_limit: Vec<bool>,
@@ -55,6 +56,7 @@ impl SampleBlock {
             cmd_dot: f(),
             u: f(),
             tau_g: f(),
+            torque_limit: f(),
             saturated: Vec::with_capacity(capacity * n),
             chatter: Vec::with_capacity(capacity * n),
             at_limit: Vec::with_capacity(capacity * n),
@@ -78,6 +80,7 @@ impl SampleBlock {
         self.cmd_dot.extend_from_slice(s.cmd_dot);
         self.u.extend_from_slice(s.u);
         self.tau_g.extend_from_slice(s.tau_g);
+        self.torque_limit.extend_from_slice(s.torque_limit);
         self.saturated.extend_from_slice(s.saturated);
         self.chatter.extend_from_slice(s.chatter);
         self.at_limit.extend_from_slice(s.at_limit);
@@ -98,6 +101,7 @@ impl SampleBlock {
             cmd_dot: &self.cmd_dot[a..b],
             u: &self.u[a..b],
             tau_g: &self.tau_g[a..b],
+            torque_limit: &self.torque_limit[a..b],
             saturated: &self.saturated[a..b],
             chatter: &self.chatter[a..b],
             at_limit: &self.at_limit[a..b],
@@ -113,7 +117,7 @@ impl Reusable for SampleBlock {
         self.k.clear();
         self.t.clear();
         self.is_final.clear();
-        for v in [&mut self.q, &mut self.v, &mut self.cmd, &mut self.cmd_dot, &mut self.u, &mut self.tau_g] {
+        for v in [&mut self.q, &mut self.v, &mut self.cmd, &mut self.cmd_dot, &mut self.u, &mut self.tau_g, &mut self.torque_limit] {
             v.clear();
         }
         self.saturated.clear();

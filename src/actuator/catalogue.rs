@@ -1,0 +1,237 @@
+//! Motor catalogues and motor files (TOML).
+//!
+//! A catalogue (`assets/motors/catalogue.toml`, built in) names real motors:
+//!
+//! ```toml
+//! [17HS4401]
+//! kind = "stepper"            # or "servo"
+//! holding_torque = 0.40       # N·m
+//! rotor_inertia = 5.4e-6      # kg·m²
+//! step_angle = 1.8            # degrees
+//! inductance = 2.8e-3         # H, with current (A) and supply_voltage (V): the derived pull-out curve
+//! current = 1.7
+//! supply_voltage = 24
+//! # pull_out = [[0, 0.40], [5, 0.30], [10, 0.15]]   # or measured points, rev/s and N·m
+//! # gearbox_ratio / gearbox_efficiency / gearbox_rated_torque: a gearmotor's own gearbox
+//! ```
+//!
+//! A motor file (`--motors FILE.toml`) gives joints a motor and a drive train:
+//!
+//! ```toml
+//! catalogue = "my_motors.toml"   # optional, beside this file; the built-in catalogue otherwise
+//! [joints.J1]
+//! motor = "17HS4401"
+//! gear_ratio = 15                # the reduction after the motor (and after its own gearbox)
+//! efficiency = 0.9               # of that reduction
+//! rated_torque = 9               # N·m at the joint
+//! ```
+
+use super::{DcServo, DriveTrain, Motor, MotorSet, PullOut, Stepper};
+use crate::error::Error;
+use crate::model::Model;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use toml::Value;
+
+pub const DEFAULT_CATALOGUE: &str = "assets/motors/catalogue.toml";
+
+/// Catalogue entries by name, as TOML tables (each made into a motor when a joint uses it).
+#[derive(Debug, Default)]
+pub struct Catalogue {
+    pub entries: BTreeMap<String, toml::Table>,
+    pub source: PathBuf,
+}
+
+fn fail(file: &Path, message: String) -> Error {
+    Error::flag("--motors", format!("{}: {message}", file.display()))
+}
+
+impl Catalogue {
+    pub fn load(path: &Path) -> Result<Self, Error> {
+        let text = crate::builtin::read_to_string(path).map_err(|e| fail(path, format!("cannot read: {e}")))?;
+        Self::parse(&text, path)
+    }
+
+    pub fn parse(text: &str, path: &Path) -> Result<Self, Error> {
+        let table: toml::Table = text.parse().map_err(|e: toml::de::Error| fail(path, e.message().to_string()))?;
+        let mut entries = BTreeMap::new();
+        for (name, value) in table {
+            let Value::Table(t) = value else { return Err(fail(path, format!("motor '{name}': expected a table"))) };
+            let catalogue = Self { entries: BTreeMap::new(), source: path.to_path_buf() };
+            catalogue.motor_from(&name, &t)?; // every entry checked at load
+            entries.insert(name, t);
+        }
+        Ok(Self { entries, source: path.to_path_buf() })
+    }
+
+    /// The motor named `name`, with its own gearbox (ratio, efficiency, rated torque at its output).
+    pub fn motor(&self, name: &str) -> Result<(Box<dyn Motor>, f64, f64, f64), Error> {
+        let t = self.entries.get(name).ok_or_else(|| fail(&self.source, format!("no motor '{name}' (known: {})", self.entries.keys().cloned().collect::<Vec<_>>().join(", "))))?;
+        self.motor_from(name, t)
+    }
+
+    fn motor_from(&self, name: &str, t: &toml::Table) -> Result<(Box<dyn Motor>, f64, f64, f64), Error> {
+        let what = format!("motor '{name}'");
+        let fields = Fields { file: &self.source, what: &what, table: t };
+        let kind = fields.string("kind")?;
+        let (gear_ratio, efficiency, rated) =
+            (fields.optional_positive("gearbox_ratio")?.unwrap_or(1.0), fields.optional_fraction("gearbox_efficiency")?.unwrap_or(1.0), fields.optional_positive("gearbox_rated_torque")?.unwrap_or(f64::INFINITY));
+        let common = ["kind", "gearbox_ratio", "gearbox_efficiency", "gearbox_rated_torque", "rotor_inertia", "source"];
+        let motor: Box<dyn Motor> = match kind.as_str() {
+            "stepper" => {
+                fields.known(&[&common[..], &["holding_torque", "step_angle", "inductance", "current", "supply_voltage", "pull_out", "resistance", "mass", "detent_torque"]].concat())?;
+                let pull_out = match t.get("pull_out") {
+                    Some(points) => PullOut::Table(fields.points("pull_out", points)?),
+                    None => PullOut::Derived { inductance: fields.positive("inductance")?, current: fields.positive("current")?, supply_voltage: fields.positive("supply_voltage")? },
+                };
+                Box::new(Stepper {
+                    name: name.to_string(),
+                    holding_torque: fields.positive("holding_torque")?,
+                    rotor_inertia: fields.non_negative("rotor_inertia")?,
+                    step_angle_deg: fields.positive("step_angle")?,
+                    pull_out,
+                })
+            }
+            "servo" => {
+                fields.known(&[&common[..], &["stall_torque", "no_load_speed", "mass", "voltage"]].concat())?;
+                Box::new(DcServo { name: name.to_string(), stall_torque: fields.positive("stall_torque")?, no_load_speed: fields.positive("no_load_speed")?, rotor_inertia: fields.non_negative("rotor_inertia")? })
+            }
+            other => return Err(fail(&self.source, format!("{what}: field 'kind' is '{other}', expected 'stepper' or 'servo'"))),
+        };
+        Ok((motor, gear_ratio, efficiency, rated))
+    }
+}
+
+/// A TOML table's fields, each checked with an error naming the file, the entry and the field.
+struct Fields<'a> {
+    file: &'a Path,
+    what: &'a str,
+    table: &'a toml::Table,
+}
+
+impl Fields<'_> {
+    fn err(&self, field: &str, message: &str) -> Error {
+        fail(self.file, format!("{}: field '{field}' {message}", self.what))
+    }
+
+    fn number(&self, field: &str) -> Result<Option<f64>, Error> {
+        match self.table.get(field) {
+            None => Ok(None),
+            Some(Value::Float(x)) if x.is_finite() => Ok(Some(*x)),
+            Some(Value::Integer(i)) => Ok(Some(*i as f64)),
+            Some(_) => Err(self.err(field, "must be a finite number")),
+        }
+    }
+
+    fn positive(&self, field: &str) -> Result<f64, Error> {
+        self.optional_positive(field)?.ok_or_else(|| self.err(field, "is missing"))
+    }
+
+    fn optional_positive(&self, field: &str) -> Result<Option<f64>, Error> {
+        match self.number(field)? {
+            Some(x) if x <= 0.0 => Err(self.err(field, &format!("must be positive (got {x})"))),
+            other => Ok(other),
+        }
+    }
+
+    fn optional_fraction(&self, field: &str) -> Result<Option<f64>, Error> {
+        match self.number(field)? {
+            Some(x) if !(x > 0.0 && x <= 1.0) => Err(self.err(field, &format!("must be in (0, 1] (got {x})"))),
+            other => Ok(other),
+        }
+    }
+
+    fn non_negative(&self, field: &str) -> Result<f64, Error> {
+        match self.number(field)? {
+            None => Ok(0.0),
+            Some(x) if x < 0.0 => Err(self.err(field, &format!("must not be negative (got {x})"))),
+            Some(x) => Ok(x),
+        }
+    }
+
+    fn string(&self, field: &str) -> Result<String, Error> {
+        match self.table.get(field) {
+            Some(Value::String(s)) => Ok(s.clone()),
+            Some(_) => Err(self.err(field, "must be a string")),
+            None => Err(self.err(field, "is missing")),
+        }
+    }
+
+    fn points(&self, field: &str, value: &Value) -> Result<Vec<(f64, f64)>, Error> {
+        let bad = || self.err(field, "must be a list of [speed rev/s, torque N·m] pairs with speeds increasing from 0 and torques ≥ 0");
+        let list = value.as_array().ok_or_else(bad)?;
+        let mut points = Vec::new();
+        for p in list {
+            let pair = p.as_array().filter(|a| a.len() == 2).ok_or_else(bad)?;
+            let num = |v: &Value| v.as_float().or(v.as_integer().map(|i| i as f64)).filter(|x| x.is_finite() && *x >= 0.0).ok_or_else(bad);
+            points.push((num(&pair[0])?, num(&pair[1])?));
+        }
+        if points.is_empty() || points.windows(2).any(|w| w[1].0 <= w[0].0) {
+            return Err(bad());
+        }
+        Ok(points)
+    }
+
+    fn known(&self, fields: &[&str]) -> Result<(), Error> {
+        match self.table.keys().find(|k| !fields.contains(&k.as_str())) {
+            Some(k) => Err(fail(self.file, format!("{}: unknown field '{k}' (known: {})", self.what, fields.join(", ")))),
+            None => Ok(()),
+        }
+    }
+}
+
+/// A motor file for `model`: the drive train of each joint it names (the others keep the URDF's
+/// constant effort limit).
+pub fn load_motor_file(path: &Path, model: &Model) -> Result<MotorSet, Error> {
+    let text = crate::builtin::read_to_string(path).map_err(|e| fail(path, format!("cannot read: {e}")))?;
+    let table: toml::Table = text.parse().map_err(|e: toml::de::Error| fail(path, e.message().to_string()))?;
+    if let Some(k) = table.keys().find(|k| !["catalogue", "joints", "motors", "description"].contains(&k.as_str())) {
+        return Err(fail(path, format!("unknown key '{k}' (known: catalogue, joints, motors, description)")));
+    }
+    let mut catalogue = match table.get("catalogue") {
+        Some(Value::String(file)) => Catalogue::load(&path.parent().unwrap_or(Path::new(".")).join(file))?,
+        Some(_) => return Err(fail(path, "field 'catalogue' must be a file name".into())),
+        None => Catalogue::load(Path::new(DEFAULT_CATALOGUE))?,
+    };
+    // motors defined in the file itself
+    if let Some(motors) = table.get("motors") {
+        let text = toml::to_string(motors).unwrap_or_default();
+        let own = Catalogue::parse(&text, path)?;
+        catalogue.entries.extend(own.entries);
+    }
+    let joints = match table.get("joints") {
+        Some(Value::Table(t)) => t,
+        _ => return Err(fail(path, "no [joints.NAME] tables".into())),
+    };
+    let mut set = MotorSet { joints: (0..model.dof()).map(|_| None).collect(), source: path.to_path_buf() };
+    for (name, value) in joints {
+        let what = format!("joint '{name}'");
+        let Some(index) = model.joint_index(name) else {
+            return Err(fail(path, format!("{what}: {} has no moving joint of that name (joints: {})", model.source.display(), model.joints.iter().map(|j| j.name.as_str()).collect::<Vec<_>>().join(", "))));
+        };
+        let Value::Table(t) = value else { return Err(fail(path, format!("{what}: expected a table"))) };
+        let fields = Fields { file: path, what: &what, table: t };
+        fields.known(&["motor", "gear_ratio", "efficiency", "rated_torque", "microsteps"])?;
+        let motor_name = fields.string("motor")?;
+        let (motor, own_ratio, own_efficiency, own_rated) = catalogue.motor(&motor_name).map_err(|e| match e {
+            Error::Flag { message, .. } => fail(path, format!("{what}: {}", message.split(": ").skip(1).collect::<Vec<_>>().join(": "))),
+            other => other,
+        })?;
+        let ratio = fields.optional_positive("gear_ratio")?.unwrap_or(1.0);
+        let efficiency = fields.optional_fraction("efficiency")?.unwrap_or(1.0);
+        let rated = fields.optional_positive("rated_torque")?.unwrap_or(f64::INFINITY);
+        if let Some(m) = fields.optional_positive("microsteps")? {
+            if m.fract() != 0.0 {
+                return Err(fields.err("microsteps", "must be a whole number"));
+            }
+        }
+        set.joints[index] = Some(DriveTrain {
+            motor,
+            gear_ratio: own_ratio * ratio,
+            efficiency: own_efficiency * efficiency,
+            // the motor's own gearbox is rated at its output, before this reduction
+            rated_torque: (own_rated * ratio * efficiency).min(rated),
+        });
+    }
+    Ok(set)
+}

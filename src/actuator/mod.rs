@@ -1,0 +1,107 @@
+//! Motors and their drive trains as a joint sees them: what torque the joint can get at a speed.
+//!
+//! A motor kind (servo, stepper, …) is one file behind [`Motor`]; a [`DriveTrain`] puts a motor
+//! behind a gearbox (ratio, efficiency, rated output torque); a [`MotorSet`] assigns drive trains to
+//! a model's joints, from a motor file (`--motors FILE.toml`, see [`catalogue`]).
+
+pub mod catalogue;
+mod servo;
+mod stepper;
+
+pub use catalogue::{Catalogue, load_motor_file};
+pub use servo::DcServo;
+pub use stepper::{PullOut, Stepper};
+
+use std::fmt::Debug;
+
+/// A motor at its own shaft.
+pub trait Motor: Debug + Send + Sync {
+    /// The largest torque (N·m, ≥ 0) it can give at shaft speed `speed` (rad/s, either sign).
+    fn torque_at(&self, speed: f64) -> f64;
+    /// Rotor inertia, kg·m².
+    fn rotor_inertia(&self) -> f64;
+    /// The catalogue name.
+    fn name(&self) -> &str;
+    /// One line: kind and main numbers.
+    fn describe(&self) -> String;
+    /// The stepper, if this is one (stepper mode needs its step geometry).
+    fn as_stepper(&self) -> Option<&Stepper> {
+        None
+    }
+}
+
+/// A motor behind a gearbox: the joint turns `gear_ratio` times slower than the motor.
+#[derive(Debug)]
+pub struct DriveTrain {
+    pub motor: Box<dyn Motor>,
+    pub gear_ratio: f64,
+    /// Gearbox efficiency η (0, 1]: the joint gets η·N·T_motor.
+    pub efficiency: f64,
+    /// The gearbox's rated output torque, N·m (infinite when not limited).
+    pub rated_torque: f64,
+}
+
+impl DriveTrain {
+    /// Torque available at the joint at joint speed `speed`: min(η·N·T_motor(N·speed), rated).
+    pub fn torque_limit(&self, speed: f64) -> f64 {
+        (self.efficiency * self.gear_ratio * self.motor.torque_at(self.gear_ratio * speed)).min(self.rated_torque)
+    }
+
+    /// The rotor's inertia seen at the joint, J_r·N².
+    pub fn reflected_inertia(&self) -> f64 {
+        self.motor.rotor_inertia() * self.gear_ratio * self.gear_ratio
+    }
+
+    /// The joint speed above which the joint gets less than `fraction` of its torque at rest
+    /// (bisection on the monotone torque–speed curve; infinite if it never falls that far).
+    pub fn speed_at_fraction(&self, fraction: f64) -> f64 {
+        let target = fraction * self.torque_limit(0.0);
+        let (mut lo, mut hi) = (0.0_f64, 1e-3_f64);
+        while self.torque_limit(hi) > target {
+            hi *= 2.0;
+            if hi > 1e9 {
+                return f64::INFINITY;
+            }
+        }
+        for _ in 0..60 {
+            let mid = 0.5 * (lo + hi);
+            if self.torque_limit(mid) > target { lo = mid } else { hi = mid }
+        }
+        hi
+    }
+}
+
+/// The drive trains of a model's joints (by coordinate; `None`: the URDF's constant effort limit).
+#[derive(Debug, Default)]
+pub struct MotorSet {
+    pub joints: Vec<Option<DriveTrain>>,
+    /// The motor file it came from.
+    pub source: std::path::PathBuf,
+}
+
+impl MotorSet {
+    /// For people: one line per joint with a motor — the motor, the drive train, the torque at rest,
+    /// the rotor's inertia at the joint and the joint speed at which the torque runs out.
+    pub fn table(&self, joint_names: &[String]) -> String {
+        let w = joint_names.iter().map(|n| n.chars().count()).max().unwrap_or(5).max(5) + 2;
+        let mut out = format!("    {:<w$}{:<20}{:>7}{:>6}{:>10}{:>15}{:>16}{:>26}\n", "joint", "motor", "ratio", "η", "rated", "at rest (N·m)", "J_r·N² (kg·m²)", "half of it above (rad/s)");
+        for (name, drive) in joint_names.iter().zip(&self.joints) {
+            let Some(d) = drive else { continue };
+            let rated = if d.rated_torque.is_finite() { format!("{:.2}", d.rated_torque) } else { "–".into() };
+            let top = d.speed_at_fraction(0.5);
+            let top = if top.is_finite() { format!("{top:.2}") } else { "–".into() };
+            out += &format!("    {:<w$}{:<20}{:>7}{:>6}{:>10}{:>15.3}{:>16.3e}{:>26}\n", name, d.motor.name(), d.gear_ratio, d.efficiency, rated, d.torque_limit(0.0), d.reflected_inertia(), top);
+        }
+        out
+    }
+
+    /// Each joint's torque limit at joint speeds `v`, into `out`; `effort` where no drive train is set.
+    pub fn torque_limits(&self, v: &[f64], effort: &[f64], out: &mut [f64]) {
+        for i in 0..out.len() {
+            out[i] = match &self.joints[i] {
+                Some(d) => d.torque_limit(v[i]),
+                None => effort[i],
+            };
+        }
+    }
+}

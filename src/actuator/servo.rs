@@ -1,0 +1,33 @@
+//! A DC motor or hobby servo: a linear torque–speed line from the stall torque at rest to zero at
+//! the no-load speed, T(ω) = T_stall·(1 − |ω|/ω₀), clamped at 0 (Isaac Lab's `DCMotor`, Newton's
+//! `ClampingDCMotor`; MuJoCo's `dcmotor` without inductance).
+
+use super::Motor;
+
+#[derive(Clone, Debug)]
+pub struct DcServo {
+    pub name: String,
+    /// N·m at the shaft this entry describes (a servo's output shaft: its internal gearbox included).
+    pub stall_torque: f64,
+    /// rad/s.
+    pub no_load_speed: f64,
+    pub rotor_inertia: f64,
+}
+
+impl Motor for DcServo {
+    fn torque_at(&self, speed: f64) -> f64 {
+        (self.stall_torque * (1.0 - speed.abs() / self.no_load_speed)).max(0.0)
+    }
+
+    fn rotor_inertia(&self) -> f64 {
+        self.rotor_inertia
+    }
+
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn describe(&self) -> String {
+        format!("{}: servo, stall {} N·m, no-load {:.3} rad/s", self.name, self.stall_torque, self.no_load_speed)
+    }
+}

@@ -1,0 +1,196 @@
+//! Motors and drive trains (`--motors FILE.toml`): the catalogue, the torque a joint gets at a speed
+//! through its gearbox, servo mode (the tutorial's PD loop on that limit), the rotor in M, and what
+//! the console, the summary and both recordings show of it.
+
+mod common;
+
+use armscope::actuator::{Catalogue, DcServo, DriveTrain, Motor, PullOut, Stepper, load_motor_file};
+use armscope::config::RunConfig;
+use armscope::dynamics::{Data, crba};
+use armscope::experiment::Experiment;
+use armscope::model::load_urdf;
+use armscope::recorder::{Recorder, RunInfo};
+use armscope::sample::Sample;
+use armscope::sim::simulate;
+use armscope::summary::Summary;
+
+fn motors_file(name: &str) -> std::path::PathBuf {
+    common::repo().join("assets/motors").join(name)
+}
+
+#[test]
+fn every_catalogue_entry_loads_with_its_numbers() {
+    let catalogue = Catalogue::load(&motors_file("catalogue.toml")).unwrap();
+    for name in ["17HS4401", "17HS15-1584S-MG5", "23HS22-2804S", "STS3215-C018"] {
+        let (motor, ..) = catalogue.motor(name).unwrap_or_else(|e| panic!("{e}"));
+        assert!(motor.torque_at(0.0) > 0.0, "{name}");
+    }
+    let (nema17, ratio, efficiency, rated) = catalogue.motor("17HS4401").unwrap();
+    assert_eq!((nema17.torque_at(0.0), nema17.rotor_inertia(), ratio, efficiency, rated), (0.40, 5.4e-6, 1.0, 1.0, f64::INFINITY));
+    let (_, ratio, efficiency, rated) = catalogue.motor("17HS15-1584S-MG5").unwrap();
+    assert_eq!((ratio, efficiency, rated), (5.0, 0.9, 9.0), "the gearmotor's own 5:1 planetary");
+}
+
+/// The stepper's derived pull-out curve: holding torque up to the corner speed V/(2·L·I·200) rev/s
+/// (12.6 rev/s for the 17HS4401 at 24 V), then falling as 1/speed; a table is interpolated; a servo's
+/// line falls from stall to zero at its no-load speed.
+#[test]
+fn torque_speed_curves_follow_their_stated_formulas() {
+    let stepper = Stepper { name: "s".into(), holding_torque: 0.4, rotor_inertia: 5.4e-6, step_angle_deg: 1.8, pull_out: PullOut::Derived { inductance: 2.8e-3, current: 1.7, supply_voltage: 24.0 } };
+    let corner = 24.0 / (2.0 * 2.8e-3 * 1.7 * 200.0);
+    assert!((stepper.corner_speed_rev_s().unwrap() - corner).abs() < 1e-12 && (corner - 12.605).abs() < 1e-3);
+    let omega = |rev_s: f64| rev_s * 2.0 * std::f64::consts::PI;
+    assert_eq!(stepper.torque_at(omega(0.99 * corner)), 0.4);
+    assert!((stepper.torque_at(-omega(2.0 * corner)) - 0.2).abs() < 1e-12, "half the torque at twice the corner speed, either direction");
+    let table = Stepper { pull_out: PullOut::Table(vec![(0.0, 0.4), (10.0, 0.2), (20.0, 0.05)]), ..stepper.clone() };
+    assert!((table.torque_at(omega(5.0)) - 0.3).abs() < 1e-12 && (table.torque_at(omega(15.0)) - 0.125).abs() < 1e-12 && table.torque_at(omega(50.0)) == 0.05);
+    let servo = DcServo { name: "v".into(), stall_torque: 2.94, no_load_speed: 4.71, rotor_inertia: 0.0 };
+    assert_eq!((servo.torque_at(0.0), servo.torque_at(4.71), servo.torque_at(-10.0)), (2.94, 0.0, 0.0));
+    assert!((servo.torque_at(2.355) - 1.47).abs() < 1e-12);
+}
+
+/// Through a gearbox: η·N·T_motor(N·ω), capped by the gearbox's rating; the rotor seen at the joint is J_r·N².
+#[test]
+fn a_drive_train_multiplies_torque_divides_speed_and_is_capped_by_its_rating() {
+    let servo = DcServo { name: "v".into(), stall_torque: 1.0, no_load_speed: 100.0, rotor_inertia: 2e-6 };
+    let drive = DriveTrain { motor: Box::new(servo), gear_ratio: 10.0, efficiency: 0.8, rated_torque: 7.0 };
+    assert_eq!(drive.torque_limit(0.0), 7.0, "0.8·10·1 = 8 N·m, rated 7");
+    assert!((drive.torque_limit(5.0) - 4.0).abs() < 1e-12, "motor at 50 rad/s gives 0.5 N·m: 0.8·10·0.5");
+    assert_eq!(drive.torque_limit(10.0), 0.0, "the motor's no-load speed reached at the joint's 10 rad/s");
+    assert!((drive.reflected_inertia() - 2e-4).abs() < 1e-18);
+    assert!((drive.speed_at_fraction(0.5) - 5.625).abs() < 1e-9, "3.5 N·m at 1 − 3.5/8 of 10 rad/s");
+}
+
+#[test]
+fn bad_motor_files_get_one_line_naming_the_file_the_joint_and_the_field() {
+    let model = load_urdf(&common::box_urdf()).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let cases = [
+        ("[joints.J9]\nmotor = \"17HS4401\"\n", vec!["joint 'J9'", "no moving joint"]),
+        ("[joints.J1]\nmotor = \"NOPE\"\n", vec!["joint 'J1'", "no motor 'NOPE'", "17HS4401"]),
+        ("[joints.J1]\nmotor = \"17HS4401\"\ngear_ratio = -3\n", vec!["joint 'J1'", "field 'gear_ratio'", "positive"]),
+        ("[joints.J1]\nmotor = \"17HS4401\"\nefficiency = 1.5\n", vec!["joint 'J1'", "field 'efficiency'", "(0, 1]"]),
+        ("[joints.J1]\nmotor = \"17HS4401\"\ngear_ration = 3\n", vec!["joint 'J1'", "unknown field 'gear_ration'"]),
+        ("[joints.J1]\ngear_ratio = 3\n", vec!["joint 'J1'", "field 'motor'", "missing"]),
+        ("[motors.M]\nkind = \"stepper\"\nholding_torque = 0.4\nstep_angle = 1.8\n[joints.J1]\nmotor = \"M\"\n", vec!["motor 'M'", "field 'inductance'", "missing"]),
+        ("[motors.M]\nkind = \"brushless\"\n[joints.J1]\nmotor = \"M\"\n", vec!["motor 'M'", "field 'kind'", "'brushless'"]),
+        ("[joints.J1\n", vec!["m.toml"]),
+    ];
+    for (text, words) in cases {
+        let path = dir.path().join("m.toml");
+        std::fs::write(&path, text).unwrap();
+        let err = load_motor_file(&path, &model).unwrap_err().to_string();
+        assert!(!err.contains('\n'), "one line: {err}");
+        assert!(err.starts_with("--motors: ") && err.contains("m.toml"), "{err}");
+        for w in words {
+            assert!(err.contains(w), "'{w}' missing from: {err}");
+        }
+    }
+}
+
+/// Captures every sample's torque, limit, speed and saturation flag.
+#[derive(Default)]
+struct Capture {
+    rows: Vec<(Vec<f64>, Vec<f64>, Vec<f64>, Vec<bool>)>,
+}
+
+impl Recorder for Capture {
+    fn start(&mut self, _: &RunInfo) -> Result<(), armscope::error::Error> {
+        Ok(())
+    }
+    fn record(&mut self, s: &Sample) -> Result<(), armscope::error::Error> {
+        if !s.is_final {
+            self.rows.push((s.u.to_vec(), s.torque_limit.to_vec(), s.v.to_vec(), s.saturated.to_vec()));
+        }
+        Ok(())
+    }
+    fn finish(&mut self, _: &RunInfo, _: &Summary) -> Result<(), armscope::error::Error> {
+        Ok(())
+    }
+}
+
+/// Servo mode on the tutorial's motor file with a fast wave: at every step the limit is what the
+/// drive train gives at the joint's speed, the applied torque never exceeds it, and a step is
+/// flagged saturated exactly when the torque sits at the limit; the limit does fall (J2, J3 below
+/// their 5.4 N·m at rest), and the summary reports the lowest.
+#[test]
+fn servo_mode_clips_to_the_speed_dependent_limit_at_every_step() {
+    let config = RunConfig { urdf: common::box_urdf(), motors: Some(motors_file("tutorial.toml")), duration: 6.0, freq: 3.0, ..RunConfig::default() };
+    let experiment = Experiment::prepare(config).unwrap();
+    let motors = experiment.motors.clone().expect("motors");
+    let mut capture = Capture::default();
+    let summary = simulate(&experiment, &mut [&mut capture], None).unwrap();
+    let mut lowest = [f64::INFINITY; 6];
+    for (u, limit, v, saturated) in &capture.rows {
+        for j in 0..6 {
+            let want = motors.joints[j].as_ref().unwrap().torque_limit(v[j]);
+            assert_eq!(limit[j], want, "J{} limit at q̇ = {}", j + 1, v[j]);
+            assert!(u[j].abs() <= limit[j], "J{}: |u| {} > limit {}", j + 1, u[j], limit[j]);
+            if saturated[j] {
+                assert_eq!(u[j].abs(), limit[j]);
+            }
+            lowest[j] = lowest[j].min(limit[j]);
+        }
+    }
+    assert!(lowest[1] < 5.0 && lowest[2] < 5.0, "the limit falls with speed: {lowest:?}");
+    assert_eq!(summary.lowest_torque_limit, lowest.to_vec());
+    for (got, want) in summary.effort_limit.iter().zip([5.4, 5.4, 5.4, 1.8, 1.8, 1.5]) {
+        assert!((got - want).abs() < 1e-12, "limit at rest {got} vs {want}");
+    }
+}
+
+/// The motor file's rotors join the mass matrix: J_r·N² on the diagonal (1.215e-3 kg·m² behind 15:1).
+#[test]
+fn the_motor_files_rotors_are_in_the_mass_matrix() {
+    let bare = Experiment::prepare(RunConfig { urdf: common::box_urdf(), ..RunConfig::default() }).unwrap();
+    let with = Experiment::prepare(RunConfig { urdf: common::box_urdf(), motors: Some(motors_file("tutorial.toml")), ..RunConfig::default() }).unwrap();
+    let q = [0.3, -0.5, 0.8, -1.1, 0.6, 0.2];
+    let m0 = crba(&bare.model, &mut Data::new(&bare.model), &q).clone();
+    let m1 = crba(&with.model, &mut Data::new(&with.model), &q).clone();
+    for i in 0..6 {
+        let want = 5.4e-6 * if i < 3 { 225.0 } else { 25.0 };
+        assert!((m1[(i, i)] - m0[(i, i)] - want).abs() < 1e-15, "J{}", i + 1);
+    }
+}
+
+/// The limit at every step is in both recordings: the .rrd's `joints/J2/torque_limit` per step, the
+/// MCAP's `/controller` `torque_limit` field; and the console lists the motors.
+#[test]
+fn recordings_and_console_show_the_speed_dependent_limit() {
+    let dir = tempfile::tempdir().unwrap();
+    let (rrd, mcap) = (dir.path().join("m.rrd"), dir.path().join("m.mcap"));
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_armscope"))
+        .args(["run", "--urdf", common::box_urdf().to_str().unwrap(), "--motors", motors_file("tutorial.toml").to_str().unwrap(), "--duration", "1", "--freq", "3"])
+        .args(["--rrd", rrd.to_str().unwrap(), "--mcap", mcap.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("motors (") && stdout.contains("17HS4401") && stdout.contains("lowest limit (N·m)"), "{stdout}");
+    let limits = common::rrd::Rrd::open(&rrd).series("/joints/J2/torque_limit");
+    assert_eq!(limits.len(), 1001, "one row per step");
+    assert!(limits.iter().all(|(_, v)| v.len() == 2 && v[0] == -v[1] && v[0] > 0.0 && v[0] <= 5.4 + 1e-12));
+    assert!(limits.iter().any(|(_, v)| v[0] < 5.3), "the limit falls somewhere in the run");
+    let bytes = std::fs::read(&mcap).unwrap();
+    let mut count = 0;
+    for m in mcap::MessageStream::new(&bytes).unwrap().map(|m| m.unwrap()).filter(|m| m.channel.topic == "/controller") {
+        let schema = m.channel.schema.clone().unwrap();
+        let pool = prost_reflect::DescriptorPool::decode(&schema.data[..]).unwrap();
+        let v = prost_reflect::DynamicMessage::decode(pool.get_message_by_name(&schema.name).unwrap(), &m.data[..]).unwrap();
+        let list = v.get_field_by_name("torque_limit").unwrap().as_list().unwrap().to_vec();
+        assert_eq!(list.len(), 6);
+        count += 1;
+    }
+    assert_eq!(count, 1001);
+}
+
+#[test]
+fn the_motor_files_are_built_into_the_binary() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_armscope"))
+        .current_dir(dir.path())
+        .args(["run", "--motors", "assets/motors/tutorial.toml", "--duration", "0.2", "--no-rrd", "--no-mcap", "--quiet"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+}
