@@ -275,6 +275,10 @@ pub struct RunArgs {
     /// with its speed. E.g. assets/motors/tutorial.toml.
     #[arg(long, value_name = "FILE")]
     pub motors: Option<PathBuf>,
+    /// Joints whose motor is a stepper: `stepper` drives them open loop (the command in microsteps;
+    /// steps can be lost), `pd` runs the tutorial's PD controller on their pull-out torque.
+    #[arg(long, value_enum, default_value = "stepper")]
+    pub drive: crate::config::DriveMode,
 
     /// Write the tutorial's CSV (t, q, tool xyz every --print-every).
     #[arg(long, value_name = "PATH")]
@@ -393,6 +397,7 @@ impl RunArgs {
             strict_inertia: self.strict_inertia,
             q0: self.q0.clone(),
             motors: self.motors.clone(),
+            drive: self.drive,
         }
     }
 }

@@ -11,6 +11,17 @@ pub enum IntegratorKind {
     Continuous,
 }
 
+/// How a joint whose motor is a stepper is driven.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum DriveMode {
+    /// Open loop, as the real SmallRobotArm runs: the command in microsteps, lost steps possible.
+    #[default]
+    Stepper,
+    /// The tutorial's PD controller on the motor's torque–speed limit.
+    Pd,
+}
+
 #[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case", default)]
 pub struct RunConfig {
@@ -58,6 +69,8 @@ pub struct RunConfig {
     pub q0: Option<String>,
     /// A motor file: each named joint's motor and drive train (its torque falls with speed).
     pub motors: Option<PathBuf>,
+    /// Stepper joints open loop (default) or under the PD controller.
+    pub drive: DriveMode,
 }
 
 pub use crate::builtin::DEFAULT_URDF;
@@ -91,6 +104,7 @@ impl Default for RunConfig {
             strict_inertia: false,
             q0: None,
             motors: None,
+            drive: DriveMode::Stepper,
         }
     }
 }

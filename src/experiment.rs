@@ -1,11 +1,11 @@
 //! A [`RunConfig`] checked and resolved against its model: everything the simulation loop needs.
 
-use crate::config::{IntegratorKind, RunConfig};
+use crate::config::{DriveMode, IntegratorKind, RunConfig};
 use crate::controller::PdGravityController;
 use crate::error::Error;
 use crate::gains::{Gains, TUTORIAL_KD, TUTORIAL_KP, auto_tune, is_tutorial_model};
 use crate::integrator::{ContinuousPlant, DiscretePlant, Plant, Tolerances};
-use crate::actuator::{MotorSet, load_motor_file};
+use crate::actuator::{MotorSet, OpenLoopSteppers, load_motor_file};
 use crate::model::{Actuator, LoadOptions, Model, load_urdf_with};
 use crate::analysis::LoopPlant;
 use crate::trajectory::{Hold, JointSchedule, JointStep, JointWave, Trajectory, Wave};
@@ -32,6 +32,11 @@ pub struct Experiment {
     pub start: Vec<f64>,
     /// The motors of `--motors`: each named joint's torque limit at its speed.
     pub motors: Option<Arc<MotorSet>>,
+    /// Stepper joints are driven open loop (`--motors` with steppers, `--drive stepper`).
+    pub stepper_mode: bool,
+    /// Stepper mode: where the steppers were energized (the command's start); `start` is this plus
+    /// the sag at which each stepper carries its share of the weight.
+    pub stepper_zero: Vec<f64>,
 }
 
 impl Experiment {
@@ -66,12 +71,53 @@ impl Experiment {
             Some(path) => Some(Arc::new(apply_motor_file(path, &mut model)?)),
             None => None,
         };
-        let plant = plant_spec(&config)?;
-        let start = start_pose(&config, &model)?;
+        let stepper_mode = config.drive == DriveMode::Stepper && motors.as_ref().is_some_and(|m| m.has_steppers());
+        let mut stepper_zero = Vec::new();
+        let mut plant = plant_spec(&config)?;
+        let mut start = start_pose(&config, &model)?;
         let trajectory = trajectory(&config, &model, &start)?;
+        if stepper_mode {
+            let motors = motors.as_ref().expect("stepper mode has motors");
+            if config.q0.is_none() {
+                // an open-loop stepper cannot jump: the arm starts where the command starts
+                let (mut cmd, mut cmd_dot) = (vec![0.0; model.dof()], vec![0.0; model.dof()]);
+                trajectory.sample(0.0, &mut cmd, &mut cmd_dot);
+                for (j, joint) in model.joints.iter().enumerate() {
+                    if motors.joints[j].as_ref().is_some_and(|d| d.motor.as_stepper().is_some()) {
+                        start[j] = cmd[j].clamp(joint.lower, joint.upper);
+                    }
+                }
+                model.notices.push("stepper mode: the stepper joints start where the command starts (an open-loop stepper cannot jump); --q0 sets another start".into());
+            }
+            stepper_zero = start.clone();
+            if let Some(steppers) = OpenLoopSteppers::new(motors, &motors.microsteps, &start, &inertia_diagonal(&model, &start)) {
+                // at rest, held: each stepper lags by the load angle that carries the weight
+                let mut data = crate::dynamics::Data::new(&model);
+                let mut sagged = start.clone();
+                for _ in 0..5 {
+                    let tau_g = crate::dynamics::gravity_forces(&model, &mut data, &sagged).to_vec();
+                    for (j, sag) in steppers.rest_sag(&tau_g) {
+                        sagged[j] = stepper_zero[j] + sag.unwrap_or(0.0);
+                    }
+                }
+                let biggest = (0..model.dof()).map(|j| (sagged[j] - start[j]).abs()).fold(0.0, f64::max);
+                start = sagged;
+                model.notices.push(format!("stepper mode: the arm starts at rest, held by its steppers, each lagging by the load angle that carries its weight (at most {biggest:.2e} rad at a joint)"));
+            }
+            if let (PlantSpec::Discrete { substeps, .. }, None) = (&plant, config.time_step) {
+                let needed = stepper_substeps(&model, motors, &start, config.dt);
+                if needed > *substeps {
+                    plant = PlantSpec::Discrete { time_step: config.dt / needed as f64, substeps: needed };
+                    model.notices.push(format!(
+                        "stepper mode: plant step {:.4} ms ({needed} per control period), short enough for the stiffest stepper joint's oscillation and damping (ω_n·h, h·c/I ≤ 0.2); --time-step sets another",
+                        config.dt / needed as f64 * 1e3
+                    ));
+                }
+            }
+        }
         let gains = gains(&config, &model, &start, trajectory.as_ref(), &plant)?;
         let steps = (config.duration / config.dt - 1e-9).ceil() as usize;
-        Ok(Self { config, model: Arc::new(model), gains, plant, trajectory, steps, start, motors })
+        Ok(Self { config, model: Arc::new(model), gains, plant, trajectory, steps, start, motors, stepper_mode, stepper_zero })
     }
 
     pub fn controller(&self) -> PdGravityController {
@@ -93,6 +139,15 @@ impl Experiment {
                 Box::new(ContinuousPlant::new(&self.model, self.config.dt, Tolerances { rtol, atol }))
             }
         }
+    }
+
+    /// The open-loop steppers of a stepper-mode run, at the start pose.
+    pub fn open_loop_steppers(&self) -> Option<OpenLoopSteppers> {
+        if !self.stepper_mode {
+            return None;
+        }
+        let motors = self.motors.as_ref()?;
+        OpenLoopSteppers::new(motors, &motors.microsteps, &self.stepper_zero, &inertia_diagonal(&self.model, &self.stepper_zero))
     }
 
     /// The start state: the start pose (`--q0`, or every joint at 0 clamped into its range), at rest.
@@ -287,4 +342,23 @@ fn apply_motor_file(path: &std::path::Path, model: &mut Model) -> Result<MotorSe
         model.armature[a.joint] += a.reflected_inertia();
     }
     Ok(set)
+}
+
+/// Plant steps per control period that keep every stepper joint's oscillation about its stable
+/// position (stiffness η·N²·T_H·N_r against M_ii at the start pose) resolved: ω_n·h ≤ 0.2.
+fn stepper_substeps(model: &Model, motors: &MotorSet, start: &[f64], dt: f64) -> usize {
+    let inertia = inertia_diagonal(model, start);
+    let Some(steppers) = OpenLoopSteppers::new(motors, &motors.microsteps, start, &inertia) else { return 1 };
+    let omega = steppers.stiffness().iter().map(|&(j, k)| (k / inertia[j]).sqrt()).fold(0.0, f64::max);
+    // the damping is explicit in the stepper's torque: h·c/I ≤ 0.2 as well
+    let rate = steppers.damping().iter().map(|&(j, c)| c / inertia[j]).fold(0.0, f64::max);
+    let omega = omega.max(rate);
+    ((omega * dt / 0.2).ceil() as usize).max(1)
+}
+
+/// The mass matrix's diagonal at `q` (each joint's inertia with the others held).
+fn inertia_diagonal(model: &Model, q: &[f64]) -> Vec<f64> {
+    let mut data = crate::dynamics::Data::new(model);
+    let m = crate::dynamics::crba(model, &mut data, q);
+    (0..model.dof()).map(|j| m[(j, j)]).collect()
 }

@@ -23,6 +23,11 @@ pub struct Sample<'a> {
     /// The torque limit at this step: the URDF's effort, or with `--motors` what the motor gives at
     /// the joint's speed through its gearbox (0 on a passive joint).
     pub torque_limit: &'a [f64],
+    /// Stepper mode: each stepper joint's load angle, electrical degrees (±90° the peak torque, ±180°
+    /// the slip point); 0 elsewhere.
+    pub load_angle: &'a [f64],
+    /// Stepper mode: full steps lost so far per joint (signed); 0 elsewhere.
+    pub lost_steps: &'a [i64],
     /// Chatter: the torque flipped sign since the previous step while at least one of the two was
     /// saturated (the signature of an unstable sampled loop, not of torque demand).
     pub chatter: &'a [bool],

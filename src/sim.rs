@@ -1,5 +1,6 @@
 //! The simulation loop: controller and plant at the control rate, every sample to every recorder.
 
+use crate::actuator::OpenLoopSteppers;
 use crate::dynamics::{Data, body_poses, forward_kinematics, frame_pose, frame_pose_in, gravity_and_bias_from_kinematics};
 use crate::error::Error;
 use crate::experiment::Experiment;
@@ -36,6 +37,9 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
     let (mut cmd, mut cmd_dot, mut u) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
     let mut saturated = vec![false; n];
     let mut torque_limit = vec![0.0; n];
+    // stepper mode: the open-loop steppers, their load angles and lost steps
+    let mut steppers = experiment.open_loop_steppers();
+    let (mut load_angle, mut lost_steps, mut lost_events) = (vec![0.0; n], vec![0i64; n], Vec::new());
     let (mut chatter, mut previous_u, mut previous_saturated) = (vec![false; n], vec![0.0; n], vec![false; n]);
     let mut at_limit = vec![false; n];
     let joint_names: Vec<String> = model.joints.iter().map(|j| j.name.clone()).collect();
@@ -50,10 +54,27 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
         gravity_and_bias_from_kinematics(model, &mut data, &v);
         experiment.trajectory.sample(t, &mut cmd, &mut cmd_dot);
         controller.compute(&q, &v, &cmd, &cmd_dot, &data.gravity, ControlOutput { u: &mut u, saturated: &mut saturated, limit: &mut torque_limit });
+        if let Some(s) = steppers.as_mut() {
+            // no PD on a stepper joint: the driver steps to the command, the rotor follows as it can
+            s.set_command(&cmd, &cmd_dot, dt);
+            s.torques(&q, &v, &mut u);
+            s.load_angles(&q, &mut load_angle);
+            s.lost_steps(&mut lost_steps);
+            for j in (0..n).filter(|&j| s.stepped[j]) {
+                // past the peak of the torque–angle curve: the motor is giving all it can
+                saturated[j] = load_angle[j].abs() > 90.0;
+            }
+        }
         for i in 0..n {
             chatter[i] = k > 0 && u[i] * previous_u[i] < 0.0 && (saturated[i] || previous_saturated[i]);
             previous_u[i] = u[i];
             previous_saturated[i] = saturated[i];
+        }
+        if let Some(s) = steppers.as_ref() {
+            for j in (0..n).filter(|&j| s.stepped[j]) {
+                // a slipping rotor's torque swings sign with the lag: that is the motor, not the loop
+                chatter[j] = false;
+            }
         }
         body_poses(model, &cmd, &mut command_poses);
         let interrupted = stop.is_some_and(|s| s.load(Ordering::Relaxed));
@@ -69,6 +90,8 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
             tau_g: &data.gravity,
             saturated: &saturated,
             torque_limit: &torque_limit,
+            load_angle: &load_angle,
+            lost_steps: &lost_steps,
             chatter: &chatter,
             at_limit: &at_limit,
             tool_position: frame_pose(model, &data, model.tool_frame).translation,
@@ -89,7 +112,20 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
             a.remember(&v);
             a.potential_energy(model, &data)
         });
-        plant.advance(model, &mut data, &u, &mut q, &mut v);
+        match steppers.as_mut() {
+            Some(s) => {
+                // the stepper torque follows the rotor within the control period: at every plant step
+                let s: &OpenLoopSteppers = s;
+                plant.advance_driven(model, &mut data, &mut u, &mut |q, v, u| s.torques(q, v, u), &mut q, &mut v);
+            }
+            None => plant.advance(model, &mut data, &u, &mut q, &mut v),
+        }
+        if let Some(s) = steppers.as_mut() {
+            s.update(&q, t + dt, &mut lost_events);
+            for e in lost_events.drain(..) {
+                stats.lost_steps(e);
+            }
+        }
         at_limit.copy_from_slice(plant.limit_active());
         if let Some(diverged) = divergence(experiment, &q, &v, t + dt) {
             status = diverged;

@@ -51,6 +51,12 @@ pub struct Summary {
     /// the joint's fastest; the effort limit otherwise.
     #[serde(default)]
     pub lowest_torque_limit: Vec<f64>,
+    /// Stepper mode: full steps each joint lost over the run (0 where none, or not a stepper).
+    #[serde(default)]
+    pub lost_steps: Vec<u64>,
+    /// Stepper mode: when each joint first lost steps, s (null if never).
+    #[serde(default)]
+    pub first_lost_step_time: Vec<Option<f64>>,
     /// Steps at which the joint was stopped at a position limit.
     pub limit_hits: Vec<u64>,
     pub tool_range: ToolRange,
@@ -72,6 +78,8 @@ pub struct SummaryBuilder {
     peak_torque: Vec<f64>,
     effort: Vec<f64>,
     lowest_limit: Vec<f64>,
+    lost_steps: Vec<u64>,
+    first_lost: Vec<Option<f64>>,
     limit_hits: Vec<u64>,
     tool_min: [f64; 3],
     tool_max: [f64; 3],
@@ -94,12 +102,20 @@ impl SummaryBuilder {
             control_steps: 0,
             peak_torque: vec![0.0; n],
             lowest_limit: effort.clone(),
+            lost_steps: vec![0; n],
+            first_lost: vec![None; n],
             effort,
             limit_hits: vec![0; n],
             tool_min: [f64::INFINITY; 3],
             tool_max: [f64::NEG_INFINITY; 3],
             last_t: 0.0,
         }
+    }
+
+    /// A stepper lost steps (stepper mode).
+    pub fn lost_steps(&mut self, e: crate::actuator::LostSteps) {
+        self.lost_steps[e.joint] += e.steps.unsigned_abs();
+        self.first_lost[e.joint].get_or_insert(e.t);
     }
 
     pub fn record(&mut self, s: &Sample) {
@@ -155,6 +171,8 @@ impl SummaryBuilder {
             peak_abs_torque: self.peak_torque.clone(),
             effort_limit: self.effort.clone(),
             lowest_torque_limit: self.lowest_limit.clone(),
+            lost_steps: self.lost_steps.clone(),
+            first_lost_step_time: self.first_lost.clone(),
             limit_hits: self.limit_hits.clone(),
             tool_range: ToolRange { x: range(0), y: range(1), z: range(2) },
             wall_time,
@@ -168,6 +186,14 @@ impl Summary {
         let mut out = Vec::new();
         for (j, name) in self.joints.iter().enumerate() {
             let (sat, chat) = (self.saturation_percent[j], self.chatter_percent[j]);
+            if let (Some(&lost), Some(Some(first))) = (self.lost_steps.get(j), self.first_lost_step_time.get(j)) {
+                if lost > 0 {
+                    out.push(format!(
+                        "{name}: its stepper lost {lost} full steps, the first at t = {first:.3} s — the command asked for more torque or speed than the pull-out curve gives there; open loop, the joint keeps that offset"
+                    ));
+                    continue;
+                }
+            }
             if sat < 2.0 {
                 continue;
             }

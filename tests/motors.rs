@@ -36,7 +36,7 @@ fn every_catalogue_entry_loads_with_its_numbers() {
 /// line falls from stall to zero at its no-load speed.
 #[test]
 fn torque_speed_curves_follow_their_stated_formulas() {
-    let stepper = Stepper { name: "s".into(), holding_torque: 0.4, rotor_inertia: 5.4e-6, step_angle_deg: 1.8, pull_out: PullOut::Derived { inductance: 2.8e-3, current: 1.7, supply_voltage: 24.0 } };
+    let stepper = Stepper { name: "s".into(), holding_torque: 0.4, rotor_inertia: 5.4e-6, step_angle_deg: 1.8, pull_out: PullOut::Derived { inductance: 2.8e-3, current: 1.7, supply_voltage: 24.0 }, damping: 0.0 };
     let corner = 24.0 / (2.0 * 2.8e-3 * 1.7 * 200.0);
     assert!((stepper.corner_speed_rev_s().unwrap() - corner).abs() < 1e-12 && (corner - 12.605).abs() < 1e-3);
     let omega = |rev_s: f64| rev_s * 2.0 * std::f64::consts::PI;
@@ -109,13 +109,14 @@ impl Recorder for Capture {
     }
 }
 
-/// Servo mode on the tutorial's motor file with a fast wave: at every step the limit is what the
+/// Servo mode (`--drive pd`: the PD loop on the steppers' pull-out curve) on the tutorial's motor
+/// file with a fast wave: at every step the limit is what the
 /// drive train gives at the joint's speed, the applied torque never exceeds it, and a step is
 /// flagged saturated exactly when the torque sits at the limit; the limit does fall (J2, J3 below
 /// their 5.4 N·m at rest), and the summary reports the lowest.
 #[test]
 fn servo_mode_clips_to_the_speed_dependent_limit_at_every_step() {
-    let config = RunConfig { urdf: common::box_urdf(), motors: Some(motors_file("tutorial.toml")), duration: 6.0, freq: 3.0, ..RunConfig::default() };
+    let config = RunConfig { urdf: common::box_urdf(), motors: Some(motors_file("tutorial.toml")), drive: armscope::config::DriveMode::Pd, duration: 6.0, freq: 3.0, ..RunConfig::default() };
     let experiment = Experiment::prepare(config).unwrap();
     let motors = experiment.motors.clone().expect("motors");
     let mut capture = Capture::default();
@@ -160,7 +161,7 @@ fn recordings_and_console_show_the_speed_dependent_limit() {
     let dir = tempfile::tempdir().unwrap();
     let (rrd, mcap) = (dir.path().join("m.rrd"), dir.path().join("m.mcap"));
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_armscope"))
-        .args(["run", "--urdf", common::box_urdf().to_str().unwrap(), "--motors", motors_file("tutorial.toml").to_str().unwrap(), "--duration", "1", "--freq", "3"])
+        .args(["run", "--urdf", common::box_urdf().to_str().unwrap(), "--motors", motors_file("tutorial.toml").to_str().unwrap(), "--drive", "pd", "--duration", "1", "--freq", "3"])
         .args(["--rrd", rrd.to_str().unwrap(), "--mcap", mcap.to_str().unwrap()])
         .output()
         .unwrap();

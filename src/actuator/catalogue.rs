@@ -84,9 +84,15 @@ impl Catalogue {
                     Some(points) => PullOut::Table(fields.points("pull_out", points)?),
                     None => PullOut::Derived { inductance: fields.positive("inductance")?, current: fields.positive("current")?, supply_voltage: fields.positive("supply_voltage")? },
                 };
+                let holding_torque = fields.positive("holding_torque")?;
+                let damping = match (fields.number("resistance")?, fields.number("current")?) {
+                    (Some(r), Some(i)) if r > 0.0 && i > 0.0 => (holding_torque / i).powi(2) / r,
+                    _ => 0.0,
+                };
                 Box::new(Stepper {
                     name: name.to_string(),
-                    holding_torque: fields.positive("holding_torque")?,
+                    holding_torque,
+                    damping,
                     rotor_inertia: fields.non_negative("rotor_inertia")?,
                     step_angle_deg: fields.positive("step_angle")?,
                     pull_out,
@@ -203,7 +209,7 @@ pub fn load_motor_file(path: &Path, model: &Model) -> Result<MotorSet, Error> {
         Some(Value::Table(t)) => t,
         _ => return Err(fail(path, "no [joints.NAME] tables".into())),
     };
-    let mut set = MotorSet { joints: (0..model.dof()).map(|_| None).collect(), source: path.to_path_buf() };
+    let mut set = MotorSet { joints: (0..model.dof()).map(|_| None).collect(), microsteps: vec![None; model.dof()], acceleration: vec![None; model.dof()], source: path.to_path_buf() };
     for (name, value) in joints {
         let what = format!("joint '{name}'");
         let Some(index) = model.joint_index(name) else {
@@ -211,7 +217,8 @@ pub fn load_motor_file(path: &Path, model: &Model) -> Result<MotorSet, Error> {
         };
         let Value::Table(t) = value else { return Err(fail(path, format!("{what}: expected a table"))) };
         let fields = Fields { file: path, what: &what, table: t };
-        fields.known(&["motor", "gear_ratio", "efficiency", "rated_torque", "microsteps"])?;
+        fields.known(&["motor", "gear_ratio", "efficiency", "rated_torque", "microsteps", "acceleration"])?;
+        set.acceleration[index] = fields.optional_positive("acceleration")?;
         let motor_name = fields.string("motor")?;
         let (motor, own_ratio, own_efficiency, own_rated) = catalogue.motor(&motor_name).map_err(|e| match e {
             Error::Flag { message, .. } => fail(path, format!("{what}: {}", message.split(": ").skip(1).collect::<Vec<_>>().join(": "))),
@@ -221,9 +228,10 @@ pub fn load_motor_file(path: &Path, model: &Model) -> Result<MotorSet, Error> {
         let efficiency = fields.optional_fraction("efficiency")?.unwrap_or(1.0);
         let rated = fields.optional_positive("rated_torque")?.unwrap_or(f64::INFINITY);
         if let Some(m) = fields.optional_positive("microsteps")? {
-            if m.fract() != 0.0 {
-                return Err(fields.err("microsteps", "must be a whole number"));
+            if m.fract() != 0.0 || m > 1024.0 {
+                return Err(fields.err("microsteps", "must be a whole number up to 1024"));
             }
+            set.microsteps[index] = Some(m as u32);
         }
         set.joints[index] = Some(DriveTrain {
             motor,

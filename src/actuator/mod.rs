@@ -5,10 +5,12 @@
 //! a model's joints, from a motor file (`--motors FILE.toml`, see [`catalogue`]).
 
 pub mod catalogue;
+mod open_loop;
 mod servo;
 mod stepper;
 
 pub use catalogue::{Catalogue, load_motor_file};
+pub use open_loop::{LostSteps, OpenLoopSteppers};
 pub use servo::DcServo;
 pub use stepper::{PullOut, Stepper};
 
@@ -75,6 +77,10 @@ impl DriveTrain {
 #[derive(Debug, Default)]
 pub struct MotorSet {
     pub joints: Vec<Option<DriveTrain>>,
+    /// Per coordinate, the driver's microsteps per full step (steppers).
+    pub microsteps: Vec<Option<u32>>,
+    /// Per coordinate, the step generator's acceleration bound, rad/s² at the joint (steppers).
+    pub acceleration: Vec<Option<f64>>,
     /// The motor file it came from.
     pub source: std::path::PathBuf,
 }
@@ -93,6 +99,11 @@ impl MotorSet {
             out += &format!("    {:<w$}{:<20}{:>7}{:>6}{:>10}{:>15.3}{:>16.3e}{:>26}\n", name, d.motor.name(), d.gear_ratio, d.efficiency, rated, d.torque_limit(0.0), d.reflected_inertia(), top);
         }
         out
+    }
+
+    /// Whether any joint has a stepper.
+    pub fn has_steppers(&self) -> bool {
+        self.joints.iter().flatten().any(|d| d.motor.as_stepper().is_some())
     }
 
     /// Each joint's torque limit at joint speeds `v`, into `out`; `effort` where no drive train is set.

@@ -25,6 +25,11 @@ pub struct Stepper {
     /// Full-step angle, degrees (1.8 for a 200-step motor).
     pub step_angle_deg: f64,
     pub pull_out: PullOut,
+    /// Viscous damping of the rotor's oscillation about the field, N·m·s/rad at the shaft, acting on
+    /// the slip speed: the back-EMF's through the winding resistance, c = K_t²/R with K_t ≈ T_H/I
+    /// (0.037 for the 17HS4401). An estimate, upper bound: a chopper drive that holds the current
+    /// removes part of it. 0 when the catalogue gives no resistance.
+    pub damping: f64,
 }
 
 impl Stepper {

@@ -155,6 +155,18 @@ impl Plant for DiscretePlant {
         }
     }
 
+    fn advance_driven(&mut self, model: &Model, data: &mut Data, u: &mut [f64], torque: &mut dyn FnMut(&[f64], &[f64], &mut [f64]), q: &mut [f64], v: &mut [f64]) {
+        self.limit_active.fill(false);
+        for s in 0..self.substeps {
+            if s > 0 {
+                forward_kinematics(model, data, q);
+                gravity_and_bias_from_kinematics(model, data, v);
+            }
+            torque(q, v, u);
+            self.step(model, data, u, q, v);
+        }
+    }
+
     fn limit_active(&self) -> &[bool] {
         &self.limit_active
     }

@@ -84,7 +84,8 @@ impl Console {
         writeln!(self.out, "  plant: {}", run.plant).map_err(io)?;
         if let Some(motors) = &e.motors {
             let names: Vec<String> = m.joints.iter().map(|j| j.name.clone()).collect();
-            writeln!(self.out, "  motors ({}): the torque limit falls with the joint's speed", motors.source.display()).map_err(io)?;
+            let mode = if e.stepper_mode { "; stepper joints driven open loop in microsteps (no PD; --drive pd for the PD controller)" } else { "" };
+            writeln!(self.out, "  motors ({}): the torque limit falls with the joint's speed{mode}", motors.source.display()).map_err(io)?;
             write!(self.out, "{}", motors.table(&names)).map_err(io)?;
         }
         writeln!(self.out, "  command: {}", run.trajectory).map_err(io)?;
@@ -157,6 +158,9 @@ pub fn write_summary(out: &mut dyn Write, s: &Summary) -> std::io::Result<()> {
     writeln!(out, "{}", row("chatter (%)", s.chatter_percent.iter().map(|p| format!("{p:.1}")).collect()))?;
     writeln!(out, "{}", row("peak |u| (N·m)", s.peak_abs_torque.iter().map(|p| format!("{p:.3}")).collect()))?;
     writeln!(out, "{}", row("effort limit (N·m)", s.effort_limit.iter().map(|p| format!("{}", (p * 1e3).round() / 1e3)).collect()))?;
+    if s.first_lost_step_time.iter().any(|t| t.is_some()) || s.lost_steps.iter().any(|&l| l > 0) {
+        writeln!(out, "{}", row("lost steps (full)", s.lost_steps.iter().map(|p| format!("{p}")).collect()))?;
+    }
     if s.lowest_torque_limit.iter().zip(&s.effort_limit).any(|(a, b)| a != b) {
         writeln!(out, "{}", row("lowest limit (N·m)", s.lowest_torque_limit.iter().map(|p| format!("{p:.3}")).collect()))?;
     }

@@ -600,6 +600,8 @@ impl Recorder for McapRecorder {
             tool_error: 0.0,
             tool_position: Vec::with_capacity(3),
             torque_limit: vec![0.0; n],
+            load_angle: vec![0.0; n],
+            lost_steps: vec![0; n],
         };
         self.scene = scene_from_model(model).map_err(|(path, err)| Error::output(&path, err))?;
         let scene_bytes = foxglove::Encode::encoded_len(&self.scene).unwrap_or(0);
@@ -660,6 +662,8 @@ impl Recorder for McapRecorder {
             tel.saturated[j] = s.saturated[j] as u32;
             tel.chatter[j] = s.chatter[j] as u32;
             tel.torque_limit[j] = s.torque_limit[j];
+            tel.load_angle[j] = s.load_angle[j];
+            tel.lost_steps[j] = s.lost_steps[j];
         }
         let path = &self.path;
         let fail = |e: String| Error::output(path, e);

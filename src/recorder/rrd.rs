@@ -55,6 +55,10 @@ struct JointColumns {
     /// `joints/<joint>/torque_limit` per step, [+limit, −limit], when the limit falls with speed
     /// (`--motors`); otherwise two lines spanning each block.
     limit: Vec<f64>,
+    /// Stepper mode: `joints/<joint>/load_angle` (electrical degrees) and `joints/<joint>/lost_steps`
+    /// (full steps lost so far) per step.
+    load_angle: Vec<f64>,
+    lost_steps: Vec<f64>,
 }
 
 impl JointColumns {
@@ -66,11 +70,13 @@ impl JointColumns {
             saturated_times: Vec::new(),
             saturated_torque: Vec::new(),
             limit: Vec::new(),
+            load_angle: Vec::new(),
+            lost_steps: Vec::new(),
         }
     }
 
     fn clear(&mut self) {
-        for c in [&mut self.position, &mut self.torque, &mut self.status, &mut self.saturated_times, &mut self.saturated_torque, &mut self.limit] {
+        for c in [&mut self.position, &mut self.torque, &mut self.status, &mut self.saturated_times, &mut self.saturated_torque, &mut self.limit, &mut self.load_angle, &mut self.lost_steps] {
             c.clear();
         }
     }
@@ -95,6 +101,8 @@ pub struct RerunRecorder {
     effort: Vec<f64>,
     /// The torque limit falls with speed (`--motors`): recorded at every step.
     speed_dependent_limit: bool,
+    /// Per joint: driven open loop (stepper mode): its load angle and lost steps are recorded.
+    stepped: Vec<bool>,
     times: Vec<f64>,
     joints: Vec<JointColumns>,
     /// [x, y, z] per step.
@@ -137,6 +145,7 @@ impl RerunRecorder {
             joint_names: Vec::new(),
             effort: Vec::new(),
             speed_dependent_limit: false,
+            stepped: Vec::new(),
             times: Vec::new(),
             joints: Vec::new(),
             tool: Vec::new(),
@@ -327,6 +336,10 @@ impl RerunRecorder {
             for (leaf, values, width) in [("position", &c.position, 2), ("torque", &c.torque, 2), ("status", &c.status, 3)] {
                 debug_assert_eq!(values.len(), width * steps);
                 send(&format!("{base}/{leaf}"), time.clone(), scalars(values, width))?;
+            }
+            if self.stepped[j] {
+                send(&format!("{base}/load_angle"), time.clone(), scalars(&c.load_angle, 1))?;
+                send(&format!("{base}/lost_steps"), time.clone(), scalars(&c.lost_steps, 1))?;
             }
             if !c.saturated_times.is_empty() {
                 let times = TimeColumn::new_duration_secs(TIMELINE, c.saturated_times.iter().copied());
@@ -561,6 +574,7 @@ impl Recorder for RerunRecorder {
         self.joint_names = model.joints.iter().map(|j| j.name.clone()).collect();
         self.effort = e.controller().effort;
         self.speed_dependent_limit = e.motors.is_some();
+        self.stepped = e.open_loop_steppers().map_or(vec![false; e.model.dof()], |s| s.stepped);
         let cap = FILE_BLOCK_STEPS + 1;
         self.times = Vec::with_capacity(cap);
         self.joints = (0..model.dof()).map(|_| JointColumns::with_capacity(cap)).collect();
@@ -611,6 +625,10 @@ impl Recorder for RerunRecorder {
             c.torque.extend_from_slice(&[s.u[j], s.tau_g[j]]);
             if self.speed_dependent_limit {
                 c.limit.extend_from_slice(&[s.torque_limit[j], -s.torque_limit[j]]);
+            }
+            if self.stepped[j] {
+                c.load_angle.push(s.load_angle[j]);
+                c.lost_steps.push(s.lost_steps[j] as f64);
             }
             c.status.extend_from_slice(&[s.tracking_error(j), flag(s.saturated[j]), flag(s.chatter[j])]);
             if s.saturated[j] {

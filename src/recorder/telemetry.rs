@@ -45,6 +45,12 @@ pub struct ControllerTelemetry {
     /// the motor gives at the joint's speed through its gearbox.
     #[prost(double, repeated, tag = "10")]
     pub torque_limit: Vec<f64>,
+    /// Stepper mode: each joint's load angle, electrical degrees (0 where not a stepper).
+    #[prost(double, repeated, tag = "11")]
+    pub load_angle: Vec<f64>,
+    /// Stepper mode: full steps each joint has lost so far.
+    #[prost(int64, repeated, tag = "12")]
+    pub lost_steps: Vec<i64>,
 }
 
 /// The schema as MCAP's protobuf profile wants it: a serialized FileDescriptorSet. Kept next to
@@ -71,6 +77,8 @@ pub fn file_descriptor_set() -> Vec<u8> {
             field("tool_error", 8, false, Type::Double),
             field("tool_position", 9, true, Type::Double),
             field("torque_limit", 10, true, Type::Double),
+            field("load_angle", 11, true, Type::Double),
+            field("lost_steps", 12, true, Type::Int64),
         ],
         ..Default::default()
     };

@@ -33,6 +33,8 @@ struct SampleBlock {
     u: Vec<f64>,
     tau_g: Vec<f64>,
     torque_limit: Vec<f64>,
+    load_angle: Vec<f64>,
+    lost_steps: Vec<i64>,
     saturated: Vec<bool>,
     chatter: Vec<bool>,
     at_limit: Vec<bool>,
@@ -57,6 +59,8 @@ impl SampleBlock {
             u: f(),
             tau_g: f(),
             torque_limit: f(),
+            load_angle: f(),
+            lost_steps: Vec::with_capacity(capacity * n),
             saturated: Vec::with_capacity(capacity * n),
             chatter: Vec::with_capacity(capacity * n),
             at_limit: Vec::with_capacity(capacity * n),
@@ -81,6 +85,8 @@ impl SampleBlock {
         self.u.extend_from_slice(s.u);
         self.tau_g.extend_from_slice(s.tau_g);
         self.torque_limit.extend_from_slice(s.torque_limit);
+        self.load_angle.extend_from_slice(s.load_angle);
+        self.lost_steps.extend_from_slice(s.lost_steps);
         self.saturated.extend_from_slice(s.saturated);
         self.chatter.extend_from_slice(s.chatter);
         self.at_limit.extend_from_slice(s.at_limit);
@@ -102,6 +108,8 @@ impl SampleBlock {
             u: &self.u[a..b],
             tau_g: &self.tau_g[a..b],
             torque_limit: &self.torque_limit[a..b],
+            load_angle: &self.load_angle[a..b],
+            lost_steps: &self.lost_steps[a..b],
             saturated: &self.saturated[a..b],
             chatter: &self.chatter[a..b],
             at_limit: &self.at_limit[a..b],
@@ -117,9 +125,10 @@ impl Reusable for SampleBlock {
         self.k.clear();
         self.t.clear();
         self.is_final.clear();
-        for v in [&mut self.q, &mut self.v, &mut self.cmd, &mut self.cmd_dot, &mut self.u, &mut self.tau_g, &mut self.torque_limit] {
+        for v in [&mut self.q, &mut self.v, &mut self.cmd, &mut self.cmd_dot, &mut self.u, &mut self.tau_g, &mut self.torque_limit, &mut self.load_angle] {
             v.clear();
         }
+        self.lost_steps.clear();
         self.saturated.clear();
         self.chatter.clear();
         self.at_limit.clear();

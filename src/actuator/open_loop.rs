@@ -1,0 +1,187 @@
+//! Stepper mode: open-loop steppers, as the real SmallRobotArm runs them (no encoders, no PD loop).
+//!
+//! The commanded joint angle becomes a commanded motor position in microsteps, N·(cmd − q₀) rounded
+//! to a microstep (the rotor is energized where it stands at the start). The rotor, at N·(q − q₀), is
+//! pulled toward it with T(ω)·sin(N_r·Δ): Δ the lag of the rotor behind the command (the load angle),
+//! N_r = 90°/step angle (50 for 1.8°: an electrical period is 4 full steps), T(ω) the pull-out curve at
+//! the rotor's speed. At the joint that is η·N·T·sin(N_r·Δ), capped by the gearbox's rating. When the lag
+//! passes 2 full steps the rotor falls into the next stable position, 4 full steps away: those steps are
+//! lost, and, open loop, the arm keeps that offset. The torque is evaluated at the plant rate.
+//!
+//! The driver's step generator, as AccelStepper and the arm's firmware do, follows the command with
+//! a bounded acceleration (a stepper cannot start at full speed): its velocity moves toward
+//! cmd_dot + K·(cmd − position), K = 50/s, by at most `acceleration`·dt per control period (motor file
+//! field `acceleration`, rad/s² at the joint; by default half of what the motor gives at rest against
+//! the joint's inertia at the start pose). Once caught up on a smooth command it follows it exactly.
+
+use super::{DriveTrain, MotorSet, Stepper};
+use std::f64::consts::PI;
+
+/// One joint's open-loop stepper.
+#[derive(Debug)]
+struct SteppedJoint {
+    joint: usize,
+    gear_ratio: f64,
+    efficiency: f64,
+    rated_torque: f64,
+    stepper: Stepper,
+    /// Electrical periods per motor radian (N_r).
+    teeth: f64,
+    /// One microstep, motor radians.
+    microstep: f64,
+    start: f64,
+    /// The step generator: position (joint, from the start) and velocity, and its acceleration bound.
+    generator_position: f64,
+    generator_velocity: f64,
+    max_acceleration: f64,
+    /// The commanded motor position, motor radians from the start.
+    command: f64,
+    /// Full steps lost so far, signed (+: the rotor fell behind a positive command).
+    lost_steps: i64,
+}
+
+impl SteppedJoint {
+    fn lag(&self, q: f64) -> f64 {
+        self.command - self.gear_ratio * (q - self.start)
+    }
+
+    fn torque(&self, q: f64, v: f64) -> f64 {
+        let available = super::Motor::torque_at(&self.stepper, self.gear_ratio * v);
+        let pull = self.efficiency * self.gear_ratio * available * (self.teeth * self.lag(q)).sin();
+        // the rotor's oscillation about the field damped (at the joint through the gears, N²): on the
+        // slip speed, the field turning at the step generator's speed (the drive holds the current,
+        // so there is no drag on the speed itself: that is the pull-out curve's part)
+        let damping = self.stepper.damping * self.gear_ratio * self.gear_ratio * (self.generator_velocity - v);
+        (pull + damping).clamp(-self.rated_torque, self.rated_torque)
+    }
+}
+
+/// The joints a motor file drives open loop (every stepper, unless `--drive pd`).
+#[derive(Debug)]
+pub struct OpenLoopSteppers {
+    joints: Vec<SteppedJoint>,
+    /// Per coordinate: driven open loop here.
+    pub stepped: Vec<bool>,
+}
+
+/// A lost-step event: at time `t`, joint `joint` lost `steps` full steps (signed).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LostSteps {
+    pub joint: usize,
+    pub t: f64,
+    pub steps: i64,
+}
+
+impl OpenLoopSteppers {
+    /// The stepper joints of `motors` with their microsteps, their step generators' acceleration
+    /// bounds (`inertia`: M_ii at the start pose, for the default); None when there are none.
+    pub fn new(motors: &MotorSet, microsteps: &[Option<u32>], start: &[f64], inertia: &[f64]) -> Option<Self> {
+        let mut joints = Vec::new();
+        for (j, drive) in motors.joints.iter().enumerate() {
+            let Some(DriveTrain { motor, gear_ratio, efficiency, rated_torque }) = drive else { continue };
+            let Some(stepper) = motor.as_stepper() else { continue };
+            let micro = microsteps.get(j).copied().flatten().unwrap_or(1) as f64;
+            joints.push(SteppedJoint {
+                joint: j,
+                gear_ratio: *gear_ratio,
+                efficiency: *efficiency,
+                rated_torque: *rated_torque,
+                teeth: 90.0 / stepper.step_angle_deg,
+                microstep: stepper.step_angle_deg.to_radians() / micro,
+                stepper: stepper.clone(),
+                start: start[j],
+                generator_position: 0.0,
+                generator_velocity: 0.0,
+                max_acceleration: motors.acceleration.get(j).copied().flatten().unwrap_or(0.5 * efficiency * gear_ratio * stepper.holding_torque / inertia[j]),
+                command: 0.0,
+                lost_steps: 0,
+            });
+        }
+        if joints.is_empty() {
+            return None;
+        }
+        let mut stepped = vec![false; start.len()];
+        for s in &joints {
+            stepped[s.joint] = true;
+        }
+        Some(Self { joints, stepped })
+    }
+
+    /// The driver's step pulses for this control period: the step generator moves toward the
+    /// command with bounded acceleration; its position in whole microsteps is the motor's command.
+    pub fn set_command(&mut self, cmd: &[f64], cmd_dot: &[f64], dt: f64) {
+        const CATCH_UP: f64 = 50.0;
+        for s in &mut self.joints {
+            let error = cmd[s.joint] - s.start - s.generator_position;
+            let wanted = cmd_dot[s.joint] + CATCH_UP * error;
+            let bound = s.max_acceleration * dt;
+            s.generator_velocity += (wanted - s.generator_velocity).clamp(-bound, bound);
+            s.generator_position += s.generator_velocity * dt;
+            s.command = (s.gear_ratio * s.generator_position / s.microstep).round() * s.microstep;
+        }
+    }
+
+    /// The rest positions that carry the weight: per stepper joint, the sag q − q_start at which its
+    /// holding torque balances `tau_g` (η·N·T_H·sin(N_r·N·(−sag)) + τ_g = 0), or None for a joint
+    /// whose load is beyond its holding torque.
+    pub fn rest_sag(&self, tau_g: &[f64]) -> Vec<(usize, Option<f64>)> {
+        self.joints
+            .iter()
+            .map(|s| {
+                let ratio = tau_g[s.joint] / (s.efficiency * s.gear_ratio * s.stepper.holding_torque.min(s.rated_torque / (s.efficiency * s.gear_ratio)));
+                (s.joint, (ratio.abs() < 1.0).then(|| ratio.asin() / (s.teeth * s.gear_ratio)))
+            })
+            .collect()
+    }
+
+    /// The torque each stepper joint gets at (q, q̇), into `u` (other joints untouched).
+    pub fn torques(&self, q: &[f64], v: &[f64], u: &mut [f64]) {
+        for s in &self.joints {
+            u[s.joint] = s.torque(q[s.joint], v[s.joint]);
+        }
+    }
+
+    /// Each stepper joint's load angle, electrical degrees (±90° is the peak torque, ±180° the slip
+    /// point), of the lag left after whole lost periods; 0 elsewhere.
+    pub fn load_angles(&self, q: &[f64], out: &mut [f64]) {
+        for s in &self.joints {
+            let electrical = s.teeth * s.lag(q[s.joint]);
+            out[s.joint] = (electrical - 2.0 * PI * (electrical / (2.0 * PI)).round()).to_degrees();
+        }
+    }
+
+    /// After a step: count the electrical periods the rotor has slipped (4 full steps each); report
+    /// each new loss.
+    pub fn update(&mut self, q: &[f64], t: f64, events: &mut Vec<LostSteps>) {
+        for s in &mut self.joints {
+            let periods = (s.teeth * s.lag(q[s.joint]) / (2.0 * PI)).round() as i64;
+            let lost = 4 * periods;
+            if lost != s.lost_steps {
+                events.push(LostSteps { joint: s.joint, t, steps: lost - s.lost_steps });
+                s.lost_steps = lost;
+            }
+        }
+    }
+
+    /// Full steps lost so far per coordinate (0 for joints not driven here).
+    pub fn lost_steps(&self, out: &mut [i64]) {
+        for s in &self.joints {
+            out[s.joint] = s.lost_steps;
+        }
+    }
+
+    /// The generator's acceleration bound per stepper joint (rad/s² at the joint).
+    pub fn accelerations(&self) -> Vec<(usize, f64)> {
+        self.joints.iter().map(|s| (s.joint, s.max_acceleration)).collect()
+    }
+
+    /// The electrical damping of each stepper joint at the joint, N²·c (N·m·s/rad).
+    pub fn damping(&self) -> Vec<(usize, f64)> {
+        self.joints.iter().map(|s| (s.joint, s.stepper.damping * s.gear_ratio * s.gear_ratio)).collect()
+    }
+
+    /// The stiffness of each stepper joint about its stable position at rest, η·N²·T_H·N_r (N·m/rad).
+    pub fn stiffness(&self) -> Vec<(usize, f64)> {
+        self.joints.iter().map(|s| (s.joint, s.efficiency * s.gear_ratio * s.gear_ratio * s.stepper.holding_torque * s.teeth)).collect()
+    }
+}

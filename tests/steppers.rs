@@ -1,0 +1,184 @@
+//! Stepper mode (`--motors` with steppers): open-loop steppers against the physics they must show.
+//! The box model with the tutorial's motor file (a 17HS4401, 0.40 N·m, through 15:1 on J1–J3 and 5:1
+//! on J4–J6, 90 % efficient) and with the real SmallRobotArm's reductions.
+
+mod common;
+
+use armscope::config::{DriveMode, RunConfig};
+use armscope::dynamics::{Data, gravity_forces, rnea};
+use armscope::experiment::Experiment;
+use armscope::recorder::{Recorder, RunInfo};
+use armscope::sample::Sample;
+use armscope::sim::simulate;
+use armscope::summary::{RunStatus, Summary};
+
+fn config(motors: &str, extra: impl FnOnce(&mut RunConfig)) -> RunConfig {
+    let mut c = RunConfig { urdf: common::box_urdf(), motors: Some(common::repo().join("assets/motors").join(motors)), ..RunConfig::default() };
+    extra(&mut c);
+    c
+}
+
+#[derive(Default)]
+struct Positions {
+    rows: Vec<(f64, Vec<f64>, Vec<i64>)>,
+}
+
+impl Recorder for Positions {
+    fn start(&mut self, _: &RunInfo) -> Result<(), armscope::error::Error> {
+        Ok(())
+    }
+    fn record(&mut self, s: &Sample) -> Result<(), armscope::error::Error> {
+        self.rows.push((s.t, s.q.to_vec(), s.lost_steps.to_vec()));
+        Ok(())
+    }
+    fn finish(&mut self, _: &RunInfo, _: &Summary) -> Result<(), armscope::error::Error> {
+        Ok(())
+    }
+}
+
+/// Holding the arm out horizontally (every joint commanded to 0): each stepper sags by the load angle
+/// that carries its share of the weight, η·N·T_H·sin(N_r·N·Δq) = τ_g, and loses no step while the
+/// weight is within its holding torque (J2 needs 4.43 of its 5.4 N·m). The rotor rings about that
+/// angle (almost no damping): its mean over the last 2 s of 6 s is compared, within 3 %.
+#[test]
+fn a_stepper_holding_the_arm_sags_by_the_load_angle_that_carries_the_weight_and_loses_nothing() {
+    let experiment = Experiment::prepare(config("tutorial.toml", |c| {
+        c.hold = true;
+        c.q0 = Some("0,0,0,0,0,0".into());
+        c.duration = 6.0;
+    }))
+    .unwrap();
+    let mut rec = Positions::default();
+    let summary = simulate(&experiment, &mut [&mut rec], None).unwrap();
+    assert_eq!(summary.lost_steps, [0, 0, 0, 0, 0, 0]);
+    let tail: Vec<&Vec<f64>> = rec.rows.iter().filter(|r| r.0 >= 4.0).map(|r| &r.1).collect();
+    let mean: Vec<f64> = (0..6).map(|j| tail.iter().map(|q| q[j]).sum::<f64>() / tail.len() as f64).collect();
+    let tau_g = gravity_forces(&experiment.model, &mut Data::new(&experiment.model), &mean).to_vec();
+    let ratios = [15.0, 15.0, 15.0, 5.0, 5.0, 5.0];
+    for j in 1..5 {
+        // equilibrium: the stepper's torque η·N·T_H·sin(50·N·(0 − q)) balances τ_g
+        let available = 0.9 * ratios[j] * 0.40;
+        let want = (tau_g[j] / available).asin() / (50.0 * ratios[j]);
+        assert!((mean[j] - want).abs() <= 0.03 * want.abs(), "J{}: mean sag {:.4e} rad, load angle predicts {want:.4e}", j + 1, mean[j]);
+    }
+    assert!(mean[1] > 1e-3, "J2 sags visibly: {}", mean[1]);
+}
+
+/// The same pose with the real SmallRobotArm's reductions: J2's stepper (4:1, 1.52 N·m) cannot
+/// carry the 4.43 N·m: it slips and keeps slipping.
+#[test]
+fn a_stepper_slips_when_the_weight_is_beyond_its_holding_torque() {
+    let experiment = Experiment::prepare(config("smallrobotarm.toml", |c| {
+        c.hold = true;
+        c.q0 = Some("0,0,0,0,0,0".into());
+        c.duration = 2.0;
+    }))
+    .unwrap();
+    let summary = simulate(&experiment, &mut [], None).unwrap();
+    assert!(summary.lost_steps[1] >= 4, "J2 lost {} steps", summary.lost_steps[1]);
+    assert!(summary.first_lost_step_time[1].unwrap() < 0.5);
+    assert_eq!(summary.lost_steps[0], 0, "J1 (vertical axis) carries no weight");
+}
+
+/// Peak torque the commanded motion needs (inverse dynamics of cmd, cmd_dot and a numerical cmd_ddot)
+/// against what the drive train gives at the commanded speed, per joint: the worst ratio.
+fn demand_over_supply(experiment: &Experiment) -> Vec<f64> {
+    let model = &experiment.model;
+    let motors = experiment.motors.as_ref().unwrap();
+    let mut data = Data::new(model);
+    let (h, n) = (1e-4, model.dof());
+    let mut worst = vec![0.0f64; n];
+    let (mut c0, mut d0, mut c1, mut d1) = (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+    for k in 0..(experiment.config.duration / 0.002) as usize {
+        let t = k as f64 * 0.002;
+        experiment.trajectory.sample(t, &mut c0, &mut d0);
+        experiment.trajectory.sample(t + h, &mut c1, &mut d1);
+        let a: Vec<f64> = d0.iter().zip(&d1).map(|(x, y)| (y - x) / h).collect();
+        let tau = rnea(model, &mut data, &c0, &d0, &a).to_vec();
+        for j in 0..n {
+            let supply = motors.joints[j].as_ref().unwrap().torque_limit(d0[j]);
+            worst[j] = worst[j].max(tau[j].abs() / supply);
+        }
+    }
+    worst
+}
+
+/// The default wave (0.5 rad/s) is within every joint's pull-out curve and loses nothing; at
+/// `--freq 3` J2, whose demand reaches 85 % of its curve, loses steps — already below 100 %: the
+/// rotor rings about its mean load angle whenever the motion's acceleration changes, which is why
+/// steppers are sized with ~30 % headroom — and the joints that need less than half their torque
+/// lose none.
+#[test]
+fn a_slow_wave_within_the_pull_out_curve_loses_nothing_a_fast_one_loses_steps_where_demand_exceeds_it() {
+    let slow = Experiment::prepare(config("tutorial.toml", |c| c.duration = 10.0)).unwrap();
+    assert!(demand_over_supply(&slow).iter().all(|&r| r < 1.0), "{:?}", demand_over_supply(&slow));
+    let summary = simulate(&slow, &mut [], None).unwrap();
+    assert_eq!(summary.lost_steps, [0, 0, 0, 0, 0, 0], "slow wave");
+    assert!(matches!(summary.status, RunStatus::Completed));
+
+    let fast = Experiment::prepare(config("tutorial.toml", |c| {
+        c.duration = 10.0;
+        c.freq = 3.0;
+    }))
+    .unwrap();
+    let ratio = demand_over_supply(&fast);
+    let summary = simulate(&fast, &mut [], None).unwrap();
+    for j in 0..6 {
+        if ratio[j] > 0.8 {
+            assert!(summary.lost_steps[j] > 0, "J{} needs {:.2}× its curve and loses nothing", j + 1, ratio[j]);
+        }
+        if ratio[j] < 0.5 {
+            assert_eq!(summary.lost_steps[j], 0, "J{} needs only {:.2}× its curve", j + 1, ratio[j]);
+        }
+    }
+    assert!(ratio[1] > 0.8 && ratio.iter().enumerate().all(|(j, &r)| j == 1 || r < 0.5), "{ratio:?}");
+}
+
+/// `--drive pd` runs the tutorial's PD controller on the steppers' pull-out limit instead: no open
+/// loop, no lost steps counted; on the discrete plant with one step per control period the energy
+/// audit is on, and the run completes (the books balance with the motors' rotors and limits).
+#[test]
+fn drive_pd_runs_the_pd_loop_on_the_pull_out_limit_and_the_energy_audit_balances() {
+    let experiment = Experiment::prepare(config("tutorial.toml", |c| {
+        c.drive = DriveMode::Pd;
+        c.duration = 10.0;
+    }))
+    .unwrap();
+    assert!(!experiment.stepper_mode);
+    assert!(experiment.open_loop_steppers().is_none());
+    let summary = simulate(&experiment, &mut [], None).unwrap();
+    assert!(matches!(summary.status, RunStatus::Completed), "{:?}", summary.status);
+    assert_eq!(summary.lost_steps, [0, 0, 0, 0, 0, 0]);
+}
+
+/// The lost steps and load angles are in both recordings, the summary JSON names them, and the
+/// console says in words which joint lost steps and when.
+#[test]
+fn lost_steps_and_load_angles_are_in_both_recordings_and_the_summary() {
+    let dir = tempfile::tempdir().unwrap();
+    let (rrd, mcap, json) = (dir.path().join("s.rrd"), dir.path().join("s.mcap"), dir.path().join("s.json"));
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_armscope"))
+        .args(["run", "--motors", common::repo().join("assets/motors/smallrobotarm.toml").to_str().unwrap(), "--urdf", common::box_urdf().to_str().unwrap(), "--duration", "1"])
+        .args(["--rrd", rrd.to_str().unwrap(), "--mcap", mcap.to_str().unwrap(), "--summary-json", json.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("lost steps (full)") && stdout.contains("J2: its stepper lost"), "{stdout}");
+    let summary: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let lost_j2 = summary["summary"]["lost_steps"][1].as_u64().unwrap();
+    assert!(lost_j2 > 0);
+    let rrd = common::rrd::Rrd::open(&rrd);
+    let lost = rrd.series("/joints/J2/lost_steps");
+    let angle = rrd.series("/joints/J2/load_angle");
+    assert_eq!((lost.len(), angle.len()), (1001, 1001), "one row per step");
+    assert!(angle.iter().all(|(_, a)| a[0].abs() <= 180.0));
+    assert!(lost.last().unwrap().1[0].abs() > 0.0, "the count reached the end of the run");
+    let bytes = std::fs::read(&mcap).unwrap();
+    let last = mcap::MessageStream::new(&bytes).unwrap().map(|m| m.unwrap()).filter(|m| m.channel.topic == "/controller").last().unwrap();
+    let schema = last.channel.schema.clone().unwrap();
+    let pool = prost_reflect::DescriptorPool::decode(&schema.data[..]).unwrap();
+    let v = prost_reflect::DynamicMessage::decode(pool.get_message_by_name(&schema.name).unwrap(), &last.data[..]).unwrap();
+    let steps = v.get_field_by_name("lost_steps").unwrap().as_list().unwrap().to_vec();
+    assert_eq!(steps[1].as_i64().unwrap(), lost.last().unwrap().1[0] as i64, "the MCAP's count is the .rrd's");
+}
