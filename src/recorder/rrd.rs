@@ -293,7 +293,9 @@ impl RerunRecorder {
                     "status",
                     lines(&[format!("{name} error (rad)"), format!("{name} saturated (0/1)"), format!("{name} chatter (0/1)")], &[c, red, rerun::Color::from_rgb(240, 160, 40)], &[1.5, 1.0, 1.0]),
                 ),
-                ("torque_limit", lines(&[format!("{name} +effort"), format!("{name} −effort")], &[red, red], &[1.0, 1.0])),
+                ("torque_limit", lines(&[format!("{name} +limit"), format!("{name} −limit")], &[red, red], &[1.0, 1.0])),
+                ("load_angle", lines(&[format!("{name} load angle (electrical °; ±90 peak torque, ±180 slip)")], &[c], &[1.5])),
+                ("lost_steps", lines(&[format!("{name} lost steps (full)")], &[red], &[2.0])),
             ];
             for (leaf, style) in styles {
                 rec.log_static(format!("{base}/{leaf}"), &style).map_err(e)?;
@@ -505,7 +507,8 @@ pub fn joint_color(j: usize) -> rerun::Color {
 
 /// The layout the file opens to: the arm in 3D with the tool's position below it, and per joint
 /// its angle against the target and its torque against the motor's limits, saturated steps marked.
-pub fn blueprint(joint_names: &[String], prefix: &str) -> Blueprint {
+/// With steppers driven open loop (`stepped`), a third row: each one's load angle and lost steps.
+pub fn blueprint(joint_names: &[String], stepped: &[bool], prefix: &str) -> Blueprint {
     let angle_views = joint_names.iter().map(|j| {
         TimeSeriesView::new(format!("{j} angle vs target"))
             .with_origin(format!("{prefix}joints/{j}"))
@@ -525,10 +528,20 @@ pub fn blueprint(joint_names: &[String], prefix: &str) -> Blueprint {
         TimeSeriesView::new("tool tip error").with_origin(format!("{prefix}tool_error")).into(),
     ])
     .with_row_shares([4.0, 1.0, 1.0]);
-    let right = Vertical::new([
+    let stepper_views: Vec<_> = joint_names
+        .iter()
+        .zip(stepped.iter().chain(std::iter::repeat(&false)))
+        .filter(|(_, s)| **s)
+        .map(|(j, _)| TimeSeriesView::new(format!("{j} stepper: load angle, lost steps")).with_origin(format!("{prefix}joints/{j}")).with_contents(["$origin/load_angle", "$origin/lost_steps"]).into())
+        .collect();
+    let mut rows = vec![
         Grid::new(angle_views).with_grid_columns(columns).with_name("joint angles").into(),
         Grid::new(torque_views).with_grid_columns(columns).with_name("joint torques").into(),
-    ]);
+    ];
+    if !stepper_views.is_empty() {
+        rows.push(Grid::new(stepper_views).with_grid_columns(columns).with_name("steppers").into());
+    }
+    let right = Vertical::new(rows);
     Blueprint::new(Horizontal::new([left.into(), right.into()]).with_column_shares([2.0, 3.0]))
         .with_time_panel(TimePanel::new().with_timeline(TIMELINE).with_play_state(PlayState::Following).with_state(PanelState::Collapsed))
         .with_selection_panel(SelectionPanel::new().with_state(PanelState::Collapsed))
@@ -590,7 +603,7 @@ impl Recorder for RerunRecorder {
         self.steps_per_trail_point = ((1.0 / TRAIL_RATE_HZ) / e.config.dt).round().max(1.0) as usize;
         self.steps_per_pose = super::steps_per_pose(e.config.dt);
 
-        blueprint(&self.joint_names, "").send(&rec, BlueprintActivation { make_active: true, make_default: true }).map_err(|x| self.err(x))?;
+        blueprint(&self.joint_names, &self.stepped, "").send(&rec, BlueprintActivation { make_active: true, make_default: true }).map_err(|x| self.err(x))?;
         self.log_static_scene(&rec, model)?;
         self.log_series_styles(&rec)?;
         rec.log_static("config", &rerun::TextDocument::from_markdown(config_markdown(run))).map_err(|x| self.err(x))?;
