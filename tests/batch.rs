@@ -157,3 +157,29 @@ fn compare_overlays_runs_under_their_own_prefix() {
     std::fs::write(&junk, b"not an mcap").unwrap();
     assert_eq!(armscope(&["compare", junk.to_str().unwrap(), "--out", out.to_str().unwrap()]), 2);
 }
+
+/// A manifest can give experiments motor files; the tables count each joint's lost steps.
+#[test]
+fn batch_tables_count_lost_steps_per_joint() {
+    let dir = tempfile::tempdir().unwrap();
+    let manifest = dir.path().join("m.toml");
+    let motors = common::repo().join("assets/motors");
+    std::fs::write(
+        &manifest,
+        format!(
+            "name = \"motors\"\n[[experiment]]\nname = \"tutorial\"\nmotors = \"{}\"\nduration = 2\n[[experiment]]\nname = \"real\"\nmotors = \"{}\"\nduration = 2\n",
+            motors.join("tutorial.toml").display(),
+            motors.join("smallrobotarm.toml").display()
+        ),
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    assert_eq!(armscope(&["batch", manifest.to_str().unwrap(), "--out", out.to_str().unwrap(), "--no-compare"]), 0);
+    let csv = std::fs::read_to_string(out.join("summary.csv")).unwrap();
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let col = header.iter().position(|h| *h == "lost_steps_2").expect("a lost_steps column per joint");
+    let value = |name: &str| -> u64 { csv.lines().find(|l| l.starts_with(name)).unwrap().split(',').nth(col).unwrap().parse().unwrap() };
+    assert_eq!(value("tutorial,"), 0, "the tutorial's motors carry the default wave");
+    assert!(value("real,") > 0, "the real reductions cannot hold the box model's J2");
+    assert!(std::fs::read_to_string(out.join("summary.md")).unwrap().contains("| lost steps |"));
+}

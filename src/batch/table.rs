@@ -30,21 +30,22 @@ fn per_joint(s: &Summary, f: impl Fn(usize) -> String) -> String {
 }
 
 pub fn markdown(summary: &BatchSummary) -> String {
-    let mut md = format!("# batch `{}`\n\nMax and RMS tracking error over every step with t ≥ the settle time (2 s), saturation % and chatter % of control steps, per joint J1..Jn.\n\n", summary.batch);
-    md += "| experiment | status | max err (rad) | RMS err (rad) | saturation % | chatter % | tool x / y / z range (m) | wall time incl. recording (s) |\n|---|---|---|---|---|---|---|---|\n";
+    let mut md = format!("# batch `{}`\n\nMax and RMS tracking error over every step with t ≥ the settle time (2 s), saturation % and chatter % of control steps, full steps lost (stepper mode), per joint J1..Jn.\n\n", summary.batch);
+    md += "| experiment | status | max err (rad) | RMS err (rad) | saturation % | chatter % | lost steps | tool x / y / z range (m) | wall time incl. recording (s) |\n|---|---|---|---|---|---|---|---|---|\n";
     for e in &summary.experiments {
         match &e.summary {
             Some(s) => {
                 let r = &s.tool_range;
                 let _ = writeln!(
                     md,
-                    "| {} | {} | {} | {} | {} | {} | [{:.3}, {:.3}] / [{:.3}, {:.3}] / [{:.3}, {:.3}] | {:.3} |",
+                    "| {} | {} | {} | {} | {} | {} | {} | [{:.3}, {:.3}] / [{:.3}, {:.3}] / [{:.3}, {:.3}] | {:.3} |",
                     e.name,
                     e.status,
                     per_joint(s, |j| fmt_opt(s.max_abs_error[j])),
                     per_joint(s, |j| fmt_opt(s.rms_error[j])),
                     per_joint(s, |j| format!("{:.1}", s.saturation_percent[j])),
                     per_joint(s, |j| format!("{:.1}", s.chatter_percent[j])),
+                    per_joint(s, |j| s.lost_steps.get(j).map_or("0".into(), |l| l.to_string())),
                     r.x.min,
                     r.x.max,
                     r.y.min,
@@ -55,7 +56,7 @@ pub fn markdown(summary: &BatchSummary) -> String {
                 );
             }
             None => {
-                let _ = writeln!(md, "| {} | {} | | | | | | |", e.name, e.status);
+                let _ = writeln!(md, "| {} | {} | | | | | | | |", e.name, e.status);
             }
         }
     }
@@ -65,7 +66,7 @@ pub fn markdown(summary: &BatchSummary) -> String {
 pub fn csv(summary: &BatchSummary) -> String {
     let n = summary.experiments.iter().filter_map(|e| e.summary.as_ref()).map(|s| s.joints.len()).max().unwrap_or(0);
     let mut header = vec!["experiment".to_string(), "status".into()];
-    for prefix in ["max_err", "rms_err", "saturation_pct", "chatter_pct"] {
+    for prefix in ["max_err", "rms_err", "saturation_pct", "chatter_pct", "lost_steps"] {
         header.extend((1..=n).map(|j| format!("{prefix}_{j}")));
     }
     header.extend(["x_min", "x_max", "y_min", "y_max", "z_min", "z_max", "wall_s", "error"].map(String::from));
@@ -79,12 +80,13 @@ pub fn csv(summary: &BatchSummary) -> String {
                 row.extend((0..n).map(|j| cell(s.rms_error.get(j).copied().flatten())));
                 row.extend((0..n).map(|j| cell(s.saturation_percent.get(j).copied())));
                 row.extend((0..n).map(|j| cell(s.chatter_percent.get(j).copied())));
+                row.extend((0..n).map(|j| s.lost_steps.get(j).map_or("0".into(), |l| l.to_string())));
                 let r = &s.tool_range;
                 row.extend([r.x.min, r.x.max, r.y.min, r.y.max, r.z.min, r.z.max, e.wall_time].map(|x| format!("{x:?}")));
                 row.push(String::new());
             }
             None => {
-                row.extend(std::iter::repeat_n(String::new(), 4 * n + 7));
+                row.extend(std::iter::repeat_n(String::new(), 5 * n + 7));
                 row.push(format!("\"{}\"", e.error.clone().unwrap_or_default().replace('"', "'")));
             }
         }
