@@ -111,7 +111,7 @@ pub struct AnalyzeArgs {
     pub amp_deg: f64,
     /// The plant in the loop.
     #[arg(long, value_enum, default_value = "discrete")]
-    pub plant: crate::analysis::LoopPlant,
+    pub plant: crate::diagnose::analysis::LoopPlant,
     /// Print the result as JSON.
     #[arg(long)]
     pub json: bool,
@@ -121,7 +121,7 @@ pub struct AnalyzeArgs {
 pub struct TrajectoryArgs {
     /// The shape, on a vertical plane in front of the arm.
     #[arg(value_enum)]
-    pub shape: crate::ik::Shape,
+    pub shape: crate::control::ik::Shape,
     #[arg(long, value_name = "PATH", default_value = crate::config::DEFAULT_URDF)]
     pub urdf: PathBuf,
     /// Time to draw the shape, s.
@@ -589,7 +589,7 @@ pub fn compare(args: &CompareArgs) -> Result<i32, Error> {
 
 /// `armscope trajectory`.
 pub fn trajectory(args: &TrajectoryArgs) -> Result<i32, Error> {
-    use crate::ik::{default_drawing, solve_drawing};
+    use crate::control::ik::{default_drawing, solve_drawing};
     let model = crate::model::load_urdf(&args.urdf)?;
     if !(args.duration > 0.0 && args.step > 0.0 && args.step <= args.duration) {
         return Err(Error::flag("--step", "must be positive and at most --duration"));
@@ -628,7 +628,7 @@ pub fn trajectory(args: &TrajectoryArgs) -> Result<i32, Error> {
     std::fs::write(&csv, text).map_err(|e| Error::output(&csv, e))?;
     std::fs::write(&npy, crate::npy::write_f64(times.len(), n + 1, &flat)).map_err(|e| Error::output(&npy, e))?;
     // check: every point by forward kinematics
-    let mut ik = crate::ik::PositionIk::new(&model, vec![]);
+    let mut ik = crate::control::ik::PositionIk::new(&model, vec![]);
     let worst = positions.iter().zip(&targets).map(|(q, p)| (ik.tool_position(q) - p).norm()).fold(0.0, f64::max);
     let c = drawing.centre;
     println!(
@@ -641,7 +641,7 @@ pub fn trajectory(args: &TrajectoryArgs) -> Result<i32, Error> {
 
 /// `armscope analyze`.
 pub fn analyze(args: &AnalyzeArgs) -> Result<i32, Error> {
-    use crate::analysis::{Linearization, LoopPlant, largest_stable_period, spectral_radius, stabilizing_kd_over, worst_radius};
+    use crate::diagnose::analysis::{Linearization, LoopPlant, largest_stable_period, spectral_radius, stabilizing_kd_over, worst_radius};
     let config = RunConfig {
         urdf: args.urdf.clone(),
         dt: args.dt,
@@ -664,12 +664,12 @@ pub fn analyze(args: &AnalyzeArgs) -> Result<i32, Error> {
     let h = args.dt;
     // the given pose first, then (--along-command) poses along the wave
     let poses: Vec<Vec<f64>> = if args.along_command {
-        let wave = crate::trajectory::Wave { amplitude_rad: args.amp_deg.to_radians(), omega: args.freq };
+        let wave = crate::control::trajectory::Wave { amplitude_rad: args.amp_deg.to_radians(), omega: args.freq };
         let period = 2.0 * std::f64::consts::PI / args.freq.abs().max(1e-6);
         let (mut q, mut qd) = (vec![0.0; n], vec![0.0; n]);
         std::iter::once(pose.clone())
             .chain((0..12).map(|i| {
-                crate::trajectory::Trajectory::sample(&wave, period * i as f64 / 12.0, &mut q, &mut qd);
+                crate::control::trajectory::Trajectory::sample(&wave, period * i as f64 / 12.0, &mut q, &mut qd);
                 q.clone()
             }))
             .collect()
@@ -740,8 +740,8 @@ pub fn analyze(args: &AnalyzeArgs) -> Result<i32, Error> {
 
 /// `armscope envelope`.
 pub fn envelope(args: &EnvelopeArgs) -> Result<i32, Error> {
-    use crate::analysis::{Linearization, LoopPlant, spectral_radius, stabilizing_kd};
-    use crate::envelope::{sweep, with_payload};
+    use crate::diagnose::analysis::{Linearization, LoopPlant, spectral_radius, stabilizing_kd};
+    use crate::diagnose::envelope::{sweep, with_payload};
     let freqs = args.freqs.clone().unwrap_or_else(|| (0..10).map(|i| 0.25 * 64f64.powf(i as f64 / 9.0)).map(|f| (f * 100.0).round() / 100.0).collect());
     let amps = args.amps.clone().unwrap_or_else(|| (0..10).map(|i| 5.0 + 55.0 * i as f64 / 9.0).map(|a| a.round()).collect());
     if freqs.iter().chain(&amps).any(|x| !(x.is_finite() && *x > 0.0)) {
@@ -778,7 +778,7 @@ pub fn envelope(args: &EnvelopeArgs) -> Result<i32, Error> {
         }
         let values: Vec<Vec<f64>> = (0..amps.len()).map(|a| (0..freqs.len()).map(|f| env.cell(a, f).required[j] / env.effort[j]).collect()).collect();
         let title = format!("{name} NEEDED TORQUE / LIMIT ({} NM){}", env.effort[j], if args.payload > 0.0 { format!(", PAYLOAD {} KG", args.payload) } else { String::new() });
-        let canvas = crate::heatmap::heatmap(&title, "WAVE FREQUENCY (RAD/S)", &x_ticks, "AMPLITUDE (DEG)", &y_ticks, &values);
+        let canvas = crate::diagnose::heatmap::heatmap(&title, "WAVE FREQUENCY (RAD/S)", &x_ticks, "AMPLITUDE (DEG)", &y_ticks, &values);
         let png = args.out.join(format!("envelope_{name}.png"));
         canvas.save_png(&png).map_err(|e| Error::output(&png, e))?;
         files.push(png);

@@ -1,14 +1,14 @@
 //! A [`RunConfig`] checked and resolved against its model: everything the simulation loop needs.
 
 use crate::config::{DriveMode, IntegratorKind, RunConfig};
-use crate::controller::PdGravityController;
+use crate::control::controller::PdGravityController;
 use crate::error::Error;
-use crate::gains::{Gains, TUTORIAL_KD, TUTORIAL_KP, auto_tune, is_tutorial_model};
-use crate::integrator::{ContinuousPlant, DiscretePlant, Plant, Tolerances};
+use crate::control::gains::{Gains, TUTORIAL_KD, TUTORIAL_KP, auto_tune, is_tutorial_model};
+use crate::plant::{ContinuousPlant, DiscretePlant, Plant, Tolerances};
 use crate::actuator::{MotorSet, OpenLoopSteppers, load_motor_file};
 use crate::model::{Actuator, LoadOptions, Model, load_urdf_with};
-use crate::analysis::LoopPlant;
-use crate::trajectory::{Hold, JointSchedule, JointStep, JointWave, Trajectory, Wave};
+use crate::diagnose::analysis::LoopPlant;
+use crate::control::trajectory::{Hold, JointSchedule, JointStep, JointWave, Trajectory, Wave};
 use nalgebra::Vector3;
 use std::sync::Arc;
 

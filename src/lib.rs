@@ -4,30 +4,25 @@
 //! [`sample::Sample`]s → [`recorder::Recorder`]s (console, CSV, trace, JSON, …).
 
 pub mod actuator;
-pub mod analysis;
 pub mod batch;
 pub mod builtin;
 pub mod cli;
 pub mod config;
-pub mod controller;
+pub mod control;
+pub mod diagnose;
 pub mod dynamics;
-pub mod envelope;
 pub mod error;
 pub mod experiment;
-pub mod gains;
-pub mod heatmap;
 pub mod inspect;
-pub mod ik;
-pub mod integrator;
 pub mod meshgen;
 pub mod model;
 pub mod npy;
+pub mod plant;
 pub mod recorder;
 pub mod runner;
 pub mod sample;
 pub mod sim;
 pub mod spatial;
 pub mod summary;
-pub mod trajectory;
 
 pub use error::Error;

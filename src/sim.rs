@@ -4,7 +4,7 @@ use crate::actuator::OpenLoopSteppers;
 use crate::dynamics::{Data, body_poses, forward_kinematics, frame_pose, frame_pose_in, gravity_and_bias_from_kinematics};
 use crate::error::Error;
 use crate::experiment::Experiment;
-use crate::controller::ControlOutput;
+use crate::control::controller::ControlOutput;
 use crate::recorder::{Recorder, RunInfo};
 use crate::sample::Sample;
 use crate::summary::{RunStatus, Summary, SummaryBuilder};

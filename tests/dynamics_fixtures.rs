@@ -6,7 +6,7 @@
 mod common;
 
 use armscope::dynamics::{Data, aba, bias_forces, crba, forward_kinematics, frame_jacobian, frame_pose, gravity_and_bias_from_kinematics, gravity_forces};
-use armscope::integrator::DiscretePlant;
+use armscope::plant::DiscretePlant;
 use armscope::model::{Model, load_urdf};
 use nalgebra::DMatrix;
 use serde_json::Value;

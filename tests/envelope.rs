@@ -5,9 +5,9 @@ mod common;
 
 use armscope::config::RunConfig;
 use armscope::dynamics::{Data, gravity_forces};
-use armscope::envelope::{required_torque, sweep, with_payload};
+use armscope::diagnose::envelope::{required_torque, sweep, with_payload};
 use armscope::model::load_urdf;
-use armscope::trajectory::{Trajectory, Wave};
+use armscope::control::trajectory::{Trajectory, Wave};
 use common::{armscope, box_urdf};
 
 #[test]

@@ -5,7 +5,7 @@
 mod common;
 
 use armscope::config::RunConfig;
-use armscope::controller::ControlOutput;
+use armscope::control::controller::ControlOutput;
 use armscope::dynamics::{Data, forward_kinematics, frame_pose, gravity_and_bias_from_kinematics};
 use armscope::experiment::Experiment;
 use std::alloc::{GlobalAlloc, Layout, System};

@@ -96,8 +96,8 @@ fn static_run_holds_the_start_pose_exactly_for_10_s() {
 fn trace_rows_are_consistent_instants() {
     // u is computed from the row's own q, qd, cmd and tau_g: u = kp(cmd − q) + kd(cmd_dot − qd) − tau_g, clipped
     let ours = trace(&["--duration", "0.2"]);
-    let kp = armscope::gains::TUTORIAL_KP;
-    let kd = armscope::gains::TUTORIAL_KD;
+    let kp = armscope::control::gains::TUTORIAL_KP;
+    let kd = armscope::control::gains::TUTORIAL_KD;
     let effort = [8.0, 12.0, 8.0, 5.0, 3.0, 1.5];
     for row in &ours.rows {
         for j in 0..6 {

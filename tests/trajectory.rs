@@ -4,9 +4,9 @@
 mod common;
 
 use armscope::dynamics::{Data, forward_kinematics, frame_pose};
-use armscope::ik::{Shape, default_drawing, solve_drawing};
+use armscope::control::ik::{Shape, default_drawing, solve_drawing};
 use armscope::model::load_urdf;
-use armscope::trajectory::{JointSchedule, Trajectory};
+use armscope::control::trajectory::{JointSchedule, Trajectory};
 use common::{armscope, read_csv, repo};
 
 #[test]

@@ -3,10 +3,12 @@
 
 mod compare;
 mod manifest;
+mod outcome;
 mod runner;
 mod table;
 
 pub use compare::{ComparedRun, build_comparison};
 pub use manifest::{Manifest, PlannedExperiment, load_manifest, parse_shard, shard};
-pub use runner::{BatchOptions, ExperimentOutcome, run_batch, write_comparison};
+pub use outcome::ExperimentOutcome;
+pub use runner::{BatchOptions, run_batch, write_comparison};
 pub use table::{BatchSummary, merge_summaries, write_tables};

@@ -1,4 +1,5 @@
 use super::manifest::{PlannedExperiment, load_manifest, shard};
+use super::outcome::ExperimentOutcome;
 use super::table::{BatchSummary, write_tables};
 use super::compare::{ComparedRun, build_comparison};
 
@@ -10,7 +11,6 @@ use crate::summary::{RunStatus, Summary};
 use clap::Parser;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
-use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 
@@ -26,20 +26,6 @@ pub struct BatchOptions {
     /// Build the comparison recording.
     pub compare: bool,
     pub progress: bool,
-}
-
-/// One experiment's result, as the tables and `batch merge` see it.
-#[derive(Clone, Debug, Serialize, Deserialize)]
-pub struct ExperimentOutcome {
-    pub index: usize,
-    pub name: String,
-    pub args: Vec<String>,
-    /// completed, interrupted, diverged or failed.
-    pub status: String,
-    pub summary: Option<Summary>,
-    pub error: Option<String>,
-    /// The whole experiment, recordings included, s.
-    pub wall_time: f64,
 }
 
 /// `run` flags as the CLI parses them.

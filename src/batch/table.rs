@@ -1,4 +1,4 @@
-use super::runner::ExperimentOutcome;
+use super::outcome::ExperimentOutcome;
 use crate::error::Error;
 use crate::summary::Summary;
 use serde::{Deserialize, Serialize};

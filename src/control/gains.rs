@@ -1,6 +1,6 @@
 //! Controller gains: the tutorial's for its box model, otherwise tuned from the mass matrix.
 
-use crate::analysis::{Linearization, LoopPlant, worst_radius};
+use crate::diagnose::analysis::{Linearization, LoopPlant, worst_radius};
 use crate::model::Model;
 use serde::Serialize;
 

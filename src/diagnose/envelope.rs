@@ -10,7 +10,7 @@ use crate::error::Error;
 use crate::experiment::Experiment;
 use crate::model::Model;
 use crate::sim::simulate;
-use crate::trajectory::{Trajectory, Wave};
+use crate::control::trajectory::{Trajectory, Wave};
 use rayon::prelude::*;
 use serde::Serialize;
 

@@ -1,0 +1,8 @@
+//! What drives the arm: the tutorial's PD + gravity feed-forward controller, its gains (the
+//! tutorial's, or auto-tuned for any arm), the commanded trajectories, and the inverse kinematics
+//! that turns a drawn shape into a joint schedule.
+
+pub mod controller;
+pub mod gains;
+pub mod ik;
+pub mod trajectory;
