@@ -1,0 +1,107 @@
+//! The command line: a thin layer that turns flags into library calls, one file per subcommand.
+
+mod analyze;
+mod batch;
+mod compare;
+mod envelope;
+mod model;
+mod run;
+mod trajectory;
+
+pub use analyze::{AnalyzeArgs, analyze};
+pub use batch::{BatchAction, BatchArgs, batch};
+pub use compare::{CompareArgs, compare};
+pub use envelope::{EnvelopeArgs, envelope};
+pub use model::{ModelArgs, model};
+pub use run::{RunArgs, default_run_name, run};
+pub use trajectory::{TrajectoryArgs, trajectory};
+
+use crate::config::{IntegratorKind, RunConfig};
+use crate::error::Error;
+use crate::experiment::Experiment;
+use crate::recorder::LiveViewer;
+use crate::runner::{Outputs, run_experiment};
+use crate::summary::RunStatus;
+use clap::{Args, Parser, Subcommand};
+use std::ffi::OsString;
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+#[derive(Parser, Debug)]
+#[command(name = "armscope", version, about = "Simulate a robot arm with real rigid-body dynamics and record every experiment")]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Run one experiment: the tutorial's PD + gravity-compensation controller on the arm.
+    Run(RunArgs),
+    /// Run many experiments from a TOML manifest, in parallel, into recordings/BATCH/.
+    Batch(BatchArgs),
+    /// Build one comparison recording (.rrd) from the .mcap files of finished runs.
+    Compare(CompareArgs),
+    /// Draw a shape with the tool: inverse kinematics into a joint schedule for `run --trajectory`.
+    Trajectory(TrajectoryArgs),
+    /// Is the sampled control loop stable? Spectral radius, the joints that drive it, stable dt and gains.
+    Analyze(AnalyzeArgs),
+    /// How fast can the arm go: sweep wave frequency × amplitude, map where each motor runs out of torque.
+    Envelope(EnvelopeArgs),
+    /// What armscope made of a URDF: joints, limits, motors, notices; with --states, the dynamics
+    /// (M, τ_g, C·v, q̈, link poses) at given states as JSON, to compare with other libraries.
+    Model(ModelArgs),
+}
+
+/// Parse `args` and run; returns the process exit code. Errors are printed as one line.
+pub fn main_with_args<I, T>(args: I) -> i32
+where
+    I: IntoIterator<Item = T>,
+    T: Into<OsString> + Clone,
+{
+    let cli = match Cli::try_parse_from(args) {
+        Ok(cli) => cli,
+        Err(e) => {
+            use clap::error::ErrorKind;
+            if matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand) {
+                let _ = e.print();
+                return if e.kind() == ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand { 2 } else { 0 };
+            }
+            let rendered = e.render().to_string();
+            let first = rendered.lines().find(|l| !l.trim().is_empty()).unwrap_or("invalid arguments");
+            eprintln!("armscope: {}", first.trim_start_matches("error: "));
+            return 2;
+        }
+    };
+    match run_command(cli.command) {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("armscope: error: {e}");
+            e.exit_code()
+        }
+    }
+}
+
+fn run_command(command: Command) -> Result<i32, Error> {
+    match command {
+        Command::Run(args) => run(&args),
+        Command::Batch(args) => batch(&args),
+        Command::Compare(args) => compare(&args),
+        Command::Trajectory(args) => trajectory(&args),
+        Command::Analyze(args) => analyze(&args),
+        Command::Envelope(args) => envelope(&args),
+        Command::Model(args) => model(&args),
+    }
+}
+
+/// Set by SIGINT (Ctrl-C): the run stops after the current step and finishes its files.
+static INTERRUPTED: AtomicBool = AtomicBool::new(false);
+
+/// Ctrl-C sets a flag the simulation loop checks every step (the files are then finished).
+pub fn install_interrupt_handler() {
+    static INSTALLED: std::sync::Once = std::sync::Once::new();
+    INSTALLED.call_once(|| {
+        // a second handler cannot be installed (e.g. by an embedding program): then Ctrl-C just kills
+        let _ = ctrlc::set_handler(|| INTERRUPTED.store(true, Ordering::SeqCst));
+    });
+}

@@ -1,0 +1,275 @@
+//! `armscope run`: one experiment, its flags and its default name.
+
+use super::*;
+
+fn defaults() -> RunConfig {
+    RunConfig::default()
+}
+
+#[derive(Args, Debug, Clone)]
+pub struct RunArgs {
+    /// The robot model.
+    #[arg(long, value_name = "PATH", default_value = crate::config::DEFAULT_URDF)]
+    pub urdf: PathBuf,
+    /// Simulated time, s.
+    #[arg(long, value_name = "SECONDS", default_value_t = defaults().duration)]
+    pub duration: f64,
+    /// Control period, s (the controller runs at 1/dt).
+    #[arg(long, value_name = "SECONDS", default_value_t = defaults().dt)]
+    pub dt: f64,
+    /// Plant step, s: 0 selects the continuous plant; default: the control period.
+    #[arg(long, value_name = "SECONDS")]
+    pub time_step: Option<f64>,
+    /// discrete (Drake's update, the default) or continuous (adaptive Runge–Kutta).
+    #[arg(long, value_enum)]
+    pub integrator: Option<IntegratorKind>,
+    /// Relative tolerance of the continuous plant.
+    #[arg(long, default_value_t = defaults().rtol)]
+    pub rtol: f64,
+    /// Absolute tolerance of the continuous plant.
+    #[arg(long, default_value_t = defaults().atol)]
+    pub atol: f64,
+    /// Wave frequency ω, rad/s.
+    #[arg(long, allow_negative_numbers = true, default_value_t = defaults().freq)]
+    pub freq: f64,
+    /// Wave amplitude, degrees.
+    #[arg(long, allow_negative_numbers = true, default_value_t = defaults().amp_deg)]
+    pub amp_deg: f64,
+    /// Proportional gains: one value for every joint or a comma list, one per joint.
+    #[arg(long, value_delimiter = ',', num_args = 1)]
+    pub kp: Option<Vec<f64>>,
+    /// Derivative gains: one value for every joint or a comma list, one per joint.
+    #[arg(long, value_delimiter = ',', num_args = 1)]
+    pub kd: Option<Vec<f64>>,
+    /// Tune gains from the mass matrix (default for models without tutorial gains).
+    #[arg(long)]
+    pub auto_tune: bool,
+    /// Interval of the --csv rows, s.
+    #[arg(long, value_name = "SECONDS", default_value_t = defaults().print_every)]
+    pub print_every: f64,
+    /// Hold every joint at 0.
+    #[arg(long = "static")]
+    pub hold: bool,
+    /// No gravity feed-forward in the controller.
+    #[arg(long)]
+    pub no_ff: bool,
+    /// Switch gravity off.
+    #[arg(long)]
+    pub no_gravity: bool,
+    /// Step one joint (number from 1, or name) to --test-angle, the others held at 0.
+    #[arg(long, value_name = "N|NAME")]
+    pub test_joint: Option<String>,
+    /// Follow a joint schedule (CSV or .npy with columns t,q1..qN, e.g. from `armscope trajectory`).
+    #[arg(long, value_name = "FILE")]
+    pub trajectory: Option<PathBuf>,
+    /// Step size of --test-joint, rad.
+    #[arg(long, allow_negative_numbers = true, default_value_t = defaults().test_angle)]
+    pub test_angle: f64,
+    /// Print command, error, τ_g and torque with every console line.
+    #[arg(long)]
+    pub debug: bool,
+    /// The link whose origin is the tool tip (default: the deepest leaf link).
+    #[arg(long, value_name = "LINK")]
+    pub tool: Option<String>,
+    /// Tracking error statistics cover every step with t ≥ this, s.
+    #[arg(long, value_name = "SECONDS", default_value_t = defaults().settle_time)]
+    pub settle_time: f64,
+    /// A joint speed above this is reported as divergence, rad/s.
+    #[arg(long, default_value_t = defaults().divergence_speed)]
+    pub divergence_speed: f64,
+    /// Refuse physically inconsistent link inertias (as Drake does) instead of a notice.
+    #[arg(long)]
+    pub strict_inertia: bool,
+    /// Initial joint positions (rad or m): a comma list in joint order, or NAME=VALUE pairs
+    /// (default: each joint's 0 clamped into its range). The default wave swings around them.
+    #[arg(long, value_name = "LIST", allow_hyphen_values = true)]
+    pub q0: Option<String>,
+    /// A motor file (TOML): each joint's motor from the catalogue (assets/motors/catalogue.toml, built
+    /// in) and its gearbox (ratio, efficiency, rated torque); the torque a joint can get then falls
+    /// with its speed. E.g. assets/motors/tutorial.toml.
+    #[arg(long, value_name = "FILE")]
+    pub motors: Option<PathBuf>,
+    /// Joints whose motor is a stepper: `stepper` drives them open loop (the command in microsteps;
+    /// steps can be lost), `pd` runs the tutorial's PD controller on their pull-out torque.
+    #[arg(long, value_enum, default_value = "stepper")]
+    pub drive: crate::config::DriveMode,
+
+    /// Write the tutorial's CSV (t, q, tool xyz every --print-every).
+    #[arg(long, value_name = "PATH")]
+    pub csv: Option<PathBuf>,
+    /// Write one CSV row per control step with state, command, torque, τ_g and tool position.
+    #[arg(long, value_name = "PATH")]
+    pub trace: Option<PathBuf>,
+    /// Write the summary as JSON.
+    #[arg(long, value_name = "PATH")]
+    pub summary_json: Option<PathBuf>,
+    /// No console output.
+    #[arg(long, short)]
+    pub quiet: bool,
+
+    /// Name of the recordings (default: from the flags, e.g. "default", "no-ff").
+    #[arg(long)]
+    pub name: Option<String>,
+    /// Where to write the Rerun recording (default: recordings/NAME.rrd).
+    #[arg(long, value_name = "PATH")]
+    pub rrd: Option<PathBuf>,
+    /// Where to write the MCAP for Foxglove (default: recordings/NAME.mcap).
+    #[arg(long, value_name = "PATH")]
+    pub mcap: Option<PathBuf>,
+    /// No Rerun recording file.
+    #[arg(long)]
+    pub no_rrd: bool,
+    /// No MCAP file.
+    #[arg(long)]
+    pub no_mcap: bool,
+    /// Start a Rerun viewer and stream the run to it (the files are written too).
+    #[arg(long)]
+    pub spawn: bool,
+    /// Stream to a running Rerun viewer (default URL: rerun+http://127.0.0.1:9876/proxy).
+    #[arg(long, value_name = "URL", num_args = 0..=1, default_missing_value = crate::recorder::DEFAULT_CONNECT_URL)]
+    pub connect: Option<String>,
+    /// Serve the run live to Foxglove (Open connection → Foxglove WebSocket), the MCAP's channels,
+    /// at HOST:PORT (default 127.0.0.1:8765); with --realtime the arm moves at real speed.
+    #[arg(long, value_name = "HOST:PORT", num_args = 0..=1, default_missing_value = crate::recorder::foxglove_live::DEFAULT_ADDRESS)]
+    pub foxglove: Option<String>,
+    /// Pace the simulation to the wall clock, FACTOR × real time (default 1).
+    #[arg(long, value_name = "FACTOR", num_args = 0..=1, default_missing_value = "1")]
+    pub realtime: Option<f64>,
+}
+
+/// A file-name-safe name for a run, from the flags that differ from the tutorial's defaults.
+pub fn default_run_name(config: &RunConfig) -> String {
+    let d = RunConfig::default();
+    let mut parts: Vec<String> = Vec::new();
+    if config.urdf != d.urdf {
+        parts.push(config.urdf.file_stem().map_or("model".into(), |s| s.to_string_lossy().to_string()));
+    }
+    if config.hold {
+        parts.push("static".into());
+    }
+    if let Some(j) = &config.test_joint {
+        parts.push(format!("test-joint-{j}"));
+    }
+    if config.no_ff {
+        parts.push("no-ff".into());
+    }
+    if config.no_gravity {
+        parts.push("no-gravity".into());
+    }
+    if config.freq != d.freq {
+        parts.push(format!("freq{}", config.freq));
+    }
+    if config.amp_deg != d.amp_deg {
+        parts.push(format!("amp{}", config.amp_deg));
+    }
+    if config.kp.is_some() || config.kd.is_some() || config.auto_tune {
+        parts.push("gains".into());
+    }
+    if config.time_step == Some(0.0) || config.integrator == Some(IntegratorKind::Continuous) {
+        parts.push("continuous".into());
+    } else if let Some(h) = config.time_step {
+        parts.push(format!("h{h}"));
+    }
+    if config.dt != d.dt {
+        parts.push(format!("dt{}", config.dt));
+    }
+    if config.duration != d.duration {
+        parts.push(format!("{}s", config.duration));
+    }
+    if parts.is_empty() {
+        parts.push("default".into());
+    }
+    crate::runner::file_safe(&parts.join("_"))
+}
+
+impl RunArgs {
+    pub fn config(&self) -> RunConfig {
+        RunConfig {
+            urdf: self.urdf.clone(),
+            duration: self.duration,
+            dt: self.dt,
+            time_step: self.time_step,
+            integrator: self.integrator,
+            rtol: self.rtol,
+            atol: self.atol,
+            freq: self.freq,
+            amp_deg: self.amp_deg,
+            kp: self.kp.clone(),
+            kd: self.kd.clone(),
+            auto_tune: self.auto_tune,
+            print_every: self.print_every,
+            hold: self.hold,
+            no_ff: self.no_ff,
+            no_gravity: self.no_gravity,
+            test_joint: self.test_joint.clone(),
+            test_angle: self.test_angle,
+            trajectory: self.trajectory.clone(),
+            debug: self.debug,
+            tool: self.tool.clone(),
+            settle_time: self.settle_time,
+            divergence_speed: self.divergence_speed,
+            strict_inertia: self.strict_inertia,
+            q0: self.q0.clone(),
+            motors: self.motors.clone(),
+            drive: self.drive,
+        }
+    }
+}
+
+
+/// `armscope run`.
+pub fn run(args: &RunArgs) -> Result<i32, Error> {
+    let config = args.config();
+    let name = args.name.clone().unwrap_or_else(|| default_run_name(&config));
+    let experiment = Experiment::prepare(config)?;
+    for notice in &experiment.model.notices {
+        eprintln!("armscope: notice: {notice}");
+    }
+    if let Some(f) = args.realtime {
+        if !(f.is_finite() && f > 0.0) {
+            return Err(Error::flag("--realtime", format!("must be a positive factor (got {f})")));
+        }
+    }
+    let recordings = PathBuf::from("recordings");
+    let rrd_path = (!args.no_rrd).then(|| args.rrd.clone().unwrap_or_else(|| recordings.join(format!("{name}.rrd"))));
+    let mcap_path = (!args.no_mcap).then(|| args.mcap.clone().unwrap_or_else(|| recordings.join(format!("{name}.mcap"))));
+    let live = if args.spawn {
+        Some(LiveViewer::Spawn)
+    } else {
+        args.connect.clone().map(LiveViewer::Connect)
+    };
+
+    let outputs = Outputs {
+        name: name.clone(),
+        console: (!args.quiet).then(|| Box::new(std::io::stdout()) as Box<dyn std::io::Write + Send>),
+        rrd: rrd_path.clone(),
+        mcap: mcap_path.clone(),
+        live,
+        foxglove: args.foxglove.clone(),
+        realtime: args.realtime,
+        csv: args.csv.clone(),
+        trace: args.trace.clone(),
+        summary_json: args.summary_json.clone(),
+        notice: Some(|n| eprintln!("armscope: notice: {n}")),
+    };
+    install_interrupt_handler();
+    INTERRUPTED.store(false, Ordering::SeqCst);
+    let summary = run_experiment(&experiment, outputs, Some(&INTERRUPTED))?;
+    if !args.quiet {
+        let mut files = Vec::new();
+        if let Some(p) = &rrd_path {
+            files.push(format!("  {}   open in Rerun: rerun {}", p.display(), p.display()));
+        }
+        if let Some(p) = &mcap_path {
+            files.push(format!("  {}  open in Foxglove: Open local file… → {}", p.display(), p.display()));
+        }
+        if !files.is_empty() {
+            println!("\nRecordings{}:\n{}", if matches!(summary.status, RunStatus::Completed) { "" } else { " (complete up to the last step simulated)" }, files.join("\n"));
+        }
+    }
+    match summary.status {
+        RunStatus::Diverged { message, .. } => Err(Error::Diverged(message)),
+        RunStatus::Interrupted { .. } => Ok(130),
+        RunStatus::Completed => Ok(0),
+    }
+}
