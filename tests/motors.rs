@@ -172,6 +172,10 @@ fn recordings_and_console_show_the_speed_dependent_limit() {
     assert_eq!(limits.len(), 1001, "one row per step");
     assert!(limits.iter().all(|(_, v)| v.len() == 2 && v[0] == -v[1] && v[0] > 0.0 && v[0] <= 5.4 + 1e-12));
     assert!(limits.iter().any(|(_, v)| v[0] < 5.3), "the limit falls somewhere in the run");
+    // the motor's shaft speed, N·q̇ in rev/s, at every step
+    let speed = common::rrd::Rrd::open(&rrd).series("/joints/J2/motor_speed");
+    assert_eq!(speed.len(), 1001);
+    assert!(speed.iter().any(|(_, s)| s[0].abs() > 1.0), "15:1 turns the motor at several rev/s");
     let bytes = std::fs::read(&mcap).unwrap();
     let mut count = 0;
     for m in mcap::MessageStream::new(&bytes).unwrap().map(|m| m.unwrap()).filter(|m| m.channel.topic == "/controller") {
@@ -180,6 +184,7 @@ fn recordings_and_console_show_the_speed_dependent_limit() {
         let v = prost_reflect::DynamicMessage::decode(pool.get_message_by_name(&schema.name).unwrap(), &m.data[..]).unwrap();
         let list = v.get_field_by_name("torque_limit").unwrap().as_list().unwrap().to_vec();
         assert_eq!(list.len(), 6);
+        assert_eq!(v.get_field_by_name("motor_speed").unwrap().as_list().unwrap().len(), 6);
         count += 1;
     }
     assert_eq!(count, 1001);

@@ -182,3 +182,25 @@ fn lost_steps_and_load_angles_are_in_both_recordings_and_the_summary() {
     let steps = v.get_field_by_name("lost_steps").unwrap().as_list().unwrap().to_vec();
     assert_eq!(steps[1].as_i64().unwrap(), lost.last().unwrap().1[0] as i64, "the MCAP's count is the .rrd's");
 }
+
+/// The bar from the command line: `--static` loses no steps; `--freq 8 --amp-deg 60` loses
+/// steps and the summary says on which joint and when.
+#[test]
+fn static_loses_nothing_and_a_fast_wide_wave_is_reported_where_and_when() {
+    let motors = common::repo().join("assets/motors/tutorial.toml");
+    let run = |extra: &[&str]| {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_armscope"))
+            .args(["run", "--urdf", common::box_urdf().to_str().unwrap(), "--motors", motors.to_str().unwrap(), "--duration", "5", "--no-rrd", "--no-mcap"])
+            .args(extra)
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        String::from_utf8_lossy(&out.stdout).to_string()
+    };
+    let held = run(&["--static"]);
+    assert!(!held.contains("lost steps (full)") && !held.contains("its stepper lost"), "{held}");
+    let fast = run(&["--freq", "8", "--amp-deg", "60"]);
+    assert!(fast.contains("lost steps (full)"), "{fast}");
+    let said = fast.lines().find(|l| l.contains("its stepper lost")).unwrap_or_else(|| panic!("{fast}"));
+    assert!(said.contains("full steps, the first at t = "), "{said}");
+}

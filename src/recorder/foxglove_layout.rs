@@ -44,6 +44,12 @@ fn camera(model: &Model, q: &[f64]) -> ([f64; 3], f64) {
 
 /// The layout for `model`, whose run starts at joint positions `q0`.
 pub fn layout(model: &Model, q0: &[f64]) -> Value {
+    layout_with_motors(model, q0, false, &[])
+}
+
+/// With `--motors` (`motors`): each joint's speed-dependent torque limit beside its torque; with
+/// steppers driven open loop (`stepped`): a third plot of their load angles and lost steps.
+pub fn layout_with_motors(model: &Model, q0: &[f64], motors: bool, stepped: &[bool]) -> Value {
     let (target, distance) = camera(model, q0);
     let names: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();
     let angles = names
@@ -51,9 +57,28 @@ pub fn layout(model: &Model, q0: &[f64]) -> Value {
         .enumerate()
         .flat_map(|(i, n)| [series(format!("/joint_states.joints[{i}].position"), format!("{n} angle")), series(format!("/controller.target[{i}]"), format!("{n} target"))])
         .collect();
-    let torques = names.iter().enumerate().map(|(i, n)| series(format!("/controller.torque[{i}]"), format!("{n} torque"))).collect();
+    let torques = names
+        .iter()
+        .enumerate()
+        .flat_map(|(i, n)| {
+            let limit = motors.then(|| series(format!("/controller.torque_limit[{i}]"), format!("{n} limit")));
+            std::iter::once(series(format!("/controller.torque[{i}]"), format!("{n} torque"))).chain(limit)
+        })
+        .collect();
+    let steppers: Vec<Value> = names
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| stepped.get(*i).copied().unwrap_or(false))
+        .flat_map(|(i, n)| [series(format!("/controller.load_angle[{i}]"), format!("{n} load angle (el. °)")), series(format!("/controller.lost_steps[{i}]"), format!("{n} lost steps"))])
+        .collect();
+    let right = if steppers.is_empty() {
+        json!({ "first": "Plot!angles", "second": "Plot!torques", "direction": "column", "splitPercentage": 50 })
+    } else {
+        json!({ "first": "Plot!angles", "second": { "first": "Plot!torques", "second": "Plot!steppers", "direction": "column", "splitPercentage": 50 }, "direction": "column", "splitPercentage": 34 })
+    };
     let visible = |topics: &[&str]| topics.iter().map(|t| (t.to_string(), json!({ "visible": true }))).collect::<serde_json::Map<_, _>>();
-    json!({
+    let has_steppers = !steppers.is_empty();
+    let mut doc = json!({
         "configById": {
             "3D!arm": {
                 "followTf": "world",
@@ -80,11 +105,15 @@ pub fn layout(model: &Model, q0: &[f64]) -> Value {
         "playbackConfig": { "speed": 1 },
         "layout": {
             "first": "3D!arm",
-            "second": { "first": "Plot!angles", "second": "Plot!torques", "direction": "column", "splitPercentage": 50 },
+            "second": right,
             "direction": "row",
             "splitPercentage": 50
         }
-    })
+    });
+    if has_steppers {
+        doc["configById"]["Plot!steppers"] = plot(steppers);
+    }
+    doc
 }
 
 /// Where the layout of the recording `mcap` goes: `NAME.layout.json` beside it.

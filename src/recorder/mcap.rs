@@ -236,6 +236,8 @@ pub struct McapRecorder {
     steps_per_tf: usize,
     tool_path: ToolPath,
     last_scene_second: i64,
+    /// Per joint, its motor's gear ratio from `--motors` (0: no motor file entry).
+    motor_ratio: Vec<f64>,
     /// Simulated seconds between republished geometries: 1 for small scenes, longer for big meshes.
     scene_interval_s: i64,
 }
@@ -327,6 +329,7 @@ impl McapRecorder {
             steps_per_tf: 10,
             tool_path: ToolPath::default(),
             last_scene_second: -1,
+            motor_ratio: Vec::new(),
             scene_interval_s: 1,
         }
     }
@@ -485,7 +488,8 @@ impl Recorder for McapRecorder {
         let file = match &self.options.file {
             Some(path) => {
                 // the Foxglove layout for this model, beside the recording
-                let layout = super::foxglove_layout::layout(model, &e.initial_state().0);
+                let stepped = e.open_loop_steppers().map_or_else(Vec::new, |s| s.stepped);
+                let layout = super::foxglove_layout::layout_with_motors(model, &e.initial_state().0, e.motors.is_some(), &stepped);
                 let layout_path = super::foxglove_layout::layout_path(path);
                 std::fs::write(&layout_path, serde_json::to_string_pretty(&layout).unwrap_or_default()).map_err(|err| Error::output(&layout_path, err))?;
                 Some(super::output_file::create_replacing(path).map_err(|err| self.err(err))?)
@@ -602,7 +606,9 @@ impl Recorder for McapRecorder {
             torque_limit: vec![0.0; n],
             load_angle: vec![0.0; n],
             lost_steps: vec![0; n],
+            motor_speed: vec![0.0; n],
         };
+        self.motor_ratio = e.motors.as_ref().map_or(vec![0.0; n], |m| m.joints.iter().map(|d| d.as_ref().map_or(0.0, |d| d.gear_ratio)).collect());
         self.scene = scene_from_model(model).map_err(|(path, err)| Error::output(&path, err))?;
         let scene_bytes = foxglove::Encode::encoded_len(&self.scene).unwrap_or(0);
         self.scene_interval_s = scene_interval_s(scene_bytes);
@@ -664,6 +670,7 @@ impl Recorder for McapRecorder {
             tel.torque_limit[j] = s.torque_limit[j];
             tel.load_angle[j] = s.load_angle[j];
             tel.lost_steps[j] = s.lost_steps[j];
+            tel.motor_speed[j] = self.motor_ratio[j] * s.v[j] / std::f64::consts::TAU;
         }
         let path = &self.path;
         let fail = |e: String| Error::output(path, e);

@@ -59,6 +59,8 @@ struct JointColumns {
     /// (full steps lost so far) per step.
     load_angle: Vec<f64>,
     lost_steps: Vec<f64>,
+    /// With `--motors`: `joints/<joint>/motor_speed`, the motor shaft's speed N·q̇ in rev/s, per step.
+    motor_speed: Vec<f64>,
 }
 
 impl JointColumns {
@@ -72,11 +74,12 @@ impl JointColumns {
             limit: Vec::new(),
             load_angle: Vec::new(),
             lost_steps: Vec::new(),
+            motor_speed: Vec::new(),
         }
     }
 
     fn clear(&mut self) {
-        for c in [&mut self.position, &mut self.torque, &mut self.status, &mut self.saturated_times, &mut self.saturated_torque, &mut self.limit, &mut self.load_angle, &mut self.lost_steps] {
+        for c in [&mut self.position, &mut self.torque, &mut self.status, &mut self.saturated_times, &mut self.saturated_torque, &mut self.limit, &mut self.load_angle, &mut self.lost_steps, &mut self.motor_speed] {
             c.clear();
         }
     }
@@ -103,6 +106,8 @@ pub struct RerunRecorder {
     speed_dependent_limit: bool,
     /// Per joint: driven open loop (stepper mode): its load angle and lost steps are recorded.
     stepped: Vec<bool>,
+    /// Per joint with a motor from `--motors`, its gear ratio (the motor turns N times faster).
+    motor_ratio: Vec<Option<f64>>,
     times: Vec<f64>,
     joints: Vec<JointColumns>,
     /// [x, y, z] per step.
@@ -146,6 +151,7 @@ impl RerunRecorder {
             effort: Vec::new(),
             speed_dependent_limit: false,
             stepped: Vec::new(),
+            motor_ratio: Vec::new(),
             times: Vec::new(),
             joints: Vec::new(),
             tool: Vec::new(),
@@ -296,6 +302,7 @@ impl RerunRecorder {
                 ("torque_limit", lines(&[format!("{name} +limit"), format!("{name} −limit")], &[red, red], &[1.0, 1.0])),
                 ("load_angle", lines(&[format!("{name} load angle (electrical °; ±90 peak torque, ±180 slip)")], &[c], &[1.5])),
                 ("lost_steps", lines(&[format!("{name} lost steps (full)")], &[red], &[2.0])),
+                ("motor_speed", lines(&[format!("{name} motor speed (rev/s)")], &[c], &[1.5])),
             ];
             for (leaf, style) in styles {
                 rec.log_static(format!("{base}/{leaf}"), &style).map_err(e)?;
@@ -338,6 +345,9 @@ impl RerunRecorder {
             for (leaf, values, width) in [("position", &c.position, 2), ("torque", &c.torque, 2), ("status", &c.status, 3)] {
                 debug_assert_eq!(values.len(), width * steps);
                 send(&format!("{base}/{leaf}"), time.clone(), scalars(values, width))?;
+            }
+            if self.motor_ratio[j].is_some() {
+                send(&format!("{base}/motor_speed"), time.clone(), scalars(&c.motor_speed, 1))?;
             }
             if self.stepped[j] {
                 send(&format!("{base}/load_angle"), time.clone(), scalars(&c.load_angle, 1))?;
@@ -532,7 +542,7 @@ pub fn blueprint(joint_names: &[String], stepped: &[bool], prefix: &str) -> Blue
         .iter()
         .zip(stepped.iter().chain(std::iter::repeat(&false)))
         .filter(|(_, s)| **s)
-        .map(|(j, _)| TimeSeriesView::new(format!("{j} stepper: load angle, lost steps")).with_origin(format!("{prefix}joints/{j}")).with_contents(["$origin/load_angle", "$origin/lost_steps"]).into())
+        .map(|(j, _)| TimeSeriesView::new(format!("{j} stepper: load angle, lost steps, motor rev/s")).with_origin(format!("{prefix}joints/{j}")).with_contents(["$origin/load_angle", "$origin/lost_steps", "$origin/motor_speed"]).into())
         .collect();
     let mut rows = vec![
         Grid::new(angle_views).with_grid_columns(columns).with_name("joint angles").into(),
@@ -588,6 +598,7 @@ impl Recorder for RerunRecorder {
         self.effort = e.controller().effort;
         self.speed_dependent_limit = e.motors.is_some();
         self.stepped = e.open_loop_steppers().map_or(vec![false; e.model.dof()], |s| s.stepped);
+        self.motor_ratio = e.motors.as_ref().map_or(vec![None; e.model.dof()], |m| m.joints.iter().map(|d| d.as_ref().map(|d| d.gear_ratio)).collect());
         let cap = FILE_BLOCK_STEPS + 1;
         self.times = Vec::with_capacity(cap);
         self.joints = (0..model.dof()).map(|_| JointColumns::with_capacity(cap)).collect();
@@ -638,6 +649,9 @@ impl Recorder for RerunRecorder {
             c.torque.extend_from_slice(&[s.u[j], s.tau_g[j]]);
             if self.speed_dependent_limit {
                 c.limit.extend_from_slice(&[s.torque_limit[j], -s.torque_limit[j]]);
+            }
+            if let Some(ratio) = self.motor_ratio[j] {
+                c.motor_speed.push(ratio * s.v[j] / std::f64::consts::TAU);
             }
             if self.stepped[j] {
                 c.load_angle.push(s.load_angle[j]);

@@ -51,6 +51,9 @@ pub struct ControllerTelemetry {
     /// Stepper mode: full steps each joint has lost so far.
     #[prost(int64, repeated, tag = "12")]
     pub lost_steps: Vec<i64>,
+    /// With `--motors`: each motor's shaft speed N·q̇, rev/s (0 where no motor file entry).
+    #[prost(double, repeated, tag = "13")]
+    pub motor_speed: Vec<f64>,
 }
 
 /// The schema as MCAP's protobuf profile wants it: a serialized FileDescriptorSet. Kept next to
@@ -79,6 +82,7 @@ pub fn file_descriptor_set() -> Vec<u8> {
             field("torque_limit", 10, true, Type::Double),
             field("load_angle", 11, true, Type::Double),
             field("lost_steps", 12, true, Type::Int64),
+            field("motor_speed", 13, true, Type::Double),
         ],
         ..Default::default()
     };

@@ -102,5 +102,64 @@ fn large_trees(c: &mut Criterion) {
     }
 }
 
-criterion_group!(benches, algorithms, discrete_step, whole_run, large_trees);
+/// With motors (`--motors assets/motors/tutorial.toml`): one control step of the loop's work —
+/// controller (PD on the speed-dependent limit, or the open-loop steppers' command) and one plant step
+/// — against the same without motors. Stepper mode also evaluates the stepper torque at every plant
+/// step; its run takes more plant steps per control period (chosen for the stiffest stepper), which
+/// `motors_run_*` shows whole.
+fn motors(c: &mut Criterion) {
+    let urdf = urdf();
+    let motors = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/motors/tutorial.toml");
+    let cases = [
+        ("without_motors", RunConfig { urdf: urdf.clone(), ..RunConfig::default() }),
+        ("servo_mode", RunConfig { urdf: urdf.clone(), motors: Some(motors.clone()), drive: armscope::config::DriveMode::Pd, ..RunConfig::default() }),
+        ("stepper_mode_one_plant_step", RunConfig { urdf: urdf.clone(), motors: Some(motors.clone()), time_step: Some(0.001), ..RunConfig::default() }),
+    ];
+    let mut group = c.benchmark_group("motors_step");
+    for (name, config) in cases {
+        let experiment = Experiment::prepare(config).unwrap();
+        let model = &*experiment.model;
+        let mut data = Data::new(model);
+        let mut plant = experiment.make_plant();
+        let controller = experiment.controller();
+        let mut steppers = experiment.open_loop_steppers();
+        let (q0, v0, _) = state();
+        let (cmd, cmd_dot) = (vec![0.1; 6], vec![0.2; 6]);
+        let (mut u, mut sat, mut limit) = (vec![0.0; 6], vec![false; 6], vec![0.0; 6]);
+        group.bench_function(name, |b| {
+            b.iter_batched_ref(
+                || (q0.clone(), v0.clone()),
+                |(q, v)| {
+                    forward_kinematics(model, &mut data, q);
+                    gravity_and_bias_from_kinematics(model, &mut data, v);
+                    controller.compute(q, v, &cmd, &cmd_dot, &data.gravity, armscope::control::controller::ControlOutput { u: &mut u, saturated: &mut sat, limit: &mut limit });
+                    match steppers.as_mut() {
+                        Some(s) => {
+                            s.set_command(&cmd, &cmd_dot, 0.001);
+                            let s: &armscope::actuator::OpenLoopSteppers = s;
+                            plant.advance_driven(model, &mut data, &mut u, &mut |q, v, u| s.torques(q, v, u), q, v);
+                        }
+                        None => plant.advance(model, &mut data, &u, q, v),
+                    }
+                    black_box(q[0])
+                },
+                criterion::BatchSize::SmallInput,
+            )
+        });
+    }
+    group.finish();
+    let mut group = c.benchmark_group("motors_run");
+    group.sample_size(10);
+    for (name, config) in [
+        ("default_30s_without_motors", RunConfig { urdf: urdf.clone(), ..RunConfig::default() }),
+        ("default_30s_servo_mode", RunConfig { urdf: urdf.clone(), motors: Some(motors.clone()), drive: armscope::config::DriveMode::Pd, ..RunConfig::default() }),
+        ("default_30s_stepper_mode", RunConfig { urdf: urdf.clone(), motors: Some(motors.clone()), ..RunConfig::default() }),
+    ] {
+        let experiment = Experiment::prepare(config).unwrap();
+        group.bench_function(name, |b| b.iter(|| black_box(simulate(&experiment, &mut [], None).unwrap().steps)));
+    }
+    group.finish();
+}
+
+criterion_group!(benches, algorithms, discrete_step, whole_run, large_trees, motors);
 criterion_main!(benches);
