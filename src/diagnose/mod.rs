@@ -4,3 +4,4 @@
 pub mod analysis;
 pub mod envelope;
 pub mod heatmap;
+pub mod loop_report;
