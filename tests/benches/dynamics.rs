@@ -32,25 +32,27 @@ fn algorithms(c: &mut Criterion) {
     c.bench_function("aba", |b| b.iter(|| black_box(aba(&model, &mut data, black_box(&q), black_box(&v), black_box(&tau))[0])));
 }
 
+/// One plant step including what it needs at the new state: kinematics, τ_g and C·v.
+fn plant_step(b: &mut criterion::Bencher, model: &armscope::model::Model, data: &mut Data, plant: &mut dyn armscope::plant::Plant, q0: &[f64], v0: &[f64], u: &[f64]) {
+    b.iter_batched_ref(
+        || (q0.to_vec(), v0.to_vec()),
+        |(q, v)| {
+            forward_kinematics(model, data, q);
+            gravity_and_bias_from_kinematics(model, data, v);
+            plant.advance(model, data, u, q, v);
+            black_box(q[0])
+        },
+        criterion::BatchSize::SmallInput,
+    )
+}
+
 fn discrete_step(c: &mut Criterion) {
     let experiment = Experiment::prepare(RunConfig { urdf: urdf(), ..RunConfig::default() }).unwrap();
     let model = &*experiment.model;
     let mut data = Data::new(model);
     let mut plant = experiment.make_plant();
     let (q0, v0, u) = state();
-    // one plant step including what it needs at the new state: kinematics, τ_g and C·v
-    c.bench_function("discrete_step", |b| {
-        b.iter_batched_ref(
-            || (q0.clone(), v0.clone()),
-            |(q, v)| {
-                forward_kinematics(model, &mut data, q);
-                gravity_and_bias_from_kinematics(model, &mut data, v);
-                plant.advance(model, &mut data, &u, q, v);
-                black_box(q[0])
-            },
-            criterion::BatchSize::SmallInput,
-        )
-    });
+    c.bench_function("discrete_step", |b| plant_step(b, model, &mut data, plant.as_mut(), &q0, &v0, &u));
 }
 
 fn whole_run(c: &mut Criterion) {
@@ -86,18 +88,7 @@ fn large_trees(c: &mut Criterion) {
         group.bench_function("crba", |b| b.iter(|| black_box(crba(model, &mut data, black_box(&q))[(0, 0)])));
         let mut plant = experiment.make_plant();
         let u = vec![0.0; n];
-        group.bench_function("discrete_step", |b| {
-            b.iter_batched_ref(
-                || (q.clone(), v.clone()),
-                |(q, v)| {
-                    forward_kinematics(model, &mut data, q);
-                    gravity_and_bias_from_kinematics(model, &mut data, v);
-                    plant.advance(model, &mut data, &u, q, v);
-                    black_box(q[0])
-                },
-                criterion::BatchSize::SmallInput,
-            )
-        });
+        group.bench_function("discrete_step", |b| plant_step(b, model, &mut data, plant.as_mut(), &q, &v, &u));
         group.finish();
     }
 }
