@@ -104,6 +104,16 @@ impl Experiment {
                 start = sagged;
                 model.notices.push(format!("stepper mode: the arm starts at rest, held by its steppers, each lagging by the load angle that carries its weight (at most {biggest:.2e} rad at a joint)"));
             }
+            if let (PlantSpec::Discrete { substeps, .. }, Some(_)) = (&plant, config.time_step) {
+                let needed = stepper_substeps(&model, motors, &start, config.dt);
+                if needed > *substeps {
+                    model.notices.push(format!(
+                        "stepper mode: --time-step {} ms is longer than the stiffest stepper joint's oscillation allows ({:.4} ms for ω_n·h ≤ 0.2): its lost steps are not to be trusted",
+                        config.dt / *substeps as f64 * 1e3,
+                        config.dt / needed as f64 * 1e3
+                    ));
+                }
+            }
             if let (PlantSpec::Discrete { substeps, .. }, None) = (&plant, config.time_step) {
                 let needed = stepper_substeps(&model, motors, &start, config.dt);
                 if needed > *substeps {

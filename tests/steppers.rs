@@ -204,3 +204,14 @@ fn static_loses_nothing_and_a_fast_wide_wave_is_reported_where_and_when() {
     let said = fast.lines().find(|l| l.contains("its stepper lost")).unwrap_or_else(|| panic!("{fast}"));
     assert!(said.contains("full steps, the first at t = "), "{said}");
 }
+
+/// A plant step too long for the steppers' oscillation is allowed but said: at 1 ms the slow default
+/// wave, which loses nothing when resolved, would report lost steps.
+#[test]
+fn a_plant_step_too_long_for_the_steppers_is_a_notice() {
+    let experiment = Experiment::prepare(config("tutorial.toml", |c| c.time_step = Some(0.001))).unwrap();
+    assert!(experiment.model.notices.iter().any(|n| n.contains("--time-step 1 ms is longer than") && n.contains("not to be trusted")), "{:?}", experiment.model.notices);
+    let resolved = Experiment::prepare(config("tutorial.toml", |_| {})).unwrap();
+    assert!(matches!(resolved.plant, armscope::experiment::PlantSpec::Discrete { substeps, .. } if substeps > 1));
+    assert!(!resolved.model.notices.iter().any(|n| n.contains("not to be trusted")));
+}
