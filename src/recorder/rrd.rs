@@ -299,7 +299,11 @@ impl RerunRecorder {
                     "status",
                     lines(&[format!("{name} error (rad)"), format!("{name} saturated (0/1)"), format!("{name} chatter (0/1)")], &[c, red, rerun::Color::from_rgb(240, 160, 40)], &[1.5, 1.0, 1.0]),
                 ),
-                ("torque_limit", lines(&[format!("{name} +limit"), format!("{name} −limit")], &[red, red], &[1.0, 1.0])),
+                // "effort" is the URDF's constant; with --motors the limit falls with speed
+                ("torque_limit", {
+                    let word = if self.speed_dependent_limit { "limit" } else { "effort" };
+                    lines(&[format!("{name} +{word}"), format!("{name} −{word}")], &[red, red], &[1.0, 1.0])
+                }),
                 ("load_angle", lines(&[format!("{name} load angle (electrical °; ±90 peak torque, ±180 slip)")], &[c], &[1.5])),
                 ("lost_steps", lines(&[format!("{name} lost steps (full)")], &[red], &[2.0])),
                 ("motor_speed", lines(&[format!("{name} motor speed (rev/s)")], &[c], &[1.5])),
