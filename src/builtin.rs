@@ -7,12 +7,13 @@ use std::path::Path;
 pub const DEFAULT_URDF: &str = "assets/smallrobot_arm.urdf";
 pub const DEFAULT_MANIFEST: &str = "assets/experiments/tutorial.toml";
 
-const FILES: [(&str, &str); 5] = [
+const FILES: [(&str, &str); 6] = [
     (DEFAULT_URDF, include_str!("../assets/smallrobot_arm.urdf")),
     (DEFAULT_MANIFEST, include_str!("../assets/experiments/tutorial.toml")),
     (crate::actuator::catalogue::DEFAULT_CATALOGUE, include_str!("../assets/motors/catalogue.toml")),
     ("assets/motors/tutorial.toml", include_str!("../assets/motors/tutorial.toml")),
     ("assets/motors/smallrobotarm.toml", include_str!("../assets/motors/smallrobotarm.toml")),
+    ("assets/motors/so100.toml", include_str!("../assets/motors/so100.toml")),
 ];
 
 /// The text of `path`: the file's, or the built-in copy when `path` is a default that is not on disk.
