@@ -12,6 +12,7 @@ mod crba;
 mod data;
 mod jacobian;
 mod kinematics;
+mod ltdl;
 mod rnea;
 
 pub use aba::{aba, aba_from_kinematics};
@@ -19,5 +20,6 @@ pub use cholesky::{cholesky_in_place, cholesky_solve_in_place};
 pub use crba::{crba, crba_from_kinematics};
 pub use data::Data;
 pub use jacobian::frame_jacobian;
+pub use ltdl::{ltdl_in_place, ltdl_solve_in_place};
 pub use kinematics::{body_poses, forward_kinematics, frame_pose, frame_pose_in};
 pub use rnea::{bias_forces, gravity_and_bias_from_kinematics, gravity_forces, gravity_from_kinematics, rnea, rnea_from_kinematics};

@@ -1,5 +1,5 @@
 use super::Plant;
-use crate::dynamics::{Data, cholesky_in_place, cholesky_solve_in_place, crba_from_kinematics, forward_kinematics, gravity_and_bias_from_kinematics};
+use crate::dynamics::{Data, cholesky_in_place, cholesky_solve_in_place, ltdl_in_place, ltdl_solve_in_place, crba_from_kinematics, forward_kinematics, gravity_and_bias_from_kinematics};
 use crate::model::Model;
 use nalgebra::DMatrix;
 
@@ -25,6 +25,9 @@ pub struct DiscretePlant {
     /// −1 lower limit, +1 upper limit, 0 free.
     constraint: Vec<i8>,
     limit_active: Vec<bool>,
+    /// A branched tree (and no `<mimic>`): M + hD factorized along the tree's sparsity (LᵀDL), each
+    /// joint's parent joint here; a chain keeps the dense Cholesky (the same cost, and its rounding).
+    tree_parents: Option<Vec<Option<usize>>>,
 }
 
 impl DiscretePlant {
@@ -40,6 +43,7 @@ impl DiscretePlant {
             v_next: vec![0.0; n],
             constraint: vec![0; n],
             limit_active: vec![false; n],
+            tree_parents: branched_tree(model),
         }
     }
 
@@ -134,12 +138,19 @@ impl DiscretePlant {
         }
         // M + hD is symmetric positive definite for any valid model; a failure means the state is
         // no longer finite, which the simulation loop reports as divergence.
-        if !cholesky_in_place(&mut self.factor) {
+        let factored = match &self.tree_parents {
+            Some(parents) => ltdl_in_place(&mut self.factor, parents),
+            None => cholesky_in_place(&mut self.factor),
+        };
+        if !factored {
             self.v_next.fill(f64::NAN);
             return;
         }
         self.v_next.copy_from_slice(&self.reduced_rhs);
-        cholesky_solve_in_place(&self.factor, &mut self.v_next);
+        match &self.tree_parents {
+            Some(parents) => ltdl_solve_in_place(&self.factor, parents, &mut self.v_next),
+            None => cholesky_solve_in_place(&self.factor, &mut self.v_next),
+        }
     }
 }
 
@@ -178,4 +189,22 @@ impl Plant for DiscretePlant {
             if self.substeps > 1 { format!(", {} steps per control period", self.substeps) } else { String::new() }
         )
     }
+}
+
+/// Each joint's parent joint when the model is a branched tree without `<mimic>` joints (then M has
+/// the tree's sparsity in its coordinates); None for a chain or a coupled model.
+fn branched_tree(model: &Model) -> Option<Vec<Option<usize>>> {
+    if model.has_mimic() {
+        return None;
+    }
+    let parents: Vec<Option<usize>> = model.bodies.iter().map(|b| b.parent).collect();
+    let mut children = vec![0usize; parents.len()];
+    let mut roots = 0;
+    for p in &parents {
+        match p {
+            Some(p) => children[*p] += 1,
+            None => roots += 1,
+        }
+    }
+    (roots > 1 || children.iter().any(|&c| c > 1)).then_some(parents)
 }
