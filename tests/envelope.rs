@@ -73,3 +73,41 @@ fn envelope_command_writes_heatmaps_recording_and_table() {
     assert_eq!(json["payload_kg"], 0.2);
     assert!(out.join("envelope.rrd").metadata().unwrap().len() > 0);
 }
+
+/// Without motors a cell's demand is its need over the constant effort; with `--motors` it is the
+/// need over what the motor gives at the speed of that instant, so never below the need over the
+/// torque at rest, and above it for a fast wave (the torque–speed curve has fallen).
+#[test]
+fn the_demand_is_the_need_over_the_limit_at_speed() {
+    let model = armscope::model::load_urdf(&common::box_urdf()).unwrap();
+    let plain = RunConfig { urdf: common::box_urdf(), ..RunConfig::default() };
+    let env = sweep(&plain, &model, &[0.5, 8.0], &[30.0], 0.0, 2).unwrap();
+    for c in &env.cells {
+        for j in 0..6 {
+            assert!((c.demand[j] - c.required[j] / env.effort[j]).abs() <= 1e-12 * c.demand[j].max(1.0));
+        }
+    }
+    let motors = RunConfig { motors: Some(common::repo().join("assets/motors/tutorial.toml")), drive: armscope::config::DriveMode::Pd, ..plain };
+    let env = sweep(&motors, &model, &[0.5, 8.0], &[30.0], 0.0, 2).unwrap();
+    for c in &env.cells {
+        for j in 0..6 {
+            assert!(c.demand[j] >= c.required[j] / env.effort[j] - 1e-12, "J{} at ω = {}", j + 1, c.freq);
+        }
+    }
+    // at t = 0 of the fast wave (J1 at its top speed, 4.2 rad/s: its motor at 10 rev/s) the demand is
+    // at least the need of that instant over the limit at that speed
+    let experiment = armscope::experiment::Experiment::prepare(RunConfig { freq: 8.0, amp_deg: 30.0, ..motors.clone() }).unwrap();
+    let drives = experiment.motors.clone().unwrap();
+    let wave = Wave { amplitude_rad: 30f64.to_radians(), omega: 8.0 };
+    let (mut q, mut v, mut v1, mut v0) = (vec![0.0; 6], vec![0.0; 6], vec![0.0; 6], vec![0.0; 6]);
+    wave.sample(1e-5, &mut q, &mut v1);
+    wave.sample(-1e-5, &mut q, &mut v0);
+    wave.sample(0.0, &mut q, &mut v);
+    let a: Vec<f64> = (0..6).map(|j| (v1[j] - v0[j]) / 2e-5).collect();
+    let tau = armscope::dynamics::rnea(&experiment.model, &mut Data::new(&experiment.model), &q, &v, &a).to_vec();
+    let fast = &env.cells[1];
+    for j in 0..6 {
+        let instant = (tau[j] + experiment.model.joints[j].damping * v[j]).abs() / drives.joints[j].as_ref().unwrap().torque_limit(v[j]);
+        assert!(fast.demand[j] >= instant * (1.0 - 1e-6), "J{}: demand {} below the need at t = 0 over the limit there, {instant}", j + 1, fast.demand[j]);
+    }
+}

@@ -28,6 +28,12 @@ pub struct EnvelopeArgs {
     /// Cells simulated at once (default: all cores).
     #[arg(long)]
     pub jobs: Option<usize>,
+    /// A motor file: the need is compared with what each motor gives at the joint's speed.
+    #[arg(long, value_name = "FILE")]
+    pub motors: Option<PathBuf>,
+    /// Stepper joints open loop or under PD in the simulated cells (as `run`).
+    #[arg(long, value_enum, default_value = "stepper")]
+    pub drive: crate::config::DriveMode,
 }
 
 
@@ -44,7 +50,7 @@ pub fn envelope(args: &EnvelopeArgs) -> Result<i32, Error> {
         return Err(Error::flag("--payload", "must be a mass in kg, not negative"));
     }
     let model = with_payload(crate::model::load_urdf(&args.urdf)?, args.payload);
-    let mut config = RunConfig { urdf: args.urdf.clone(), dt: args.dt, kp: args.kp.clone(), kd: args.kd.clone(), ..RunConfig::default() };
+    let mut config = RunConfig { urdf: args.urdf.clone(), dt: args.dt, kp: args.kp.clone(), kd: args.kd.clone(), motors: args.motors.clone(), drive: args.drive, ..RunConfig::default() };
     let probe = Experiment::with_model(config.clone(), model.clone())?;
     let (kp, kd) = probe.controller().effective_gains();
     let lin = Linearization::at(&model, &vec![0.0; model.dof()]);
@@ -69,8 +75,9 @@ pub fn envelope(args: &EnvelopeArgs) -> Result<i32, Error> {
         if env.effort[j] == 0.0 {
             continue;
         }
-        let values: Vec<Vec<f64>> = (0..amps.len()).map(|a| (0..freqs.len()).map(|f| env.cell(a, f).required[j] / env.effort[j]).collect()).collect();
-        let title = format!("{name} NEEDED TORQUE / LIMIT ({} NM){}", env.effort[j], if args.payload > 0.0 { format!(", PAYLOAD {} KG", args.payload) } else { String::new() });
+        let values: Vec<Vec<f64>> = (0..amps.len()).map(|a| (0..freqs.len()).map(|f| env.cell(a, f).demand[j]).collect()).collect();
+        let limit = if args.motors.is_some() { "AT SPEED".to_string() } else { format!("{} NM", env.effort[j]) };
+        let title = format!("{name} NEEDED TORQUE / LIMIT ({limit}){}", if args.payload > 0.0 { format!(", PAYLOAD {} KG", args.payload) } else { String::new() });
         let canvas = crate::diagnose::heatmap::heatmap(&title, "WAVE FREQUENCY (RAD/S)", &x_ticks, "AMPLITUDE (DEG)", &y_ticks, &values);
         let png = args.out.join(format!("envelope_{name}.png"));
         canvas.save_png(&png).map_err(|e| Error::output(&png, e))?;

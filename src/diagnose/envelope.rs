@@ -20,6 +20,9 @@ pub struct Cell {
     pub amp_deg: f64,
     /// Peak |torque| the commanded motion needs, per joint, N·m.
     pub required: Vec<f64>,
+    /// The largest share of the torque available at that instant the motion needs, per joint: above
+    /// 1 the motor runs out. With `--motors` the limit falls with speed; otherwise need / effort.
+    pub demand: Vec<f64>,
     /// From the simulation with the given gains: saturation and chatter shares, %.
     pub saturation_percent: Vec<f64>,
     pub chatter_percent: Vec<f64>,
@@ -52,7 +55,13 @@ pub fn with_payload(mut model: Model, kg: f64) -> Model {
 
 /// Peak |τ| per joint to follow `trajectory` exactly for `duration` seconds.
 pub fn required_torque(model: &Model, trajectory: &dyn Trajectory, duration: f64, dt: f64) -> Vec<f64> {
+    need(model, trajectory, duration, dt, &|_, _| 1.0).0
+}
+
+/// Per joint: the peak |τ| and the largest |τ(t)| / limit(joint, q̇(t)) along the exact motion.
+pub fn need(model: &Model, trajectory: &dyn Trajectory, duration: f64, dt: f64, limit: &dyn Fn(usize, f64) -> f64) -> (Vec<f64>, Vec<f64>) {
     let n = model.dof();
+    let mut demand = vec![0.0f64; n];
     let mut data = Data::new(model);
     let (mut q, mut qd, mut qdd) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
     let (mut qd_after, mut qd_before) = (vec![0.0; n], vec![0.0; n]);
@@ -70,10 +79,13 @@ pub fn required_torque(model: &Model, trajectory: &dyn Trajectory, duration: f64
         trajectory.sample(t, &mut q, &mut qd);
         let tau = rnea(model, &mut data, &q, &qd, &qdd);
         for j in 0..n {
-            peak[j] = peak[j].max((tau[j] + model.joints[j].damping * qd[j]).abs());
+            let torque = (tau[j] + model.joints[j].damping * qd[j]).abs();
+            peak[j] = peak[j].max(torque);
+            let available = limit(j, qd[j]);
+            demand[j] = demand[j].max(if available > 0.0 { torque / available } else if torque > 0.0 { f64::INFINITY } else { 0.0 });
         }
     }
-    peak
+    (peak, demand)
 }
 
 /// Sweep the grid. `base` supplies the gains and everything else; `model` carries the payload
@@ -84,6 +96,13 @@ pub fn sweep(base: &RunConfig, model: &Model, freqs: &[f64], amps_deg: &[f64], p
     let pool = rayon::ThreadPoolBuilder::new().num_threads(jobs.max(1)).build().map_err(|e| Error::flag("--jobs", e.to_string()))?;
     let first = Experiment::with_model(base.clone(), model.clone())?;
     let effort = first.controller().effort;
+    // the model as the runs see it (with `--motors`, their rotors in M) and the limit at a speed
+    let dynamics_model = first.model.clone();
+    let motors = first.motors.clone();
+    let limit = |j: usize, speed: f64| match motors.as_ref().and_then(|m| m.joints[j].as_ref()) {
+        Some(drive) => drive.torque_limit(speed),
+        None => effort[j],
+    };
     let cells: Result<Vec<Cell>, Error> = pool.install(|| {
         cells_in
             .par_iter()
@@ -92,9 +111,9 @@ pub fn sweep(base: &RunConfig, model: &Model, freqs: &[f64], amps_deg: &[f64], p
                 let config = RunConfig { freq, amp_deg, duration, hold: false, test_joint: None, trajectory: None, ..base.clone() };
                 let experiment = Experiment::with_model(config, model.clone())?;
                 let wave = Wave { amplitude_rad: amp_deg.to_radians(), omega: freq };
-                let required = required_torque(&model, &wave, duration, base.dt);
+                let (required, demand) = need(&dynamics_model, &wave, duration, base.dt, &limit);
                 let summary = simulate(&experiment, &mut [], None)?;
-                Ok(Cell { freq, amp_deg, required, saturation_percent: summary.saturation_percent, chatter_percent: summary.chatter_percent })
+                Ok(Cell { freq, amp_deg, required, demand, saturation_percent: summary.saturation_percent, chatter_percent: summary.chatter_percent })
             })
             .collect()
     });
@@ -118,7 +137,7 @@ impl Envelope {
     /// Per joint: the fastest frequency at each amplitude whose need stays within the limit.
     pub fn boundary(&self, joint: usize) -> Vec<Option<f64>> {
         (0..self.amps_deg.len())
-            .map(|a| (0..self.freqs.len()).filter(|&f| self.cell(a, f).required[joint] <= self.effort[joint]).map(|f| self.freqs[f]).fold(None, |m: Option<f64>, x| Some(m.map_or(x, |m| m.max(x)))))
+            .map(|a| (0..self.freqs.len()).filter(|&f| self.cell(a, f).demand[joint] <= 1.0).map(|f| self.freqs[f]).fold(None, |m: Option<f64>, x| Some(m.map_or(x, |m| m.max(x)))))
             .collect()
     }
 
