@@ -22,13 +22,13 @@ fn motors_file(name: &str) -> std::path::PathBuf {
 fn every_catalogue_entry_loads_with_its_numbers() {
     let catalogue = Catalogue::load(&motors_file("catalogue.toml")).unwrap();
     for name in ["17HS4401", "17HS15-1584S-MG5", "23HS22-2804S", "STS3215-C018"] {
-        let (motor, ..) = catalogue.motor(name).unwrap_or_else(|e| panic!("{e}"));
-        assert!(motor.torque_at(0.0) > 0.0, "{name}");
+        let drive = catalogue.drive_train(name).expect("in the catalogue").unwrap_or_else(|e| panic!("{e}"));
+        assert!(drive.motor.torque_at(0.0) > 0.0, "{name}");
     }
-    let (nema17, ratio, efficiency, rated) = catalogue.motor("17HS4401").unwrap();
-    assert_eq!((nema17.torque_at(0.0), nema17.rotor_inertia(), ratio, efficiency, rated), (0.40, 5.4e-6, 1.0, 1.0, f64::INFINITY));
-    let (_, ratio, efficiency, rated) = catalogue.motor("17HS15-1584S-MG5").unwrap();
-    assert_eq!((ratio, efficiency, rated), (5.0, 0.9, 9.0), "the gearmotor's own 5:1 planetary");
+    let nema17 = catalogue.drive_train("17HS4401").unwrap().unwrap();
+    assert_eq!((nema17.motor.torque_at(0.0), nema17.motor.rotor_inertia(), nema17.gear_ratio, nema17.efficiency, nema17.rated_torque), (0.40, 5.4e-6, 1.0, 1.0, f64::INFINITY));
+    let geared = catalogue.drive_train("17HS15-1584S-MG5").unwrap().unwrap();
+    assert_eq!((geared.gear_ratio, geared.efficiency, geared.rated_torque), (5.0, 0.9, 9.0), "the gearmotor's own 5:1 planetary");
 }
 
 /// The stepper's derived pull-out curve: holding torque up to the corner speed V/(2·L·I·200) rev/s

@@ -57,55 +57,60 @@ impl Catalogue {
         let mut entries = BTreeMap::new();
         for (name, value) in table {
             let Value::Table(t) = value else { return Err(fail(path, format!("motor '{name}': expected a table"))) };
-            let catalogue = Self { entries: BTreeMap::new(), source: path.to_path_buf() };
-            catalogue.motor_from(&name, &t)?; // every entry checked at load
+            drive_train_from(path, &name, &t)?; // every entry checked at load
             entries.insert(name, t);
         }
         Ok(Self { entries, source: path.to_path_buf() })
     }
 
-    /// The motor named `name`, with its own gearbox (ratio, efficiency, rated torque at its output).
-    pub fn motor(&self, name: &str) -> Result<(Box<dyn Motor>, f64, f64, f64), Error> {
-        let t = self.entries.get(name).ok_or_else(|| fail(&self.source, format!("no motor '{name}' (known: {})", self.entries.keys().cloned().collect::<Vec<_>>().join(", "))))?;
-        self.motor_from(name, t)
+    /// The motor named `name` behind its own gearbox (a gearmotor's; ratio 1 for a bare motor), or
+    /// None when the catalogue has no such motor.
+    pub fn drive_train(&self, name: &str) -> Option<Result<DriveTrain, Error>> {
+        self.entries.get(name).map(|t| drive_train_from(&self.source, name, t))
     }
 
-    fn motor_from(&self, name: &str, t: &toml::Table) -> Result<(Box<dyn Motor>, f64, f64, f64), Error> {
-        let what = format!("motor '{name}'");
-        let fields = Fields { file: &self.source, what: &what, table: t };
-        let kind = fields.string("kind")?;
-        let (gear_ratio, efficiency, rated) =
-            (fields.optional_positive("gearbox_ratio")?.unwrap_or(1.0), fields.optional_fraction("gearbox_efficiency")?.unwrap_or(1.0), fields.optional_positive("gearbox_rated_torque")?.unwrap_or(f64::INFINITY));
-        let common = ["kind", "gearbox_ratio", "gearbox_efficiency", "gearbox_rated_torque", "rotor_inertia", "source"];
-        let motor: Box<dyn Motor> = match kind.as_str() {
-            "stepper" => {
-                fields.known(&[&common[..], &["holding_torque", "step_angle", "inductance", "current", "supply_voltage", "pull_out", "resistance", "mass", "detent_torque"]].concat())?;
-                let pull_out = match t.get("pull_out") {
-                    Some(points) => PullOut::Table(fields.points("pull_out", points)?),
-                    None => PullOut::Derived { inductance: fields.positive("inductance")?, current: fields.positive("current")?, supply_voltage: fields.positive("supply_voltage")? },
-                };
-                let holding_torque = fields.positive("holding_torque")?;
-                let damping = match (fields.number("resistance")?, fields.number("current")?) {
-                    (Some(r), Some(i)) if r > 0.0 && i > 0.0 => (holding_torque / i).powi(2) / r,
-                    _ => 0.0,
-                };
-                Box::new(Stepper {
-                    name: name.to_string(),
-                    holding_torque,
-                    damping,
-                    rotor_inertia: fields.non_negative("rotor_inertia")?,
-                    step_angle_deg: fields.positive("step_angle")?,
-                    pull_out,
-                })
-            }
-            "servo" => {
-                fields.known(&[&common[..], &["stall_torque", "no_load_speed", "mass", "voltage"]].concat())?;
-                Box::new(DcServo { name: name.to_string(), stall_torque: fields.positive("stall_torque")?, no_load_speed: fields.positive("no_load_speed")?, rotor_inertia: fields.non_negative("rotor_inertia")? })
-            }
-            other => return Err(fail(&self.source, format!("{what}: field 'kind' is '{other}', expected 'stepper' or 'servo'"))),
-        };
-        Ok((motor, gear_ratio, efficiency, rated))
+    /// The catalogue's motor names, for messages.
+    pub fn names(&self) -> String {
+        self.entries.keys().cloned().collect::<Vec<_>>().join(", ")
     }
+}
+
+/// A catalogue entry as a motor behind its own gearbox; errors name `source`, the motor and the field.
+fn drive_train_from(source: &Path, name: &str, t: &toml::Table) -> Result<DriveTrain, Error> {
+    let what = format!("motor '{name}'");
+    let fields = Fields { file: source, what: &what, table: t };
+    let kind = fields.string("kind")?;
+    let (gear_ratio, efficiency, rated) =
+        (fields.optional_positive("gearbox_ratio")?.unwrap_or(1.0), fields.optional_fraction("gearbox_efficiency")?.unwrap_or(1.0), fields.optional_positive("gearbox_rated_torque")?.unwrap_or(f64::INFINITY));
+    let common = ["kind", "gearbox_ratio", "gearbox_efficiency", "gearbox_rated_torque", "rotor_inertia", "source"];
+    let motor: Box<dyn Motor> = match kind.as_str() {
+        "stepper" => {
+            fields.known(&[&common[..], &["holding_torque", "step_angle", "inductance", "current", "supply_voltage", "pull_out", "resistance", "mass", "detent_torque"]].concat())?;
+            let pull_out = match t.get("pull_out") {
+                Some(points) => PullOut::Table(fields.points("pull_out", points)?),
+                None => PullOut::Derived { inductance: fields.positive("inductance")?, current: fields.positive("current")?, supply_voltage: fields.positive("supply_voltage")? },
+            };
+            let holding_torque = fields.positive("holding_torque")?;
+            let damping = match (fields.number("resistance")?, fields.number("current")?) {
+                (Some(r), Some(i)) if r > 0.0 && i > 0.0 => (holding_torque / i).powi(2) / r,
+                _ => 0.0,
+            };
+            Box::new(Stepper {
+                name: name.to_string(),
+                holding_torque,
+                damping,
+                rotor_inertia: fields.non_negative("rotor_inertia")?,
+                step_angle_deg: fields.positive("step_angle")?,
+                pull_out,
+            })
+        }
+        "servo" => {
+            fields.known(&[&common[..], &["stall_torque", "no_load_speed", "mass", "voltage"]].concat())?;
+            Box::new(DcServo { name: name.to_string(), stall_torque: fields.positive("stall_torque")?, no_load_speed: fields.positive("no_load_speed")?, rotor_inertia: fields.non_negative("rotor_inertia")? })
+        }
+        other => return Err(fail(source, format!("{what}: field 'kind' is '{other}', expected 'stepper' or 'servo'"))),
+    };
+    Ok(DriveTrain { motor, gear_ratio, efficiency, rated_torque: rated })
 }
 
 /// A TOML table's fields, each checked with an error naming the file, the entry and the field.
@@ -220,10 +225,7 @@ pub fn load_motor_file(path: &Path, model: &Model) -> Result<MotorSet, Error> {
         fields.known(&["motor", "gear_ratio", "efficiency", "rated_torque", "microsteps", "acceleration"])?;
         set.acceleration[index] = fields.optional_positive("acceleration")?;
         let motor_name = fields.string("motor")?;
-        let (motor, own_ratio, own_efficiency, own_rated) = catalogue.motor(&motor_name).map_err(|e| match e {
-            Error::Flag { message, .. } => fail(path, format!("{what}: {}", message.split(": ").skip(1).collect::<Vec<_>>().join(": "))),
-            other => other,
-        })?;
+        let own = catalogue.drive_train(&motor_name).ok_or_else(|| fail(path, format!("{what}: no motor '{motor_name}' (known: {})", catalogue.names())))??;
         let ratio = fields.optional_positive("gear_ratio")?.unwrap_or(1.0);
         let efficiency = fields.optional_fraction("efficiency")?.unwrap_or(1.0);
         let rated = fields.optional_positive("rated_torque")?.unwrap_or(f64::INFINITY);
@@ -233,13 +235,7 @@ pub fn load_motor_file(path: &Path, model: &Model) -> Result<MotorSet, Error> {
             }
             set.microsteps[index] = Some(m as u32);
         }
-        set.joints[index] = Some(DriveTrain {
-            motor,
-            gear_ratio: own_ratio * ratio,
-            efficiency: own_efficiency * efficiency,
-            // the motor's own gearbox is rated at its output, before this reduction
-            rated_torque: (own_rated * ratio * efficiency).min(rated),
-        });
+        set.joints[index] = Some(own.followed_by(ratio, efficiency, rated));
     }
     Ok(set)
 }

@@ -49,6 +49,18 @@ impl DriveTrain {
         (self.efficiency * self.gear_ratio * self.motor.torque_at(self.gear_ratio * speed)).min(self.rated_torque)
     }
 
+    /// This drive train followed by a further reduction (a belt or gearbox after a gearmotor): the
+    /// ratios and efficiencies multiply; the first gearbox's rating, at its output, is carried through
+    /// the second, whose own rating caps it.
+    pub fn followed_by(self, gear_ratio: f64, efficiency: f64, rated_torque: f64) -> Self {
+        Self {
+            rated_torque: (self.rated_torque * gear_ratio * efficiency).min(rated_torque),
+            gear_ratio: self.gear_ratio * gear_ratio,
+            efficiency: self.efficiency * efficiency,
+            motor: self.motor,
+        }
+    }
+
     /// The rotor's inertia seen at the joint, J_r·N².
     pub fn reflected_inertia(&self) -> f64 {
         self.motor.rotor_inertia() * self.gear_ratio * self.gear_ratio
