@@ -340,17 +340,13 @@ fn gains(config: &RunConfig, model: &Model, start: &[f64], trajectory: &dyn Traj
 /// the drive train gives at rest, its gear ratio, and the rotor's inertia (so J_r·N² joins M).
 fn apply_motor_file(path: &std::path::Path, model: &mut Model) -> Result<MotorSet, Error> {
     let set = load_motor_file(path, model)?;
+    let mut actuators = std::mem::take(&mut model.actuators);
     for (joint, drive) in set.joints.iter().enumerate() {
         let Some(drive) = drive else { continue };
-        let actuator = Actuator { name: drive.motor.name().to_string(), joint, effort: drive.torque_limit(0.0), gear_ratio: drive.gear_ratio, rotor_inertia: drive.motor.rotor_inertia() };
-        model.actuators.retain(|a| a.joint != joint);
-        model.actuators.push(actuator);
+        actuators.retain(|a| a.joint != joint);
+        actuators.push(Actuator { name: drive.motor.name().to_string(), joint, effort: drive.torque_limit(0.0), gear_ratio: drive.gear_ratio, rotor_inertia: drive.motor.rotor_inertia() });
     }
-    model.actuators.sort_by_key(|a| a.joint);
-    model.armature = vec![0.0; model.dof()];
-    for a in &model.actuators {
-        model.armature[a.joint] += a.reflected_inertia();
-    }
+    model.set_actuators(actuators);
     Ok(set)
 }
 

@@ -186,6 +186,17 @@ impl Model {
         self.frames.iter().position(|f| f.name == name)
     }
 
+    /// Give the model its motors (sorted by joint) and the reflected inertias they bring to M's
+    /// diagonal: the one place `armature` is derived from `actuators`.
+    pub fn set_actuators(&mut self, mut actuators: Vec<Actuator>) {
+        actuators.sort_by_key(|a| a.joint);
+        self.armature = vec![0.0; self.dof()];
+        for a in &actuators {
+            self.armature[a.joint] += a.reflected_inertia();
+        }
+        self.actuators = actuators;
+    }
+
     /// Torque limit per joint: the actuator's effort, 0 for a joint without an actuator.
     pub fn effort_limits(&self) -> Vec<f64> {
         let mut effort = vec![0.0; self.dof()];

@@ -186,16 +186,12 @@ fn build(text: &str, source: &Path, options: LoadOptions) -> Result<Model, K> {
     }
 
     let actuators = motors(&doc, &robot, &joints, &mut notices)?;
-    let mut armature = vec![0.0; joints.len()];
-    for a in &actuators {
-        armature[a.joint] += a.reflected_inertia();
-    }
 
     // Tool: the deepest leaf link (first one in tree order on a tie).
     let is_leaf = |f: usize| !frames.iter().any(|g| g.parent_frame == Some(f));
     let tool_frame = (0..frames.len()).filter(|&f| is_leaf(f)).fold(0, |best, f| if depth[f] > depth[best] { f } else { best });
 
-    let model = Model {
+    let mut model = Model {
         name: robot.name.clone(),
         source: source.to_path_buf(),
         urdf_text: text.to_string(),
@@ -204,11 +200,12 @@ fn build(text: &str, source: &Path, options: LoadOptions) -> Result<Model, K> {
         bodies,
         couplings,
         frames,
-        actuators,
-        armature,
+        actuators: Vec::new(),
+        armature: Vec::new(),
         tool_frame,
         notices,
     };
+    model.set_actuators(actuators);
     // finite numbers whose products overflow (a massless link 1e308 m away): the mass matrix the
     // simulation will use, computed once here, must be finite
     let mut data = crate::dynamics::Data::new(&model);
