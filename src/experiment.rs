@@ -32,11 +32,10 @@ pub struct Experiment {
     pub start: Vec<f64>,
     /// The motors of `--motors`: each named joint's torque limit at its speed.
     pub motors: Option<Arc<MotorSet>>,
-    /// Stepper joints are driven open loop (`--motors` with steppers, `--drive stepper`).
-    pub stepper_mode: bool,
-    /// Stepper mode: where the steppers were energized (the command's start); `start` is this plus
-    /// the sag at which each stepper carries its share of the weight.
-    pub stepper_zero: Vec<f64>,
+    /// Stepper mode (`--motors` with steppers, `--drive stepper`): the open-loop steppers at rest,
+    /// energized where the command starts; `start` is that pose plus the sag at which each stepper
+    /// carries its share of the weight. Each run drives a copy.
+    pub steppers: Option<OpenLoopSteppers>,
 }
 
 impl Experiment {
@@ -71,63 +70,16 @@ impl Experiment {
             Some(path) => Some(Arc::new(apply_motor_file(path, &mut model)?)),
             None => None,
         };
-        let stepper_mode = config.drive == DriveMode::Stepper && motors.as_ref().is_some_and(|m| m.has_steppers());
-        let mut stepper_zero = Vec::new();
         let mut plant = plant_spec(&config)?;
         let mut start = start_pose(&config, &model)?;
         let trajectory = trajectory(&config, &model, &start)?;
-        if stepper_mode {
-            let motors = motors.as_ref().expect("stepper mode has motors");
-            if config.q0.is_none() {
-                // an open-loop stepper cannot jump: the arm starts where the command starts
-                let (mut cmd, mut cmd_dot) = (vec![0.0; model.dof()], vec![0.0; model.dof()]);
-                trajectory.sample(0.0, &mut cmd, &mut cmd_dot);
-                for (j, joint) in model.joints.iter().enumerate() {
-                    if motors.joints[j].as_ref().is_some_and(|d| d.motor.as_stepper().is_some()) {
-                        start[j] = cmd[j].clamp(joint.lower, joint.upper);
-                    }
-                }
-                model.notices.push("stepper mode: the stepper joints start where the command starts (an open-loop stepper cannot jump); --q0 sets another start".into());
-            }
-            stepper_zero = start.clone();
-            if let Some(steppers) = OpenLoopSteppers::new(motors, &motors.microsteps, &start, &inertia_diagonal(&model, &start)) {
-                // at rest, held: each stepper lags by the load angle that carries the weight
-                let mut data = crate::dynamics::Data::new(&model);
-                let mut sagged = start.clone();
-                for _ in 0..5 {
-                    let tau_g = crate::dynamics::gravity_forces(&model, &mut data, &sagged).to_vec();
-                    for (j, sag) in steppers.rest_sag(&tau_g) {
-                        sagged[j] = stepper_zero[j] + sag.unwrap_or(0.0);
-                    }
-                }
-                let biggest = (0..model.dof()).map(|j| (sagged[j] - start[j]).abs()).fold(0.0, f64::max);
-                start = sagged;
-                model.notices.push(format!("stepper mode: the arm starts at rest, held by its steppers, each lagging by the load angle that carries its weight (at most {biggest:.2e} rad at a joint)"));
-            }
-            if let (PlantSpec::Discrete { substeps, .. }, Some(_)) = (&plant, config.time_step) {
-                let needed = stepper_substeps(&model, motors, &start, config.dt);
-                if needed > *substeps {
-                    model.notices.push(format!(
-                        "stepper mode: --time-step {} ms is longer than the stiffest stepper joint's oscillation allows ({:.4} ms for ω_n·h ≤ 0.2): its lost steps are not to be trusted",
-                        config.dt / *substeps as f64 * 1e3,
-                        config.dt / needed as f64 * 1e3
-                    ));
-                }
-            }
-            if let (PlantSpec::Discrete { substeps, .. }, None) = (&plant, config.time_step) {
-                let needed = stepper_substeps(&model, motors, &start, config.dt);
-                if needed > *substeps {
-                    plant = PlantSpec::Discrete { time_step: config.dt / needed as f64, substeps: needed };
-                    model.notices.push(format!(
-                        "stepper mode: plant step {:.4} ms ({needed} per control period), short enough for the stiffest stepper joint's oscillation and damping (ω_n·h, h·c/I ≤ 0.2); --time-step sets another",
-                        config.dt / needed as f64 * 1e3
-                    ));
-                }
-            }
-        }
+        let steppers = match &motors {
+            Some(motors) if config.drive == DriveMode::Stepper && motors.has_steppers() => stepper_setup(&config, &mut model, motors, trajectory.as_ref(), &mut start, &mut plant),
+            _ => None,
+        };
         let gains = gains(&config, &model, &start, trajectory.as_ref(), &plant)?;
         let steps = (config.duration / config.dt - 1e-9).ceil() as usize;
-        Ok(Self { config, model: Arc::new(model), gains, plant, trajectory, steps, start, motors, stepper_mode, stepper_zero })
+        Ok(Self { config, model: Arc::new(model), gains, plant, trajectory, steps, start, motors, steppers })
     }
 
     pub fn controller(&self) -> PdGravityController {
@@ -151,13 +103,19 @@ impl Experiment {
         }
     }
 
-    /// The open-loop steppers of a stepper-mode run, at the start pose.
+    /// Whether stepper joints run open loop.
+    pub fn stepper_mode(&self) -> bool {
+        self.steppers.is_some()
+    }
+
+    /// The open-loop steppers for one run of this experiment (a fresh copy at rest).
     pub fn open_loop_steppers(&self) -> Option<OpenLoopSteppers> {
-        if !self.stepper_mode {
-            return None;
-        }
-        let motors = self.motors.as_ref()?;
-        OpenLoopSteppers::new(motors, &motors.microsteps, &self.stepper_zero, &inertia_diagonal(&self.model, &self.stepper_zero))
+        self.steppers.clone()
+    }
+
+    /// Per joint: driven open loop by a stepper.
+    pub fn stepped_joints(&self) -> Vec<bool> {
+        self.steppers.as_ref().map_or_else(|| vec![false; self.model.dof()], |s| s.stepped.clone())
     }
 
     /// The start state: the start pose (`--q0`, or every joint at 0 clamped into its range), at rest.
@@ -350,16 +308,65 @@ fn apply_motor_file(path: &std::path::Path, model: &mut Model) -> Result<MotorSe
     Ok(set)
 }
 
+/// Stepper mode's set-up: the stepper joints start where the command starts (unless `--q0`), held at
+/// the load angle that carries their weight (into `start`); the plant step is made short enough for
+/// the stiffest stepper (unless `--time-step`, then a notice if it is too long). Returns the steppers
+/// at rest, energized at the command's start.
+fn stepper_setup(config: &RunConfig, model: &mut Model, motors: &MotorSet, trajectory: &dyn Trajectory, start: &mut Vec<f64>, plant: &mut PlantSpec) -> Option<OpenLoopSteppers> {
+    if config.q0.is_none() {
+        // an open-loop stepper cannot jump: the arm starts where the command starts
+        let (mut cmd, mut cmd_dot) = (vec![0.0; model.dof()], vec![0.0; model.dof()]);
+        trajectory.sample(0.0, &mut cmd, &mut cmd_dot);
+        for (j, joint) in model.joints.iter().enumerate() {
+            if motors.joints[j].as_ref().is_some_and(|d| d.motor.as_stepper().is_some()) {
+                start[j] = cmd[j].clamp(joint.lower, joint.upper);
+            }
+        }
+        model.notices.push("stepper mode: the stepper joints start where the command starts (an open-loop stepper cannot jump); --q0 sets another start".into());
+    }
+    let energized = start.clone();
+    let steppers = OpenLoopSteppers::new(motors, &energized, &inertia_diagonal(model, &energized))?;
+    // at rest, held: each stepper lags by the load angle that carries the weight
+    let mut data = crate::dynamics::Data::new(model);
+    let mut sagged = energized.clone();
+    for _ in 0..5 {
+        let tau_g = crate::dynamics::gravity_forces(model, &mut data, &sagged).to_vec();
+        for (j, sag) in steppers.rest_sag(&tau_g) {
+            sagged[j] = energized[j] + sag.unwrap_or(0.0);
+        }
+    }
+    let biggest = (0..model.dof()).map(|j| (sagged[j] - energized[j]).abs()).fold(0.0, f64::max);
+    *start = sagged;
+    model.notices.push(format!("stepper mode: the arm starts at rest, held by its steppers, each lagging by the load angle that carries its weight (at most {biggest:.2e} rad at a joint)"));
+    if let PlantSpec::Discrete { substeps, .. } = *plant {
+        let needed = stepper_substeps(&steppers, model, start, config.dt);
+        if needed > substeps {
+            let step_ms = config.dt / needed as f64 * 1e3;
+            match config.time_step {
+                Some(_) => model.notices.push(format!(
+                    "stepper mode: --time-step {} ms is longer than the stiffest stepper joint's oscillation allows ({step_ms:.4} ms for ω_n·h ≤ 0.2): its lost steps are not to be trusted",
+                    config.dt / substeps as f64 * 1e3
+                )),
+                None => {
+                    *plant = PlantSpec::Discrete { time_step: config.dt / needed as f64, substeps: needed };
+                    model.notices.push(format!(
+                        "stepper mode: plant step {step_ms:.4} ms ({needed} per control period), short enough for the stiffest stepper joint's oscillation and damping (ω_n·h, h·c/I ≤ 0.2); --time-step sets another"
+                    ));
+                }
+            }
+        }
+    }
+    Some(steppers)
+}
+
 /// Plant steps per control period that keep every stepper joint's oscillation about its stable
-/// position (stiffness η·N²·T_H·N_r against M_ii at the start pose) resolved: ω_n·h ≤ 0.2.
-fn stepper_substeps(model: &Model, motors: &MotorSet, start: &[f64], dt: f64) -> usize {
-    let inertia = inertia_diagonal(model, start);
-    let Some(steppers) = OpenLoopSteppers::new(motors, &motors.microsteps, start, &inertia) else { return 1 };
+/// position (stiffness η·N²·T_H·N_r against M_ii at `pose`) resolved: ω_n·h ≤ 0.2.
+fn stepper_substeps(steppers: &OpenLoopSteppers, model: &Model, pose: &[f64], dt: f64) -> usize {
+    let inertia = inertia_diagonal(model, pose);
     let omega = steppers.stiffness().iter().map(|&(j, k)| (k / inertia[j]).sqrt()).fold(0.0, f64::max);
     // the damping is explicit in the stepper's torque: h·c/I ≤ 0.2 as well
     let rate = steppers.damping().iter().map(|&(j, c)| c / inertia[j]).fold(0.0, f64::max);
-    let omega = omega.max(rate);
-    ((omega * dt / 0.2).ceil() as usize).max(1)
+    ((omega.max(rate) * dt / 0.2).ceil() as usize).max(1)
 }
 
 /// The mass matrix's diagonal at `q` (each joint's inertia with the others held).

@@ -208,7 +208,7 @@ fn the_motor_files_are_built_into_the_binary() {
 fn the_so100_runs_on_its_sts3215_servos() {
     let urdf = common::repo().join("tests/fixtures/robots/so100.urdf");
     let experiment = Experiment::prepare(RunConfig { urdf, motors: Some(motors_file("so100.toml")), duration: 5.0, ..RunConfig::default() }).unwrap();
-    assert!(!experiment.stepper_mode, "servos are not steppers");
+    assert!(!experiment.stepper_mode(), "servos are not steppers");
     let summary = simulate(&experiment, &mut [], None).unwrap();
     assert!(matches!(summary.status, armscope::summary::RunStatus::Completed));
     for (j, limit) in summary.effort_limit.iter().enumerate() {

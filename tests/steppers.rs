@@ -144,7 +144,7 @@ fn drive_pd_runs_the_pd_loop_on_the_pull_out_limit_and_the_energy_audit_balances
         c.duration = 10.0;
     }))
     .unwrap();
-    assert!(!experiment.stepper_mode);
+    assert!(!experiment.stepper_mode());
     assert!(experiment.open_loop_steppers().is_none());
     let summary = simulate(&experiment, &mut [], None).unwrap();
     assert!(matches!(summary.status, RunStatus::Completed), "{:?}", summary.status);

@@ -18,7 +18,7 @@ use super::{DriveTrain, MotorSet, Stepper};
 use std::f64::consts::PI;
 
 /// One joint's open-loop stepper.
-#[derive(Debug)]
+#[derive(Clone, Debug)]
 struct SteppedJoint {
     joint: usize,
     gear_ratio: f64,
@@ -57,7 +57,7 @@ impl SteppedJoint {
 }
 
 /// The joints a motor file drives open loop (every stepper, unless `--drive pd`).
-#[derive(Debug)]
+#[derive(Clone, Debug)]
 pub struct OpenLoopSteppers {
     joints: Vec<SteppedJoint>,
     /// Per coordinate: driven open loop here.
@@ -75,12 +75,12 @@ pub struct LostSteps {
 impl OpenLoopSteppers {
     /// The stepper joints of `motors` with their microsteps, their step generators' acceleration
     /// bounds (`inertia`: M_ii at the start pose, for the default); None when there are none.
-    pub fn new(motors: &MotorSet, microsteps: &[Option<u32>], start: &[f64], inertia: &[f64]) -> Option<Self> {
+    pub fn new(motors: &MotorSet, start: &[f64], inertia: &[f64]) -> Option<Self> {
         let mut joints = Vec::new();
         for (j, drive) in motors.joints.iter().enumerate() {
             let Some(DriveTrain { motor, gear_ratio, efficiency, rated_torque }) = drive else { continue };
             let Some(stepper) = motor.as_stepper() else { continue };
-            let micro = microsteps.get(j).copied().flatten().unwrap_or(1) as f64;
+            let micro = motors.microsteps.get(j).copied().flatten().unwrap_or(1) as f64;
             joints.push(SteppedJoint {
                 joint: j,
                 gear_ratio: *gear_ratio,

@@ -84,7 +84,7 @@ impl Console {
         writeln!(self.out, "  plant: {}", run.plant).map_err(io)?;
         if let Some(motors) = &e.motors {
             let names: Vec<String> = m.joints.iter().map(|j| j.name.clone()).collect();
-            let mode = if e.stepper_mode { "; stepper joints driven open loop in microsteps (no PD; --drive pd for the PD controller)" } else { "" };
+            let mode = if e.stepper_mode() { "; stepper joints driven open loop in microsteps (no PD; --drive pd for the PD controller)" } else { "" };
             writeln!(self.out, "  motors ({}): the torque limit falls with the joint's speed{mode}", motors.source.display()).map_err(io)?;
             write!(self.out, "{}", motors.table(&names)).map_err(io)?;
         }

@@ -488,8 +488,7 @@ impl Recorder for McapRecorder {
         let file = match &self.options.file {
             Some(path) => {
                 // the Foxglove layout for this model, beside the recording
-                let stepped = e.open_loop_steppers().map_or_else(Vec::new, |s| s.stepped);
-                let layout = super::foxglove_layout::layout_with_motors(model, &e.initial_state().0, e.motors.is_some(), &stepped);
+                let layout = super::foxglove_layout::layout_with_motors(model, &e.initial_state().0, e.motors.is_some(), &e.stepped_joints());
                 let layout_path = super::foxglove_layout::layout_path(path);
                 std::fs::write(&layout_path, serde_json::to_string_pretty(&layout).unwrap_or_default()).map_err(|err| Error::output(&layout_path, err))?;
                 Some(super::output_file::create_replacing(path).map_err(|err| self.err(err))?)

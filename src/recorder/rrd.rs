@@ -601,7 +601,7 @@ impl Recorder for RerunRecorder {
         self.joint_names = model.joints.iter().map(|j| j.name.clone()).collect();
         self.effort = e.controller().effort;
         self.speed_dependent_limit = e.motors.is_some();
-        self.stepped = e.open_loop_steppers().map_or(vec![false; e.model.dof()], |s| s.stepped);
+        self.stepped = e.stepped_joints();
         self.motor_ratio = e.motors.as_ref().map_or(vec![None; e.model.dof()], |m| m.joints.iter().map(|d| d.as_ref().map(|d| d.gear_ratio)).collect());
         let cap = FILE_BLOCK_STEPS + 1;
         self.times = Vec::with_capacity(cap);
