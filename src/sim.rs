@@ -1,6 +1,5 @@
 //! The simulation loop: controller and plant at the control rate, every sample to every recorder.
 
-use crate::actuator::OpenLoopSteppers;
 use crate::dynamics::{Data, body_poses, forward_kinematics, frame_pose, frame_pose_in, gravity_and_bias_from_kinematics};
 use crate::error::Error;
 use crate::experiment::Experiment;
@@ -66,15 +65,11 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
             }
         }
         for i in 0..n {
-            chatter[i] = k > 0 && u[i] * previous_u[i] < 0.0 && (saturated[i] || previous_saturated[i]);
+            // (a slipping stepper's torque swings sign with its lag: that is the motor, not the loop)
+            let stepped = steppers.as_ref().is_some_and(|s| s.stepped[i]);
+            chatter[i] = !stepped && k > 0 && u[i] * previous_u[i] < 0.0 && (saturated[i] || previous_saturated[i]);
             previous_u[i] = u[i];
             previous_saturated[i] = saturated[i];
-        }
-        if let Some(s) = steppers.as_ref() {
-            for j in (0..n).filter(|&j| s.stepped[j]) {
-                // a slipping rotor's torque swings sign with the lag: that is the motor, not the loop
-                chatter[j] = false;
-            }
         }
         body_poses(model, &cmd, &mut command_poses);
         let interrupted = stop.is_some_and(|s| s.load(Ordering::Relaxed));
@@ -112,12 +107,9 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
             a.remember(&v);
             a.potential_energy(model, &data)
         });
-        match steppers.as_mut() {
-            Some(s) => {
-                // the stepper torque follows the rotor within the control period: at every plant step
-                let s: &OpenLoopSteppers = s;
-                plant.advance_driven(model, &mut data, &mut u, &mut |q, v, u| s.torques(q, v, u), &mut q, &mut v);
-            }
+        match steppers.as_ref() {
+            // the stepper torque follows the rotor within the control period: at every plant step
+            Some(s) => plant.advance_driven(model, &mut data, &mut u, &mut |q, v, u| s.torques(q, v, u), &mut q, &mut v),
             None => plant.advance(model, &mut data, &u, &mut q, &mut v),
         }
         if let Some(s) = steppers.as_mut() {

@@ -77,6 +77,19 @@ impl DiscretePlant {
         }
     }
 
+    /// The control period's plant steps, each by `step`; the kinematics, τ_g and C·v it needs are
+    /// computed for every step after the first (the loop computed them for the first).
+    fn over_substeps(&mut self, model: &Model, data: &mut Data, q: &mut [f64], v: &mut [f64], mut step: impl FnMut(&mut Self, &mut Data, &mut [f64], &mut [f64])) {
+        self.limit_active.fill(false);
+        for s in 0..self.substeps {
+            if s > 0 {
+                forward_kinematics(model, data, q);
+                gravity_and_bias_from_kinematics(model, data, v);
+            }
+            step(self, data, q, v);
+        }
+    }
+
     /// Active-set solve: start unconstrained, fix the velocity of every joint that would pass its
     /// limit to the velocity that lands on it, release a joint whose constraint would have to pull.
     fn solve_with_limits(&mut self, model: &Model, q: &[f64]) {
@@ -156,26 +169,14 @@ impl DiscretePlant {
 
 impl Plant for DiscretePlant {
     fn advance(&mut self, model: &Model, data: &mut Data, u: &[f64], q: &mut [f64], v: &mut [f64]) {
-        self.limit_active.fill(false);
-        for s in 0..self.substeps {
-            if s > 0 {
-                forward_kinematics(model, data, q);
-                gravity_and_bias_from_kinematics(model, data, v);
-            }
-            self.step(model, data, u, q, v);
-        }
+        self.over_substeps(model, data, q, v, |plant, data, q, v| plant.step(model, data, u, q, v));
     }
 
     fn advance_driven(&mut self, model: &Model, data: &mut Data, u: &mut [f64], torque: &mut dyn FnMut(&[f64], &[f64], &mut [f64]), q: &mut [f64], v: &mut [f64]) {
-        self.limit_active.fill(false);
-        for s in 0..self.substeps {
-            if s > 0 {
-                forward_kinematics(model, data, q);
-                gravity_and_bias_from_kinematics(model, data, v);
-            }
+        self.over_substeps(model, data, q, v, |plant, data, q, v| {
             torque(q, v, u);
-            self.step(model, data, u, q, v);
-        }
+            plant.step(model, data, u, q, v)
+        });
     }
 
     fn limit_active(&self) -> &[bool] {
