@@ -113,6 +113,12 @@ impl MotorSet {
         out
     }
 
+    /// The speed of joint `joint`'s motor shaft, N·q̇ in rev/s, at joint speed `joint_speed`; None
+    /// for a joint the motor file leaves out.
+    pub fn motor_speed(&self, joint: usize, joint_speed: f64) -> Option<f64> {
+        self.joints[joint].as_ref().map(|d| d.gear_ratio * joint_speed / std::f64::consts::TAU)
+    }
+
     /// Whether any joint has a stepper.
     pub fn has_steppers(&self) -> bool {
         self.joints.iter().flatten().any(|d| d.motor.as_stepper().is_some())

@@ -237,7 +237,7 @@ pub struct McapRecorder {
     tool_path: ToolPath,
     last_scene_second: i64,
     /// Per joint, its motor's gear ratio from `--motors` (0: no motor file entry).
-    motor_ratio: Vec<f64>,
+    motors: Option<std::sync::Arc<crate::actuator::MotorSet>>,
     /// Simulated seconds between republished geometries: 1 for small scenes, longer for big meshes.
     scene_interval_s: i64,
 }
@@ -329,7 +329,7 @@ impl McapRecorder {
             steps_per_tf: 10,
             tool_path: ToolPath::default(),
             last_scene_second: -1,
-            motor_ratio: Vec::new(),
+            motors: None,
             scene_interval_s: 1,
         }
     }
@@ -607,7 +607,7 @@ impl Recorder for McapRecorder {
             lost_steps: vec![0; n],
             motor_speed: vec![0.0; n],
         };
-        self.motor_ratio = e.motors.as_ref().map_or(vec![0.0; n], |m| m.joints.iter().map(|d| d.as_ref().map_or(0.0, |d| d.gear_ratio)).collect());
+        self.motors = e.motors.clone();
         self.scene = scene_from_model(model).map_err(|(path, err)| Error::output(&path, err))?;
         let scene_bytes = foxglove::Encode::encoded_len(&self.scene).unwrap_or(0);
         self.scene_interval_s = scene_interval_s(scene_bytes);
@@ -669,7 +669,7 @@ impl Recorder for McapRecorder {
             tel.torque_limit[j] = s.torque_limit[j];
             tel.load_angle[j] = s.load_angle[j];
             tel.lost_steps[j] = s.lost_steps[j];
-            tel.motor_speed[j] = self.motor_ratio[j] * s.v[j] / std::f64::consts::TAU;
+            tel.motor_speed[j] = self.motors.as_ref().and_then(|m| m.motor_speed(j, s.v[j])).unwrap_or(0.0);
         }
         let path = &self.path;
         let fail = |e: String| Error::output(path, e);

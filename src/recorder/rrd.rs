@@ -102,12 +102,11 @@ pub struct RerunRecorder {
     model: Option<Arc<Model>>,
     joint_names: Vec<String>,
     effort: Vec<f64>,
-    /// The torque limit falls with speed (`--motors`): recorded at every step.
-    speed_dependent_limit: bool,
     /// Per joint: driven open loop (stepper mode): its load angle and lost steps are recorded.
     stepped: Vec<bool>,
-    /// Per joint with a motor from `--motors`, its gear ratio (the motor turns N times faster).
-    motor_ratio: Vec<Option<f64>>,
+    /// The motors of `--motors`: the torque limit falls with speed (recorded at every step), and
+    /// each motor's shaft speed is recorded.
+    motors: Option<Arc<crate::actuator::MotorSet>>,
     times: Vec<f64>,
     joints: Vec<JointColumns>,
     /// [x, y, z] per step.
@@ -149,9 +148,8 @@ impl RerunRecorder {
             model: None,
             joint_names: Vec::new(),
             effort: Vec::new(),
-            speed_dependent_limit: false,
             stepped: Vec::new(),
-            motor_ratio: Vec::new(),
+            motors: None,
             times: Vec::new(),
             joints: Vec::new(),
             tool: Vec::new(),
@@ -301,7 +299,7 @@ impl RerunRecorder {
                 ),
                 // "effort" is the URDF's constant; with --motors the limit falls with speed
                 ("torque_limit", {
-                    let word = if self.speed_dependent_limit { "limit" } else { "effort" };
+                    let word = if self.motors.is_some() { "limit" } else { "effort" };
                     lines(&[format!("{name} +{word}"), format!("{name} −{word}")], &[red, red], &[1.0, 1.0])
                 }),
                 ("load_angle", lines(&[format!("{name} load angle (electrical °; ±90 peak torque, ±180 slip)")], &[c], &[1.5])),
@@ -350,7 +348,7 @@ impl RerunRecorder {
                 debug_assert_eq!(values.len(), width * steps);
                 send(&format!("{base}/{leaf}"), time.clone(), scalars(values, width))?;
             }
-            if self.motor_ratio[j].is_some() {
+            if self.motors.as_ref().is_some_and(|m| m.joints[j].is_some()) {
                 send(&format!("{base}/motor_speed"), time.clone(), scalars(&c.motor_speed, 1))?;
             }
             if self.stepped[j] {
@@ -363,7 +361,7 @@ impl RerunRecorder {
             }
             // the limits: at every step when they fall with speed, else as lines spanning the block
             let effort = self.effort[j];
-            if self.speed_dependent_limit {
+            if self.motors.is_some() {
                 send(&format!("{base}/torque_limit"), time.clone(), scalars(&c.limit, 2))?;
             } else if effort.is_finite() {
                 let ends = TimeColumn::new_duration_secs(TIMELINE, [self.times[0], self.times[steps - 1]]);
@@ -600,9 +598,8 @@ impl Recorder for RerunRecorder {
         let rec = self.open_stream()?;
         self.joint_names = model.joints.iter().map(|j| j.name.clone()).collect();
         self.effort = e.controller().effort;
-        self.speed_dependent_limit = e.motors.is_some();
         self.stepped = e.stepped_joints();
-        self.motor_ratio = e.motors.as_ref().map_or(vec![None; e.model.dof()], |m| m.joints.iter().map(|d| d.as_ref().map(|d| d.gear_ratio)).collect());
+        self.motors = e.motors.clone();
         let cap = FILE_BLOCK_STEPS + 1;
         self.times = Vec::with_capacity(cap);
         self.joints = (0..model.dof()).map(|_| JointColumns::with_capacity(cap)).collect();
@@ -651,11 +648,11 @@ impl Recorder for RerunRecorder {
             let flag = |b: bool| if b { 1.0 } else { 0.0 };
             c.position.extend_from_slice(&[s.q[j], s.cmd[j]]);
             c.torque.extend_from_slice(&[s.u[j], s.tau_g[j]]);
-            if self.speed_dependent_limit {
+            if self.motors.is_some() {
                 c.limit.extend_from_slice(&[s.torque_limit[j], -s.torque_limit[j]]);
             }
-            if let Some(ratio) = self.motor_ratio[j] {
-                c.motor_speed.push(ratio * s.v[j] / std::f64::consts::TAU);
+            if let Some(speed) = self.motors.as_ref().and_then(|m| m.motor_speed(j, s.v[j])) {
+                c.motor_speed.push(speed);
             }
             if self.stepped[j] {
                 c.load_angle.push(s.load_angle[j]);
