@@ -170,11 +170,6 @@ impl OpenLoopSteppers {
         }
     }
 
-    /// The generator's acceleration bound per stepper joint (rad/s² at the joint).
-    pub fn accelerations(&self) -> Vec<(usize, f64)> {
-        self.joints.iter().map(|s| (s.joint, s.max_acceleration)).collect()
-    }
-
     /// The electrical damping of each stepper joint at the joint, N²·c (N·m·s/rad).
     pub fn damping(&self) -> Vec<(usize, f64)> {
         self.joints.iter().map(|s| (s.joint, s.stepper.damping * s.gear_ratio * s.gear_ratio)).collect()

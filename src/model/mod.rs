@@ -166,13 +166,6 @@ impl Model {
         self.bodies.iter().zip(&self.couplings).enumerate().filter(|(_, (b, c))| self.joints[c.coordinate].name != b.name).map(|(i, (b, c))| (i, b, c))
     }
 
-    /// Every body joint's position at the coordinates `q` (for drawing and recording).
-    pub fn body_positions(&self, q: &[f64], out: &mut [f64]) {
-        for (o, c) in out.iter_mut().zip(&self.couplings) {
-            *o = c.position(q);
-        }
-    }
-
     /// Number of degrees of freedom (one per independent moving joint).
     pub fn dof(&self) -> usize {
         self.joints.len()
