@@ -53,32 +53,33 @@ def robots_dir():
     sys.exit("example-robot-data not found")
 
 
+def independent_joints(model, fallback):
+    """Each joint with a coordinate of its own (a <mimic> joint follows its master): its name,
+    Pinocchio joint model and range, or `fallback` where it has no usable one (continuous,
+    unlimited, empty, or wider than a turn)."""
+    for j in range(1, model.njoints):
+        jm = model.joints[j]
+        if jm.nv == 0:
+            continue
+        lo, hi = model.lowerPositionLimit[jm.idx_q], model.upperPositionLimit[jm.idx_q]
+        if jm.nq == 2 or not (np.isfinite(lo) and np.isfinite(hi)) or hi - lo > 2 * np.pi or hi <= lo:
+            lo, hi = fallback
+        yield model.names[j], jm, lo, hi
+
+
 def random_states(model, rng, count):
     """States by joint name, and the same as Pinocchio vectors."""
     states = []
     for _ in range(count):
-        q = pin.neutral(model)
         v = np.zeros(model.nv)
         tau = np.zeros(model.nv)
         named = {"q": {}, "v": {}, "tau": {}}
-        for j in range(1, model.njoints):
-            jm = model.joints[j]
-            name = model.names[j]
-            if jm.nv == 0:  # a <mimic> joint: it follows its master
-                continue
-            lo, hi = model.lowerPositionLimit[jm.idx_q], model.upperPositionLimit[jm.idx_q]
-            if jm.nq == 2:  # continuous: (cos, sin)
-                angle = rng.uniform(-np.pi, np.pi)
-                q[jm.idx_q : jm.idx_q + 2] = [np.cos(angle), np.sin(angle)]
-            else:
-                if not (np.isfinite(lo) and np.isfinite(hi)) or hi - lo > 2 * np.pi or hi <= lo:
-                    lo, hi = -np.pi, np.pi
-                angle = rng.uniform(lo, hi)
-                q[jm.idx_q] = angle
+        for name, jm, lo, hi in independent_joints(model, (-np.pi, np.pi)):
+            named["q"][name] = float(rng.uniform(lo, hi))
             v[jm.idx_v] = rng.uniform(-1, 1)
             tau[jm.idx_v] = rng.uniform(-1, 1)
-            named["q"][name], named["v"][name], named["tau"][name] = float(angle), float(v[jm.idx_v]), float(tau[jm.idx_v])
-        states.append((named, q, v, tau))
+            named["v"][name], named["tau"][name] = float(v[jm.idx_v]), float(tau[jm.idx_v])
+        states.append((named, pin_configuration(model, named["q"]), v, tau))
     return states
 
 
@@ -151,7 +152,7 @@ def compare(armscope, urdf, tol, rng):
     names = ours["joints"]
     # Pinocchio's velocity index of each of armscope's joints
     idx = [model.joints[model.getJointId(n)].idx_v for n in names]
-    independent = [model.names[j] for j in range(1, model.njoints) if model.joints[j].nv > 0]
+    independent = [name for name, *_ in independent_joints(model, (0.0, 0.0))]
     if sorted(names) != sorted(independent):
         return None, f"joints differ: armscope {len(names)}, pinocchio {len(independent)}"
     worst = {}
@@ -174,11 +175,8 @@ def compare(armscope, urdf, tol, rng):
 def pin_configuration(model, angles):
     """Pinocchio's q from angles by joint name (continuous joints as cos, sin)."""
     q = pin.neutral(model)
-    for j in range(1, model.njoints):
-        jm = model.joints[j]
-        if jm.nv == 0:
-            continue
-        angle = angles[model.names[j]]
+    for name, jm, _, _ in independent_joints(model, (0.0, 0.0)):
+        angle = angles[name]
         if jm.nq == 2:
             q[jm.idx_q : jm.idx_q + 2] = [np.cos(angle), np.sin(angle)]
         else:
@@ -196,17 +194,9 @@ def passive_run(armscope, urdf, rng, steps=300):
     model = pin.buildModelFromUrdf(urdf, mimic=True)
     data = model.createData()
     damping = coordinate_damping(urdf, model)
-    names = [model.names[j] for j in range(1, model.njoints) if model.joints[j].nv > 0]
     # a start pose inside each joint's range, away from the limits
-    q0 = {}
-    for j in range(1, model.njoints):
-        jm = model.joints[j]
-        if jm.nv == 0:
-            continue
-        lo, hi = model.lowerPositionLimit[jm.idx_q], model.upperPositionLimit[jm.idx_q]
-        if jm.nq == 2 or not (np.isfinite(lo) and np.isfinite(hi)) or hi <= lo or hi - lo > 2 * np.pi:
-            lo, hi = -1.0, 1.0
-        q0[model.names[j]] = float(rng.uniform(lo + 0.3 * (hi - lo), hi - 0.3 * (hi - lo)))
+    q0 = {name: float(rng.uniform(lo + 0.3 * (hi - lo), hi - 0.3 * (hi - lo))) for name, _, lo, hi in independent_joints(model, (-1.0, 1.0))}
+    names = list(q0)
     h = 0.001
     with tempfile.TemporaryDirectory() as d:
         trace = os.path.join(d, "trace.csv")
