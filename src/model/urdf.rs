@@ -353,17 +353,14 @@ fn couple(bodies: &[Joint], body_urdf_joint: &[usize], robot: &urdf_rs::Robot, n
                 None => return Err(fail("names a joint this URDF does not have")),
             };
         };
-        let master = &joints[coupling.coordinate];
+        let master = &mut joints[coupling.coordinate];
+        // D_r = GᵀDG: the mimic's damping, seen through its multiplier, joins its master's
+        master.damping += coupling.multiplier * coupling.multiplier * body.damping;
         notices.push(format!(
             "joint '{}' mimics '{}' (q = {}·q + {}): it moves with it, its own limits and motor are not used",
             body.name, master.name, coupling.multiplier, coupling.offset
         ));
         couplings.push(coupling);
-    }
-    for (body, c) in bodies.iter().zip(&couplings) {
-        if joints[c.coordinate].name != body.name {
-            joints[c.coordinate].damping += c.multiplier * c.multiplier * body.damping;
-        }
     }
     Ok((joints, couplings))
 }
