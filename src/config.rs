@@ -58,6 +58,8 @@ pub struct RunConfig {
     pub debug: bool,
     /// The link whose origin is the tool tip.
     pub tool: Option<String>,
+    /// A payload at the tool tip, kg (a point mass).
+    pub payload: f64,
     /// Tracking error statistics cover every step with t ≥ this, s.
     pub settle_time: f64,
     /// A joint speed above this (rad/s or m/s) is divergence.
@@ -99,6 +101,7 @@ impl Default for RunConfig {
             trajectory: None,
             debug: false,
             tool: None,
+            payload: 0.0,
             settle_time: 2.0,
             divergence_speed: 1e4,
             strict_inertia: false,

@@ -45,7 +45,17 @@ impl Experiment {
         Self::with_model(config, model)
     }
 
-    pub fn with_model(config: RunConfig, mut model: Model) -> Result<Self, Error> {
+    pub fn with_model(config: RunConfig, model: Model) -> Result<Self, Error> {
+        let motors = match &config.motors {
+            Some(path) => Some(load_motor_file(path, &model)?),
+            None => None,
+        };
+        Self::with_motors(config, model, motors)
+    }
+
+    /// As [`Self::with_model`], with the motors given directly instead of by `config.motors` (which
+    /// only names their file here): how `armscope size` tries candidate motor sets.
+    pub fn with_motors(config: RunConfig, mut model: Model, motors: Option<MotorSet>) -> Result<Self, Error> {
         let positive = |flag: &str, value: f64| {
             if value.is_finite() && value > 0.0 { Ok(()) } else { Err(Error::flag(flag, format!("must be a positive number of seconds (got {value})"))) }
         };
@@ -66,10 +76,11 @@ impl Experiment {
         if let Some(tool) = &config.tool {
             model.set_tool_frame(tool).map_err(|m| Error::flag("--tool", m))?;
         }
-        let motors = match &config.motors {
-            Some(path) => Some(Arc::new(apply_motor_file(path, &mut model)?)),
-            None => None,
-        };
+        if !(config.payload >= 0.0 && config.payload.is_finite()) {
+            return Err(Error::flag("--payload", format!("must be a mass in kg, not negative (got {})", config.payload)));
+        }
+        let mut model = crate::diagnose::envelope::with_payload(model, config.payload);
+        let motors = motors.map(|set| Arc::new(apply_motor_set(set, &mut model)));
         let mut plant = plant_spec(&config)?;
         let mut start = start_pose(&config, &model)?;
         let trajectory = trajectory(&config, &model, &start)?;
@@ -294,10 +305,9 @@ fn gains(config: &RunConfig, model: &Model, start: &[f64], trajectory: &dyn Traj
     Ok(Gains { kp, kd, source, effective_inertia: base.effective_inertia, spectral_radius: base.spectral_radius })
 }
 
-/// Load a motor file and give each joint it names that motor: an actuator whose effort is the torque
-/// the drive train gives at rest, its gear ratio, and the rotor's inertia (so J_r·N² joins M).
-fn apply_motor_file(path: &std::path::Path, model: &mut Model) -> Result<MotorSet, Error> {
-    let set = load_motor_file(path, model)?;
+/// Give each joint of a motor set its motor: an actuator whose effort is the torque the drive train
+/// gives at rest, its gear ratio, and the rotor's inertia (so J_r·N² joins M).
+fn apply_motor_set(set: MotorSet, model: &mut Model) -> MotorSet {
     let mut actuators = std::mem::take(&mut model.actuators);
     for (joint, drive) in set.joints.iter().enumerate() {
         let Some(drive) = drive else { continue };
@@ -305,7 +315,7 @@ fn apply_motor_file(path: &std::path::Path, model: &mut Model) -> Result<MotorSe
         actuators.push(Actuator { name: drive.motor.name().to_string(), joint, effort: drive.torque_limit(0.0), gear_ratio: drive.gear_ratio, rotor_inertia: drive.motor.rotor_inertia() });
     }
     model.set_actuators(actuators);
-    Ok(set)
+    set
 }
 
 /// Stepper mode's set-up: the stepper joints start where the command starts (unless `--q0`), held at
@@ -317,17 +327,19 @@ fn stepper_setup(config: &RunConfig, model: &mut Model, motors: &MotorSet, traje
         // an open-loop stepper cannot jump: the arm starts where the command starts
         let (mut cmd, mut cmd_dot) = (vec![0.0; model.dof()], vec![0.0; model.dof()]);
         trajectory.sample(0.0, &mut cmd, &mut cmd_dot);
+        // and so do the other joints with motors: a servo leaping to its command would kick the steppers
         for (j, joint) in model.joints.iter().enumerate() {
-            if motors.joints[j].as_ref().is_some_and(|d| d.motor.as_stepper().is_some()) {
+            if motors.joints[j].is_some() {
                 start[j] = cmd[j].clamp(joint.lower, joint.upper);
             }
         }
-        model.notices.push("stepper mode: the stepper joints start where the command starts (an open-loop stepper cannot jump); --q0 sets another start".into());
+        model.notices.push("stepper mode: the joints with motors start where the command starts (an open-loop stepper cannot jump); --q0 sets another start".into());
     }
     let energized = start.clone();
-    let steppers = OpenLoopSteppers::new(motors, &energized, &inertia_diagonal(model, &energized))?;
-    // at rest, held: each stepper lags by the load angle that carries the weight
     let mut data = crate::dynamics::Data::new(model);
+    let load = crate::dynamics::gravity_forces(model, &mut data, &energized).to_vec();
+    let steppers = OpenLoopSteppers::new(motors, &energized, &inertia_diagonal(model, &energized), &load)?;
+    // at rest, held: each stepper lags by the load angle that carries the weight
     let mut sagged = energized.clone();
     for _ in 0..5 {
         let tau_g = crate::dynamics::gravity_forces(model, &mut data, &sagged).to_vec();
@@ -339,7 +351,7 @@ fn stepper_setup(config: &RunConfig, model: &mut Model, motors: &MotorSet, traje
     *start = sagged;
     model.notices.push(format!("stepper mode: the arm starts at rest, held by its steppers, each lagging by the load angle that carries its weight (at most {biggest:.2e} rad at a joint)"));
     if let PlantSpec::Discrete { substeps, .. } = *plant {
-        let needed = stepper_substeps(&steppers, model, start, config.dt);
+        let needed = stepper_substeps(&steppers, model, trajectory, start, config);
         if needed > substeps {
             let step_ms = config.dt / needed as f64 * 1e3;
             match config.time_step {
@@ -360,13 +372,31 @@ fn stepper_setup(config: &RunConfig, model: &mut Model, motors: &MotorSet, traje
 }
 
 /// Plant steps per control period that keep every stepper joint's oscillation about its stable
-/// position (stiffness η·N²·T_H·N_r against M_ii at `pose`) resolved: ω_n·h ≤ 0.2.
-fn stepper_substeps(steppers: &OpenLoopSteppers, model: &Model, pose: &[f64], dt: f64) -> usize {
-    let inertia = inertia_diagonal(model, pose);
+/// position (stiffness η·N²·T_H·N_r against M_ii) resolved, ω_n·h ≤ 0.2, and its explicit damping,
+/// h·c/I ≤ 0.2, over the poses the command passes (M_ii smallest there); and that let the field
+/// turn at most 1/32 of an electrical period (11°) per plant step at the command's top speed (a real driver
+/// steps continuously: bigger jumps ring the rotor in step with the plant).
+fn stepper_substeps(steppers: &OpenLoopSteppers, model: &Model, trajectory: &dyn Trajectory, pose: &[f64], config: &RunConfig) -> usize {
+    let n = model.dof();
+    let mut inertia = inertia_diagonal(model, pose);
+    let mut top_speed = vec![0.0f64; n];
+    let span = if config.freq > 0.0 { (std::f64::consts::TAU / config.freq).min(config.duration) } else { config.duration };
+    let (mut cmd, mut cmd_dot) = (vec![0.0; n], vec![0.0; n]);
+    for i in 0..=32 {
+        trajectory.sample(span * i as f64 / 32.0, &mut cmd, &mut cmd_dot);
+        let clamped: Vec<f64> = cmd.iter().zip(&model.joints).map(|(&c, j)| c.clamp(j.lower, j.upper)).collect();
+        for (m, x) in inertia.iter_mut().zip(inertia_diagonal(model, &clamped)) {
+            *m = m.min(x);
+        }
+        for (t, v) in top_speed.iter_mut().zip(&cmd_dot) {
+            *t = t.max(v.abs());
+        }
+    }
     let omega = steppers.stiffness().iter().map(|&(j, k)| (k / inertia[j]).sqrt()).fold(0.0, f64::max);
-    // the damping is explicit in the stepper's torque: h·c/I ≤ 0.2 as well
     let rate = steppers.damping().iter().map(|&(j, c)| c / inertia[j]).fold(0.0, f64::max);
-    ((omega.max(rate) * dt / 0.2).ceil() as usize).max(1)
+    let by_dynamics = omega.max(rate) * config.dt / 0.2;
+    let by_field = steppers.electrical_speed(&top_speed) * config.dt / (std::f64::consts::TAU / 32.0);
+    (by_dynamics.max(by_field).ceil() as usize).max(1)
 }
 
 /// The mass matrix's diagonal at `q` (each joint's inertia with the others held).

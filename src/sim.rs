@@ -38,11 +38,16 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
     let mut torque_limit = vec![0.0; n];
     // stepper mode: the open-loop steppers, their load angles and lost steps
     let mut steppers = experiment.open_loop_steppers();
+    // the step pulses advance once per plant step (the continuous plant takes the torque once per period)
+    let plant_step = match experiment.plant {
+        crate::experiment::PlantSpec::Discrete { time_step, .. } => time_step,
+        crate::experiment::PlantSpec::Continuous { .. } => dt,
+    };
     let (mut load_angle, mut lost_steps, mut lost_events) = (vec![0.0; n], vec![0i64; n], Vec::new());
     let (mut chatter, mut previous_u, mut previous_saturated) = (vec![false; n], vec![0.0; n], vec![false; n]);
     let mut at_limit = vec![false; n];
     let joint_names: Vec<String> = model.joints.iter().map(|j| j.name.clone()).collect();
-    let mut stats = SummaryBuilder::new(joint_names, controller.effort.clone(), dt, experiment.config.settle_time);
+    let mut stats = SummaryBuilder::new(joint_names, controller.effort.clone(), dt, experiment.config.settle_time).with_stepped_joints(experiment.stepped_joints());
     let started = Instant::now();
     let mut status = RunStatus::Completed;
     let mut audit = EnergyAudit::new(experiment);
@@ -107,9 +112,19 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
             a.remember(&v);
             a.potential_energy(model, &data)
         });
-        match steppers.as_ref() {
+        match steppers.as_mut() {
             // the stepper torque follows the rotor within the control period: at every plant step
-            Some(s) => plant.advance_driven(model, &mut data, &mut u, &mut |q, v, u| s.torques(q, v, u), &mut q, &mut v),
+            Some(s) => plant.advance_driven(
+                model,
+                &mut data,
+                &mut u,
+                &mut |q, v, u| {
+                    s.advance(plant_step);
+                    s.torques(q, v, u)
+                },
+                &mut q,
+                &mut v,
+            ),
             None => plant.advance(model, &mut data, &u, &mut q, &mut v),
         }
         if let Some(s) = steppers.as_mut() {

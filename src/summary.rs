@@ -51,6 +51,12 @@ pub struct Summary {
     /// the joint's fastest; the effort limit otherwise.
     #[serde(default)]
     pub lowest_torque_limit: Vec<f64>,
+    /// The largest share of the torque available at the joint's speed that the joint used, over the
+    /// control steps from `error_window_start` on (the start's catching up aside, as for the tracking
+    /// error): |τ| / limit (1 where the controller saturated); for an open-loop stepper, the share of
+    /// its pull-out torque its field gives, sin of the load angle (1 from 90° on).
+    #[serde(default)]
+    pub peak_torque_share: Vec<f64>,
     /// Stepper mode: full steps each joint lost over the run (0 where none, or not a stepper).
     #[serde(default)]
     pub lost_steps: Vec<u64>,
@@ -78,6 +84,8 @@ pub struct SummaryBuilder {
     peak_torque: Vec<f64>,
     effort: Vec<f64>,
     lowest_limit: Vec<f64>,
+    peak_share: Vec<f64>,
+    stepped: Vec<bool>,
     lost_steps: Vec<u64>,
     first_lost: Vec<Option<f64>>,
     limit_hits: Vec<u64>,
@@ -102,6 +110,8 @@ impl SummaryBuilder {
             control_steps: 0,
             peak_torque: vec![0.0; n],
             lowest_limit: effort.clone(),
+            peak_share: vec![0.0; n],
+            stepped: vec![false; n],
             lost_steps: vec![0; n],
             first_lost: vec![None; n],
             effort,
@@ -110,6 +120,12 @@ impl SummaryBuilder {
             tool_max: [f64::NEG_INFINITY; 3],
             last_t: 0.0,
         }
+    }
+
+    /// The joints driven by open-loop steppers (their torque share is their load angle's).
+    pub fn with_stepped_joints(mut self, stepped: Vec<bool>) -> Self {
+        self.stepped = stepped;
+        self
     }
 
     /// A stepper lost steps (stepper mode).
@@ -135,6 +151,16 @@ impl SummaryBuilder {
                 self.chatter_steps[i] += s.chatter[i] as u64;
                 self.peak_torque[i] = self.peak_torque[i].max(s.u[i].abs());
                 self.lowest_limit[i] = self.lowest_limit[i].min(s.torque_limit[i]);
+                let share = if s.k < self.first_window_step {
+                    0.0
+                } else if self.stepped[i] {
+                    s.load_angle[i].abs().min(90.0).to_radians().sin()
+                } else if s.torque_limit[i] > 0.0 {
+                    s.u[i].abs() / s.torque_limit[i]
+                } else {
+                    0.0
+                };
+                self.peak_share[i] = self.peak_share[i].max(share);
             }
         }
         for i in 0..n {
@@ -171,6 +197,7 @@ impl SummaryBuilder {
             peak_abs_torque: self.peak_torque.clone(),
             effort_limit: self.effort.clone(),
             lowest_torque_limit: self.lowest_limit.clone(),
+            peak_torque_share: self.peak_share.clone(),
             lost_steps: self.lost_steps.clone(),
             first_lost_step_time: self.first_lost.clone(),
             limit_hits: self.limit_hits.clone(),

@@ -217,3 +217,25 @@ fn the_so100_runs_on_its_sts3215_servos() {
         assert!(summary.chatter_percent[j] < 5.0, "{}: chatter {}", summary.joints[j], summary.chatter_percent[j]);
     }
 }
+
+/// A DC servo gives its line T_s·(1 − |ω|/ω₀) with the motion but brakes with its stall torque
+/// against it (Isaac Lab's DCMotor, clipped at the stall torque): pushed past its no-load speed it
+/// still holds back instead of giving nothing. A stepper's pull-out curve holds both ways.
+#[test]
+fn a_servo_brakes_with_its_stall_torque_and_a_stepper_is_symmetric() {
+    let catalogue = Catalogue::load(&motors_file("catalogue.toml")).unwrap();
+    let servo = catalogue.drive_train("STS3215-C018").unwrap().unwrap(); // 2.94 N·m, 4.71 rad/s
+    let (lowest, highest) = servo.torque_range(2.355);
+    assert!((highest - 1.47).abs() < 1e-9, "half the no-load speed: half the stall torque with the motion, got {highest}");
+    assert!((lowest + 2.94).abs() < 1e-12, "braking: the stall torque, got {lowest}");
+    let (lowest, highest) = servo.torque_range(-10.0);
+    assert_eq!((lowest, highest), (0.0, 2.94), "past the no-load speed backwards: nothing with the motion, all of it against");
+    assert_eq!(servo.available(1.0, 10.0), 0.0, "with the motion past the no-load speed: nothing");
+    assert_eq!(servo.available(-1.0, 10.0), 2.94, "against it: the stall torque");
+    let stepper = catalogue.drive_train("17HS4401").unwrap().unwrap().followed_by(10.0, 0.9, f64::INFINITY);
+    for speed in [0.0, 3.0, -3.0, 40.0] {
+        let (lowest, highest) = stepper.torque_range(speed);
+        assert_eq!(-lowest, highest);
+        assert_eq!(highest, stepper.torque_limit(speed));
+    }
+}

@@ -107,7 +107,8 @@ fn demand_over_supply(experiment: &Experiment) -> Vec<f64> {
 /// `--freq 3` J2, whose demand reaches 85 % of its curve, loses steps — already below 100 %: the
 /// rotor rings about its mean load angle whenever the motion's acceleration changes, which is why
 /// steppers are sized with ~30 % headroom — and the joints that need less than half their torque
-/// lose none.
+/// lose none of their own accord (after seconds of J2 slipping and the arm swinging off its command,
+/// J3 and J4 can be dragged out of step too).
 #[test]
 fn a_slow_wave_within_the_pull_out_curve_loses_nothing_a_fast_one_loses_steps_where_demand_exceeds_it() {
     let slow = Experiment::prepare(config("tutorial.toml", |c| c.duration = 10.0)).unwrap();
@@ -128,7 +129,12 @@ fn a_slow_wave_within_the_pull_out_curve_loses_nothing_a_fast_one_loses_steps_wh
             assert!(summary.lost_steps[j] > 0, "J{} needs {:.2}× its curve and loses nothing", j + 1, ratio[j]);
         }
         if ratio[j] < 0.5 {
-            assert_eq!(summary.lost_steps[j], 0, "J{} needs only {:.2}× its curve", j + 1, ratio[j]);
+            // a joint within its curve loses nothing of its own accord: only once J2 slips and the
+            // arm swings off its command can it be dragged out of step
+            if let Some(t) = summary.first_lost_step_time[j] {
+                let j2 = summary.first_lost_step_time[1].expect("J2 slips");
+                assert!(t > j2 + 1.0, "J{} needs only {:.2}× its curve yet lost steps at {t} s, J2 first at {j2} s", j + 1, ratio[j]);
+            }
         }
     }
     assert!(ratio[1] > 0.8 && ratio.iter().enumerate().all(|(j, &r)| j == 1 || r < 0.5), "{ratio:?}");

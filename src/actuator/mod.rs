@@ -18,8 +18,14 @@ use std::fmt::Debug;
 
 /// A motor at its own shaft.
 pub trait Motor: Debug + Send + Sync {
-    /// The largest torque (N·m, ≥ 0) it can give at shaft speed `speed` (rad/s, either sign).
+    /// The largest torque (N·m, ≥ 0) it can give at shaft speed `speed` (rad/s, either sign) in the
+    /// direction it turns (motoring).
     fn torque_at(&self, speed: f64) -> f64;
+    /// The largest torque against the direction it turns (braking); as motoring unless the kind
+    /// knows better (a DC motor brakes with at least its stall torque).
+    fn braking_torque_at(&self, speed: f64) -> f64 {
+        self.torque_at(speed)
+    }
     /// Rotor inertia, kg·m².
     fn rotor_inertia(&self) -> f64;
     /// The catalogue name.
@@ -44,9 +50,25 @@ pub struct DriveTrain {
 }
 
 impl DriveTrain {
-    /// Torque available at the joint at joint speed `speed`: min(η·N·T_motor(N·speed), rated).
+    /// Torque available at the joint at joint speed `speed`, driving with the motion (the smaller of
+    /// the two directions): min(η·N·T_motor(N·speed), rated).
     pub fn torque_limit(&self, speed: f64) -> f64 {
         (self.efficiency * self.gear_ratio * self.motor.torque_at(self.gear_ratio * speed)).min(self.rated_torque)
+    }
+
+    /// The range of torque the joint can get at joint speed `speed`: (lowest ≤ 0, highest ≥ 0). With
+    /// the motion the motor's torque–speed curve holds; against it (braking) the motor's braking torque.
+    pub fn torque_range(&self, speed: f64) -> (f64, f64) {
+        let at_joint = |t: f64| (self.efficiency * self.gear_ratio * t).min(self.rated_torque);
+        let motoring = at_joint(self.motor.torque_at(self.gear_ratio * speed));
+        let braking = at_joint(self.motor.braking_torque_at(self.gear_ratio * speed));
+        if speed >= 0.0 { (-braking, motoring) } else { (-motoring, braking) }
+    }
+
+    /// The torque available in the direction of `torque` at joint speed `speed` (≥ 0).
+    pub fn available(&self, torque: f64, speed: f64) -> f64 {
+        let (lowest, highest) = self.torque_range(speed);
+        if torque >= 0.0 { highest } else { -lowest }
     }
 
     /// This drive train followed by a further reduction (a belt or gearbox after a gearmotor): the
@@ -124,13 +146,4 @@ impl MotorSet {
         self.joints.iter().flatten().any(|d| d.motor.as_stepper().is_some())
     }
 
-    /// Each joint's torque limit at joint speeds `v`, into `out`; `effort` where no drive train is set.
-    pub fn torque_limits(&self, v: &[f64], effort: &[f64], out: &mut [f64]) {
-        for i in 0..out.len() {
-            out[i] = match &self.joints[i] {
-                Some(d) => d.torque_limit(v[i]),
-                None => effort[i],
-            };
-        }
-    }
 }

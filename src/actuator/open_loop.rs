@@ -6,13 +6,15 @@
 //! N_r = 90°/step angle (50 for 1.8°: an electrical period is 4 full steps), T(ω) the pull-out curve at
 //! the rotor's speed. At the joint that is η·N·T·sin(N_r·Δ), capped by the gearbox's rating. When the lag
 //! passes 2 full steps the rotor falls into the next stable position, 4 full steps away: those steps are
-//! lost, and, open loop, the arm keeps that offset. The torque is evaluated at the plant rate.
+//! lost, and, open loop, the arm keeps that offset. The torque is evaluated at the plant rate. The
+//! rotor's electrical damping adds to it, the total never more than the motor gives at its speed.
 //!
 //! The driver's step generator, as AccelStepper and the arm's firmware do, follows the command with
 //! a bounded acceleration (a stepper cannot start at full speed): its velocity moves toward
 //! cmd_dot + K·(cmd − position), K = 50/s, by at most `acceleration`·dt per control period (motor file
-//! field `acceleration`, rad/s² at the joint; by default half of what the motor gives at rest against
-//! the joint's inertia at the start pose). Once caught up on a smooth command it follows it exactly.
+//! field `acceleration`, rad/s² at the joint; by default half of what the motor has at rest beyond the
+//! weight it carries at the start pose, against the joint's inertia there). Once caught up on a smooth
+//! command it follows it exactly.
 
 use super::{DriveTrain, MotorSet, Stepper};
 use std::f64::consts::PI;
@@ -52,7 +54,10 @@ impl SteppedJoint {
         // slip speed, the field turning at the step generator's speed (the drive holds the current,
         // so there is no drag on the speed itself: that is the pull-out curve's part)
         let damping = self.stepper.damping * self.gear_ratio * self.gear_ratio * (self.generator_velocity - v);
-        (pull + damping).clamp(-self.rated_torque, self.rated_torque)
+        // the drive limits the phase current: field and damping together give at most what the
+        // motor gives at this speed (through the gearbox, capped by its rating)
+        let most = (self.efficiency * self.gear_ratio * available).min(self.rated_torque);
+        (pull + damping).clamp(-most, most)
     }
 }
 
@@ -74,8 +79,9 @@ pub struct LostSteps {
 
 impl OpenLoopSteppers {
     /// The stepper joints of `motors` with their microsteps, their step generators' acceleration
-    /// bounds (`inertia`: M_ii at the start pose, for the default); None when there are none.
-    pub fn new(motors: &MotorSet, start: &[f64], inertia: &[f64]) -> Option<Self> {
+    /// bounds (the default from `inertia`, M_ii at the start pose, and `load`, the torque gravity
+    /// asks of each joint there); None when there are none.
+    pub fn new(motors: &MotorSet, start: &[f64], inertia: &[f64], load: &[f64]) -> Option<Self> {
         let mut joints = Vec::new();
         for (j, drive) in motors.joints.iter().enumerate() {
             let Some(DriveTrain { motor, gear_ratio, efficiency, rated_torque }) = drive else { continue };
@@ -92,7 +98,13 @@ impl OpenLoopSteppers {
                 start: start[j],
                 generator_position: 0.0,
                 generator_velocity: 0.0,
-                max_acceleration: motors.acceleration.get(j).copied().flatten().unwrap_or(0.5 * efficiency * gear_ratio * stepper.holding_torque / inertia[j]),
+                max_acceleration: motors.acceleration.get(j).copied().flatten().unwrap_or_else(|| {
+                    // half of what the motor has to spare beyond carrying the weight (at least a tenth
+                    // of its torque): a generator that accelerates with the whole holding torque
+                    // leaves a loaded joint nothing to hold it with
+                    let at_rest = (efficiency * gear_ratio * stepper.holding_torque).min(*rated_torque);
+                    0.5 * (at_rest - load[j].abs()).max(0.2 * at_rest) / inertia[j]
+                }),
                 command: 0.0,
                 lost_steps: 0,
             });
@@ -107,8 +119,8 @@ impl OpenLoopSteppers {
         Some(Self { joints, stepped })
     }
 
-    /// The driver's step pulses for this control period: the step generator moves toward the
-    /// command with bounded acceleration; its position in whole microsteps is the motor's command.
+    /// The driver's step generator for this control period: its velocity moves toward the command
+    /// with bounded acceleration and holds for the period; [`Self::advance`] then emits the pulses.
     pub fn set_command(&mut self, cmd: &[f64], cmd_dot: &[f64], dt: f64) {
         const CATCH_UP: f64 = 50.0;
         for s in &mut self.joints {
@@ -116,8 +128,18 @@ impl OpenLoopSteppers {
             let wanted = cmd_dot[s.joint] + CATCH_UP * error;
             let bound = s.max_acceleration * dt;
             s.generator_velocity += (wanted - s.generator_velocity).clamp(-bound, bound);
-            s.generator_position += s.generator_velocity * dt;
-            s.command = (s.gear_ratio * s.generator_position / s.microstep).round() * s.microstep;
+        }
+    }
+
+    /// The step pulses over the next `h` seconds of the period (one plant step): the motor's command
+    /// is the generator's position at the middle of that step in whole microsteps. A real driver
+    /// steps continuously (27 microsteps per millisecond at 4 rev/s and 32 microsteps): a command
+    /// moved only at the control rate would kick the rotor by a whole period's steps at once.
+    pub fn advance(&mut self, h: f64) {
+        for s in &mut self.joints {
+            let middle = s.generator_position + 0.5 * s.generator_velocity * h;
+            s.command = (s.gear_ratio * middle / s.microstep).round() * s.microstep;
+            s.generator_position += s.generator_velocity * h;
         }
     }
 
@@ -168,6 +190,11 @@ impl OpenLoopSteppers {
         for s in &self.joints {
             out[s.joint] = s.lost_steps;
         }
+    }
+
+    /// The fastest any stepper's field turns, electrical rad/s, at joint speeds `speeds`: N_r·N·|q̇|.
+    pub fn electrical_speed(&self, speeds: &[f64]) -> f64 {
+        self.joints.iter().map(|s| s.teeth * s.gear_ratio * speeds[s.joint].abs()).fold(0.0, f64::max)
     }
 
     /// The electrical damping of each stepper joint at the joint, N²·c (N·m·s/rad).

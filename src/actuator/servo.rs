@@ -1,6 +1,8 @@
 //! A DC motor or hobby servo: a linear torque–speed line from the stall torque at rest to zero at
 //! the no-load speed, T(ω) = T_stall·(1 − |ω|/ω₀), clamped at 0 (Isaac Lab's `DCMotor`, Newton's
-//! `ClampingDCMotor`; MuJoCo's `dcmotor` without inductance).
+//! `ClampingDCMotor`; MuJoCo's `dcmotor` without inductance). Against the motion the back-EMF adds
+//! to the drive voltage: the line gives T_stall·(1 + |ω|/ω₀), held to the stall torque (Isaac Lab
+//! clips it to the effort limit) — a servo pushed past its no-load speed still brakes.
 
 use super::Motor;
 
@@ -17,6 +19,10 @@ pub struct DcServo {
 impl Motor for DcServo {
     fn torque_at(&self, speed: f64) -> f64 {
         (self.stall_torque * (1.0 - speed.abs() / self.no_load_speed)).max(0.0)
+    }
+
+    fn braking_torque_at(&self, _speed: f64) -> f64 {
+        self.stall_torque
     }
 
     fn rotor_inertia(&self) -> f64 {

@@ -71,6 +71,9 @@ pub struct RunArgs {
     /// The link whose origin is the tool tip (default: the deepest leaf link).
     #[arg(long, value_name = "LINK")]
     pub tool: Option<String>,
+    /// A payload at the tool tip, kg (a point mass at the tool link's origin).
+    #[arg(long, value_name = "KG", default_value_t = defaults().payload)]
+    pub payload: f64,
     /// Tracking error statistics cover every step with t ≥ this, s.
     #[arg(long, value_name = "SECONDS", default_value_t = defaults().settle_time)]
     pub settle_time: f64,
@@ -173,6 +176,9 @@ pub fn default_run_name(config: &RunConfig) -> String {
     if config.dt != d.dt {
         parts.push(format!("dt{}", config.dt));
     }
+    if config.payload != d.payload {
+        parts.push(format!("payload{}", config.payload));
+    }
     if config.duration != d.duration {
         parts.push(format!("{}s", config.duration));
     }
@@ -206,6 +212,7 @@ impl RunArgs {
             trajectory: self.trajectory.clone(),
             debug: self.debug,
             tool: self.tool.clone(),
+            payload: self.payload,
             settle_time: self.settle_time,
             divergence_speed: self.divergence_speed,
             strict_inertia: self.strict_inertia,

@@ -2,7 +2,8 @@
 //! motors' limits.
 
 /// u = kp∘(cmd − q) + kd∘(cmd_dot − q̇) − τ_g(q), clipped to ±effort (with `--motors`, to what the
-/// motor gives at the joint's speed through its gearbox); zero on unactuated joints.
+/// motor gives at the joint's speed through its gearbox, with the motion or braking); zero on
+/// unactuated joints.
 #[derive(Clone, Debug)]
 pub struct PdGravityController {
     pub kp: Vec<f64>,
@@ -22,7 +23,8 @@ pub struct ControlOutput<'a> {
     pub u: &'a mut [f64],
     /// Whether the unclipped torque exceeded the limit.
     pub saturated: &'a mut [bool],
-    /// The limit at this step (the motor's torque at the joint's speed, through its gearbox).
+    /// The limit at this step in the direction of the torque asked for (the motor's torque at the
+    /// joint's speed through its gearbox: with the motion, or braking against it).
     pub limit: &'a mut [f64],
 }
 
@@ -35,10 +37,6 @@ impl PdGravityController {
 
     #[allow(clippy::too_many_arguments)]
     pub fn compute(&self, q: &[f64], v: &[f64], cmd: &[f64], cmd_dot: &[f64], tau_g: &[f64], out: ControlOutput) {
-        match &self.motors {
-            Some(m) => m.torque_limits(v, &self.effort, out.limit),
-            None => out.limit.copy_from_slice(&self.effort),
-        }
         for i in 0..q.len() {
             if !self.actuated[i] {
                 out.u[i] = 0.0;
@@ -50,9 +48,13 @@ impl PdGravityController {
             if self.feed_forward {
                 u -= tau_g[i];
             }
-            let limit = out.limit[i];
-            out.saturated[i] = u.abs() > limit;
-            out.u[i] = u.clamp(-limit, limit);
+            let (lowest, highest) = match self.motors.as_ref().and_then(|m| m.joints[i].as_ref()) {
+                Some(drive) => drive.torque_range(v[i]),
+                None => (-self.effort[i], self.effort[i]),
+            };
+            out.saturated[i] = u > highest || u < lowest;
+            out.u[i] = u.clamp(lowest, highest);
+            out.limit[i] = if u >= 0.0 { highest } else { -lowest };
         }
     }
 }

@@ -55,22 +55,37 @@ pub fn with_payload(mut model: Model, kg: f64) -> Model {
 
 /// Peak |τ| per joint to follow `trajectory` exactly for `duration` seconds.
 pub fn required_torque(model: &Model, trajectory: &dyn Trajectory, duration: f64, dt: f64) -> Vec<f64> {
-    need(model, trajectory, duration, dt, &|_, _| 1.0).0
+    need(model, trajectory, duration, dt, &|_, _, _| 1.0).0
 }
 
-/// Per joint: the peak |τ| and the largest |τ(t)| / limit(joint, q̇(t)) along the exact motion.
-pub fn need(model: &Model, trajectory: &dyn Trajectory, duration: f64, dt: f64, limit: &dyn Fn(usize, f64) -> f64) -> (Vec<f64>, Vec<f64>) {
+/// Per joint: the peak |τ| and the largest |τ(t)| / limit(joint, τ(t), q̇(t)) along the exact motion
+/// (the limit in the direction of the torque, at the speed).
+pub fn need(model: &Model, trajectory: &dyn Trajectory, duration: f64, dt: f64, limit: &dyn Fn(usize, f64, f64) -> f64) -> (Vec<f64>, Vec<f64>) {
     let n = model.dof();
-    let mut demand = vec![0.0f64; n];
+    let (mut peak, mut demand) = (vec![0.0f64; n], vec![0.0f64; n]);
+    along_commanded_motion(model, trajectory, duration, dt, |_, qd, _, tau| {
+        for j in 0..n {
+            let torque = tau[j].abs();
+            peak[j] = peak[j].max(torque);
+            let available = limit(j, tau[j], qd[j]);
+            demand[j] = demand[j].max(if available > 0.0 { torque / available } else if torque > 0.0 { f64::INFINITY } else { 0.0 });
+        }
+    });
+    (peak, demand)
+}
+
+/// Walk the commanded motion every `dt` from 0 to `duration`: `visit(t, q̇, q̈, τ)` with τ the
+/// inverse dynamics of following it exactly (RNEA plus the joints' damping) — what a perfect
+/// controller must supply. q̈ is the central difference of the commanded velocity.
+pub fn along_commanded_motion(model: &Model, trajectory: &dyn Trajectory, duration: f64, dt: f64, mut visit: impl FnMut(f64, &[f64], &[f64], &[f64])) {
+    let n = model.dof();
     let mut data = Data::new(model);
     let (mut q, mut qd, mut qdd) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
-    let (mut qd_after, mut qd_before) = (vec![0.0; n], vec![0.0; n]);
-    let mut peak = vec![0.0f64; n];
+    let (mut qd_after, mut qd_before, mut torque) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
     let eps = 1e-5;
     let steps = (duration / dt).ceil() as usize;
     for k in 0..=steps {
         let t = k as f64 * dt;
-        // the acceleration by central differences of the commanded velocity
         trajectory.sample(t + eps, &mut q, &mut qd_after);
         trajectory.sample(t - eps, &mut q, &mut qd_before);
         for j in 0..n {
@@ -79,13 +94,10 @@ pub fn need(model: &Model, trajectory: &dyn Trajectory, duration: f64, dt: f64, 
         trajectory.sample(t, &mut q, &mut qd);
         let tau = rnea(model, &mut data, &q, &qd, &qdd);
         for j in 0..n {
-            let torque = (tau[j] + model.joints[j].damping * qd[j]).abs();
-            peak[j] = peak[j].max(torque);
-            let available = limit(j, qd[j]);
-            demand[j] = demand[j].max(if available > 0.0 { torque / available } else if torque > 0.0 { f64::INFINITY } else { 0.0 });
+            torque[j] = tau[j] + model.joints[j].damping * qd[j];
         }
+        visit(t, &qd, &qdd, &torque);
     }
-    (peak, demand)
 }
 
 /// Sweep the grid. `base` supplies the gains and everything else; `model` carries the payload
@@ -99,8 +111,8 @@ pub fn sweep(base: &RunConfig, model: &Model, freqs: &[f64], amps_deg: &[f64], p
     // the model as the runs see it (with `--motors`, their rotors in M) and the limit at a speed
     let dynamics_model = first.model.clone();
     let motors = first.motors.clone();
-    let limit = |j: usize, speed: f64| match motors.as_ref().and_then(|m| m.joints[j].as_ref()) {
-        Some(drive) => drive.torque_limit(speed),
+    let limit = |j: usize, torque: f64, speed: f64| match motors.as_ref().and_then(|m| m.joints[j].as_ref()) {
+        Some(drive) => drive.available(torque, speed),
         None => effort[j],
     };
     let cells: Result<Vec<Cell>, Error> = pool.install(|| {

@@ -114,6 +114,7 @@ fn motors(c: &mut Criterion) {
         let mut plant = experiment.make_plant();
         let controller = experiment.controller();
         let mut steppers = experiment.open_loop_steppers();
+        let plant_step = 0.001; // time_step above
         let (q0, v0, _) = state();
         let (cmd, cmd_dot) = (vec![0.1; 6], vec![0.2; 6]);
         let (mut u, mut sat, mut limit) = (vec![0.0; 6], vec![false; 6], vec![0.0; 6]);
@@ -127,8 +128,17 @@ fn motors(c: &mut Criterion) {
                     match steppers.as_mut() {
                         Some(s) => {
                             s.set_command(&cmd, &cmd_dot, 0.001);
-                            let s: &armscope::actuator::OpenLoopSteppers = s;
-                            plant.advance_driven(model, &mut data, &mut u, &mut |q, v, u| s.torques(q, v, u), q, v);
+                            plant.advance_driven(
+                                model,
+                                &mut data,
+                                &mut u,
+                                &mut |q, v, u| {
+                                    s.advance(plant_step);
+                                    s.torques(q, v, u)
+                                },
+                                q,
+                                v,
+                            );
                         }
                         None => plant.advance(model, &mut data, &u, q, v),
                     }
