@@ -69,6 +69,11 @@ impl Catalogue {
         self.entries.get(name).map(|t| drive_train_from(&self.source, name, t))
     }
 
+    /// The motor's mass in kg, if the catalogue gives it.
+    pub fn mass(&self, name: &str) -> Option<f64> {
+        self.entries.get(name)?.get("mass").and_then(|v| v.as_float().or(v.as_integer().map(|i| i as f64)))
+    }
+
     /// The catalogue's motor names, for messages.
     pub fn names(&self) -> String {
         self.entries.keys().cloned().collect::<Vec<_>>().join(", ")

@@ -10,5 +10,5 @@ mod table;
 pub use compare::{ComparedRun, build_comparison};
 pub use manifest::{Manifest, PlannedExperiment, load_manifest, parse_shard, shard};
 pub use outcome::ExperimentOutcome;
-pub use runner::{BatchOptions, run_batch, write_comparison};
+pub use runner::{BatchOptions, run_args, run_batch, write_comparison};
 pub use table::{BatchSummary, merge_summaries, write_tables};

@@ -43,15 +43,21 @@ fn run_one(e: &PlannedExperiment, dir: &Path, stop: Option<&AtomicBool>) -> Expe
     outcome
 }
 
+/// A manifest experiment's `run` flags, parsed as `armscope run` parses them; the error is clap's
+/// first line.
+pub fn run_args(e: &PlannedExperiment) -> Result<RunArgs, String> {
+    let argv = std::iter::once("run".to_string()).chain(e.args.iter().cloned());
+    RunFlags::try_parse_from(argv).map(|f| f.args).map_err(|err| {
+        let text = err.render().to_string();
+        text.lines().next().unwrap_or("invalid flags").trim_start_matches("error: ").to_string()
+    })
+}
+
 fn run_timed(e: &PlannedExperiment, dir: &Path, stop: Option<&AtomicBool>) -> ExperimentOutcome {
     let failed = |error: String| ExperimentOutcome { index: e.index, name: e.name.clone(), args: e.args.clone(), status: "failed".into(), summary: None, error: Some(error), wall_time: 0.0 };
-    let argv = std::iter::once("run".to_string()).chain(e.args.iter().cloned());
-    let flags = match RunFlags::try_parse_from(argv) {
-        Ok(f) => f.args,
-        Err(err) => {
-            let text = err.render().to_string();
-            return failed(text.lines().next().unwrap_or("invalid flags").trim_start_matches("error: ").to_string());
-        }
+    let flags = match run_args(e) {
+        Ok(args) => args,
+        Err(message) => return failed(message),
     };
     let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| -> Result<Summary, Error> {
         let experiment = Experiment::prepare(flags.config())?;

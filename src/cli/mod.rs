@@ -6,6 +6,7 @@ mod compare;
 mod envelope;
 mod model;
 mod run;
+mod size;
 mod trajectory;
 
 pub use analyze::{AnalyzeArgs, analyze};
@@ -14,6 +15,7 @@ pub use compare::{CompareArgs, compare};
 pub use envelope::{EnvelopeArgs, envelope};
 pub use model::{ModelArgs, model};
 pub use run::{RunArgs, default_run_name, run};
+pub use size::{SizeArgs, parse_ratios, size};
 pub use trajectory::{TrajectoryArgs, trajectory};
 
 use crate::config::{IntegratorKind, RunConfig};
@@ -51,6 +53,9 @@ pub enum Command {
     /// What armscope made of a URDF: joints, limits, motors, notices; with --states, the dynamics
     /// (M, τ_g, C·v, q̈, link poses) at given states as JSON, to compare with other libraries.
     Model(ModelArgs),
+    /// Which motor and which gear ratio per joint for a motion: ranks a catalogue over a range of
+    /// ratios, verifies the choice in simulation, writes a motor file for `run --motors`.
+    Size(SizeArgs),
 }
 
 /// Parse `args` and run; returns the process exit code. Errors are printed as one line.
@@ -91,6 +96,7 @@ fn run_command(command: Command) -> Result<i32, Error> {
         Command::Analyze(args) => analyze(&args),
         Command::Envelope(args) => envelope(&args),
         Command::Model(args) => model(&args),
+        Command::Size(args) => size(&args),
     }
 }
 

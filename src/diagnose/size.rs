@@ -1,0 +1,472 @@
+//! Motor sizing: for each joint, which motor of a catalogue and which gear ratio carry a motion.
+//!
+//! A larger ratio N multiplies the torque (η·N·T) but divides the top speed (the motor turns N·q̇)
+//! and multiplies the rotor's inertia seen at the joint (J_r·N²). The sweep rates every (motor,
+//! ratio) of every joint on the commanded motion first, cheaply and exactly: the inverse dynamics of
+//! the motion give each joint's torque τ(t) without any rotor; a candidate adds its own J_r·N²·q̈ (the
+//! reflected inertia sits on M's diagonal, so a joint's rotor changes only its own torque) and must
+//! give, with the margin m on torque and on speed,
+//!
+//!   (1 + m)·|τ(t) + J_r·N²·q̈(t)| ≤ min(η·N·T_motor(N·(1 + m)·|q̇(t)|), gearbox rating)   at every t.
+//!
+//! The feasible candidates are ranked: the lightest motor, then the smallest ratio that keeps the
+//! margin on torque and on speed. A larger ratio would only add speed and reflected inertia and
+//! spend the speed a faster motion needs; and "the ratio with the most margin" is not monotone — on
+//! the box model's J4 it climbs from 32 to 50 as the wave slows from 1.2 to 0.3 rad/s, recommending a
+//! stronger drive for a gentler motion — while the smallest sufficient ratio never falls with a
+//! heavier payload and never rises with a slower motion. Only the best and the runner-up of each joint
+//! are simulated (stepper mode, or PD on servos), all joints with their motors at once, in parallel;
+//! a joint whose choice loses steps or uses more than 1/(1 + m) of its torque in the full simulation
+//! moves on to its next candidate with more torque to spare, until the whole set passes.
+
+use crate::actuator::{Catalogue, DriveTrain, MotorSet};
+use crate::config::RunConfig;
+use crate::diagnose::envelope::along_commanded_motion;
+use crate::error::Error;
+use crate::experiment::Experiment;
+use crate::model::Model;
+use rayon::prelude::*;
+use serde::Serialize;
+
+/// What to size for.
+pub struct SizeRequest {
+    /// The motion: one or more experiments (name, config); every one must pass.
+    pub motions: Vec<(String, RunConfig)>,
+    /// The model as loaded (each motion's config adds its tool, payload, gravity switch).
+    pub model: Model,
+    /// The payload the motions carry, kg (for the report).
+    pub payload_kg: f64,
+    pub catalogue: Catalogue,
+    /// Candidate motors (catalogue names with a mass).
+    pub motors: Vec<String>,
+    /// Per coordinate: the ratios to try after the motor (and after a gearmotor's own gearbox).
+    pub ratios: Vec<Vec<f64>>,
+    /// Headroom on torque and on speed: 0.3 asks for 30 % more than the motion needs.
+    pub margin: f64,
+    /// Efficiency of the reduction the sweep chooses (1 at ratio 1: a direct drive).
+    pub efficiency: f64,
+    pub microsteps: u32,
+    /// Simulations at once.
+    pub jobs: usize,
+}
+
+/// Why a candidate cannot carry the motion, at the instant where it falls shortest.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+#[serde(tag = "reason", rename_all = "snake_case")]
+pub enum Shortfall {
+    /// Not enough torque even where the motor gives its full torque (low speed).
+    Torque { t: f64, need: f64, available: f64 },
+    /// The motor's torque has fallen with speed (pull-out curve, servo line): too fast for this ratio.
+    Speed { t: f64, motor_rev_s: f64, need: f64, available: f64 },
+    /// The gearbox's rated output torque is the limit.
+    Gearbox { t: f64, need: f64, rated: f64 },
+    /// Without its own rotor's J_r·N² the motion would fit: the reflected inertia breaks it.
+    ReflectedInertia { t: f64, reflected: f64, need: f64, available: f64 },
+}
+
+impl Shortfall {
+    pub fn describe(&self) -> String {
+        match self {
+            Shortfall::Torque { t, need, available } => format!("torque at low speed: needs {need:.2} N·m with the margin at t = {t:.2} s, gets {available:.2}"),
+            Shortfall::Speed { t, motor_rev_s, need, available } => {
+                format!("speed: at {motor_rev_s:.1} rev/s (with the margin) the motor's torque has fallen, {available:.2} N·m for {need:.2} needed at t = {t:.2} s")
+            }
+            Shortfall::Gearbox { t, need, rated } => format!("gearbox rating: {need:.2} N·m needed at t = {t:.2} s, rated {rated:.2}"),
+            Shortfall::ReflectedInertia { t, reflected, need, available } => {
+                format!("reflected inertia: the rotor's J_r·N² = {reflected:.3} kg·m² raises the need to {need:.2} N·m at t = {t:.2} s, gets {available:.2}")
+            }
+        }
+    }
+}
+
+/// One (motor, ratio) for one joint, rated on the commanded motion.
+#[derive(Clone, Debug, Serialize)]
+pub struct Candidate {
+    pub motor: String,
+    pub mass_kg: f64,
+    /// The ratio chosen after the motor.
+    pub ratio: f64,
+    /// Motor to joint, a gearmotor's own gearbox included.
+    pub total_ratio: f64,
+    /// The torque the joint gets at rest, N·m.
+    pub torque_at_rest: f64,
+    /// max over the motion of (1 + m)·need / available at (1 + m)·speed: ≤ 1 is feasible.
+    pub share: f64,
+    /// Torque to spare: min over the motion of available / need at its speed (×).
+    pub torque_headroom: f64,
+    /// Speed to spare: the joint speed at which the drive's torque has fallen to half, over the
+    /// motion's top speed (×).
+    pub speed_headroom: f64,
+    pub shortfall: Option<Shortfall>,
+}
+
+impl Candidate {
+    pub fn feasible(&self) -> bool {
+        self.share <= 1.0
+    }
+
+}
+
+/// A candidate in the full simulation.
+#[derive(Clone, Debug, Serialize)]
+pub struct SimulatedCheck {
+    pub candidate: usize,
+    pub lost_steps: u64,
+    /// Largest share of the torque available at its speed that the joint used.
+    pub peak_torque_share: f64,
+    pub passed: bool,
+    /// Why it did not pass (the run diverged, or lost steps, or used more than the margin allows).
+    pub note: Option<String>,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct JointSizing {
+    pub joint: String,
+    /// Every candidate, motor by motor (lightest first), each motor's ratios in order.
+    pub candidates: Vec<Candidate>,
+    /// The feasible candidates, best first.
+    pub ranked: Vec<usize>,
+    pub chosen: Option<usize>,
+    pub runner_up: Option<usize>,
+    /// The candidates simulated, in the order tried.
+    pub simulated: Vec<SimulatedCheck>,
+    /// The rejected candidates nearest the choice: the same motor one ratio below and above the
+    /// feasible band, and the next lighter motor at its best ratio.
+    pub nearest_rejected: Vec<usize>,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct SizeReport {
+    pub model: String,
+    pub motions: Vec<String>,
+    pub payload_kg: f64,
+    pub margin: f64,
+    pub efficiency: f64,
+    pub microsteps: u32,
+    pub motors: Vec<String>,
+    pub joints: Vec<JointSizing>,
+    /// Simulation rounds until the chosen set passed together.
+    pub rounds: usize,
+    /// The chosen set passed its full simulation on every motion.
+    pub verified: bool,
+    pub simulations: usize,
+}
+
+/// The commanded motion of every experiment, per joint: speed, acceleration and the torque without
+/// any rotor (the rotor's share differs per candidate).
+struct Motion {
+    t: Vec<f64>,
+    speed: Vec<Vec<f64>>,
+    acceleration: Vec<Vec<f64>>,
+    torque: Vec<Vec<f64>>,
+}
+
+fn commanded_motion(request: &SizeRequest) -> Result<Motion, Error> {
+    let n = request.model.dof();
+    let mut motion = Motion { t: Vec::new(), speed: vec![Vec::new(); n], acceleration: vec![Vec::new(); n], torque: vec![Vec::new(); n] };
+    for (_, config) in &request.motions {
+        let experiment = Experiment::with_model(RunConfig { motors: None, ..config.clone() }, request.model.clone())?;
+        let mut model = (*experiment.model).clone();
+        model.armature = vec![0.0; n];
+        let dt = config.dt;
+        along_commanded_motion(&model, experiment.trajectory.as_ref(), config.duration, dt, |t, qd, qdd, tau| {
+            motion.t.push(t);
+            for j in 0..n {
+                motion.speed[j].push(qd[j]);
+                motion.acceleration[j].push(qdd[j]);
+                motion.torque[j].push(tau[j]);
+            }
+        });
+    }
+    Ok(motion)
+}
+
+/// The drive train of `motor` behind `ratio` at efficiency `efficiency` (1 for ratio 1).
+pub fn drive_train(catalogue: &Catalogue, motor: &str, ratio: f64, efficiency: f64) -> Result<DriveTrain, Error> {
+    let own = catalogue.drive_train(motor).ok_or_else(|| Error::flag("--candidates", format!("no motor '{motor}' in {} (known: {})", catalogue.source.display(), catalogue.names())))??;
+    Ok(own.followed_by(ratio, if ratio == 1.0 { 1.0 } else { efficiency }, f64::INFINITY))
+}
+
+/// Rate one candidate on joint `j`'s commanded motion: its share with the margin, torque and speed
+/// headroom, and why it falls short.
+fn rate(drive: &DriveTrain, motion: &Motion, j: usize, margin: f64) -> (f64, f64, f64, Option<Shortfall>) {
+    let reflected = drive.reflected_inertia();
+    let k = 1.0 + margin;
+    let share_of = |need: f64, available: f64| if available > 0.0 { need / available } else if need > 0.0 { f64::INFINITY } else { 0.0 };
+    let (mut worst, mut at, mut plain_worst, mut top_speed) = (0.0f64, 0usize, 0.0f64, 0.0f64);
+    for i in 0..motion.t.len() {
+        let torque = motion.torque[j][i] + reflected * motion.acceleration[j][i];
+        let share = share_of(k * torque.abs(), drive.available(torque, k * motion.speed[j][i]));
+        if share > worst {
+            (worst, at) = (share, i);
+        }
+        plain_worst = plain_worst.max(share_of(torque.abs(), drive.available(torque, motion.speed[j][i])));
+        top_speed = top_speed.max(motion.speed[j][i].abs());
+    }
+    let torque_headroom = if plain_worst > 0.0 { 1.0 / plain_worst } else { f64::INFINITY };
+    let speed_headroom = if top_speed > 0.0 { drive.speed_at_fraction(0.5) / top_speed } else { f64::INFINITY };
+    if worst <= 1.0 {
+        return (worst, torque_headroom, speed_headroom, None);
+    }
+    let t = motion.t[at];
+    let speed = k * motion.speed[j][at];
+    let torque = motion.torque[j][at] + reflected * motion.acceleration[j][at];
+    let need = k * torque.abs();
+    let braking = torque * speed < 0.0;
+    let motor_torque = drive.efficiency * drive.gear_ratio * if braking { drive.motor.braking_torque_at(drive.gear_ratio * speed) } else { drive.motor.torque_at(drive.gear_ratio * speed) };
+    let available = motor_torque.min(drive.rated_torque);
+    let without_rotor = (0..motion.t.len()).all(|i| {
+        let torque = motion.torque[j][i];
+        k * torque.abs() <= drive.available(torque, k * motion.speed[j][i])
+    });
+    let shortfall = if drive.rated_torque < motor_torque {
+        Shortfall::Gearbox { t, need, rated: drive.rated_torque }
+    } else if without_rotor && reflected > 0.0 {
+        Shortfall::ReflectedInertia { t, reflected, need, available }
+    } else if !braking && drive.motor.torque_at(drive.gear_ratio * speed) < 0.9 * drive.motor.torque_at(0.0) {
+        Shortfall::Speed { t, motor_rev_s: (drive.gear_ratio * speed).abs() / std::f64::consts::TAU, need, available }
+    } else {
+        Shortfall::Torque { t, need, available }
+    };
+    (worst, torque_headroom, speed_headroom, Some(shortfall))
+}
+
+/// Size every actuated joint; see the module's notes for the method.
+pub fn size(request: &SizeRequest) -> Result<SizeReport, Error> {
+    let model = &request.model;
+    let n = model.dof();
+    let motion = commanded_motion(request)?;
+    let mut joints: Vec<JointSizing> = Vec::new();
+    for j in 0..n {
+        let mut candidates = Vec::new();
+        if model.is_actuated(j) {
+            for motor in &request.motors {
+                let mass_kg = request.catalogue.mass(motor).unwrap_or(f64::NAN);
+                for &ratio in &request.ratios[j] {
+                    let drive = drive_train(&request.catalogue, motor, ratio, request.efficiency)?;
+                    let (share, torque_headroom, speed_headroom, shortfall) = rate(&drive, &motion, j, request.margin);
+                    candidates.push(Candidate { motor: motor.clone(), mass_kg, ratio, total_ratio: drive.gear_ratio, torque_at_rest: drive.torque_limit(0.0), share, torque_headroom, speed_headroom, shortfall });
+                }
+            }
+        }
+        let mut ranked: Vec<usize> = (0..candidates.len()).filter(|&c| candidates[c].feasible()).collect();
+        ranked.sort_by(|&a, &b| {
+            let (x, y) = (&candidates[a], &candidates[b]);
+            x.mass_kg.total_cmp(&y.mass_kg).then(x.motor.cmp(&y.motor)).then(x.ratio.total_cmp(&y.ratio))
+        });
+        joints.push(JointSizing { joint: model.joints[j].name.clone(), candidates, ranked, chosen: None, runner_up: None, simulated: Vec::new(), nearest_rejected: Vec::new() });
+    }
+
+    // simulate: the set of each joint's current pick, and beside it each joint's next candidate
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(request.jobs.max(1)).build().map_err(|e| Error::flag("--jobs", e.to_string()))?;
+    let mut pick = vec![0usize; n];
+    let (mut rounds, mut verified, mut simulations) = (0, false, 0);
+    let sizable: Vec<usize> = (0..n).filter(|&j| !joints[j].candidates.is_empty()).collect();
+    let max_rounds = 40;
+    // first pass: jump on the estimate, then walk back down; if the walked-down set fails together,
+    // a second pass climbs from there one candidate at a time
+    let mut extrapolate = true;
+    'passes: loop {
+    while rounds < max_rounds && sizable.iter().all(|&j| pick[j] < joints[j].ranked.len()) {
+        rounds += 1;
+        let current: Vec<Option<usize>> = (0..n).map(|j| joints[j].ranked.get(pick[j]).copied()).collect();
+        let mut sets: Vec<(Option<usize>, Vec<Option<usize>>)> = vec![(None, current.clone())];
+        for &j in &sizable {
+            if let Some(&next) = joints[j].ranked.get(pick[j] + 1) {
+                let mut set = current.clone();
+                set[j] = Some(next);
+                sets.push((Some(j), set));
+            }
+        }
+        let results: Vec<Result<Vec<(u64, f64, Option<String>)>, Error>> = pool.install(|| sets.par_iter().map(|(_, set)| simulate_set(request, &joints, set)).collect());
+        simulations += sets.len();
+        let mut results = results.into_iter();
+        let whole = results.next().expect("the whole set is always simulated")?;
+        let mut failing = false;
+        for &j in &sizable {
+            let candidate = current[j].expect("every sizable joint has a pick in the loop");
+            let check = check(candidate, &whole[j], request.margin);
+            if !check.passed {
+                failing = true;
+                // what fails in the full run is torque: the full run used the share s of what the
+                // motor gave where the motion alone needs 1/headroom of it; a candidate of the same
+                // motor passes only with the headroom scaled by s·(1 + m), so move past the others
+                let failed = &joints[j].candidates[candidate];
+                let used = check.peak_torque_share.max(if check.lost_steps > 0 { 1.0 } else { 0.0 });
+                let scale = if extrapolate { (used * (1.0 + request.margin)).max(1.0) } else { 0.0 };
+                let (motor, needed) = (failed.motor.clone(), failed.torque_headroom * scale);
+                let js = &joints[j];
+                pick[j] += 1;
+                while let Some(&next) = js.ranked.get(pick[j]) {
+                    let c = &js.candidates[next];
+                    if c.motor == motor && c.torque_headroom < needed {
+                        pick[j] += 1;
+                    } else {
+                        break;
+                    }
+                }
+            }
+            joints[j].simulated.push(check);
+        }
+        for ((joint, set), result) in sets[1..].iter().zip(results) {
+            let j = joint.expect("the others are one joint's next candidate");
+            let candidate = set[j].expect("set above");
+            joints[j].simulated.push(check(candidate, &result?[j], request.margin));
+        }
+        if !failing {
+            verified = true;
+            break;
+        }
+    }
+    if verified && extrapolate {
+        // the jumps above skipped candidates on an estimate: walk each joint back down while the
+        // candidate ranked just before its choice passes in the full run (all in parallel), then check
+        // the whole set once more (if the set no longer passes together, keep the one that did)
+        let before = pick.clone();
+        let mut open: Vec<usize> = sizable.iter().copied().filter(|&j| pick[j] > 0).collect();
+        while !open.is_empty() {
+            let current: Vec<Option<usize>> = (0..n).map(|j| joints[j].ranked.get(pick[j]).copied()).collect();
+            let probes: Vec<(usize, Vec<Option<usize>>)> = open
+                .iter()
+                .map(|&j| {
+                    let mut set = current.clone();
+                    set[j] = Some(joints[j].ranked[pick[j] - 1]);
+                    (j, set)
+                })
+                .collect();
+            let results: Vec<Result<Vec<(u64, f64, Option<String>)>, Error>> = pool.install(|| probes.par_iter().map(|(_, set)| simulate_set(request, &joints, set)).collect());
+            simulations += probes.len();
+            let mut still = Vec::new();
+            for ((j, set), result) in probes.into_iter().zip(results) {
+                let candidate = set[j].expect("set above");
+                let probe = check(candidate, &result?[j], request.margin);
+                let passed = probe.passed;
+                joints[j].simulated.push(probe);
+                if passed {
+                    pick[j] -= 1;
+                    if pick[j] > 0 {
+                        still.push(j);
+                    }
+                }
+            }
+            open = still;
+        }
+        if pick != before {
+            let set: Vec<Option<usize>> = (0..n).map(|j| joints[j].ranked.get(pick[j]).copied()).collect();
+            let whole = simulate_set(request, &joints, &set)?;
+            simulations += 1;
+            let checks: Vec<SimulatedCheck> = sizable.iter().map(|&j| check(set[j].expect("sizable"), &whole[j], request.margin)).collect();
+            let passed = checks.iter().all(|c| c.passed);
+            for (&j, c) in sizable.iter().zip(checks) {
+                joints[j].simulated.push(c);
+            }
+            if !passed {
+                // climb from the walked-down set, one candidate at a time
+                for &j in &sizable {
+                    let c = joints[j].simulated.last().expect("pushed above");
+                    if !c.passed {
+                        pick[j] += 1;
+                    }
+                }
+                verified = false;
+                extrapolate = false;
+                continue 'passes;
+            }
+        }
+    }
+    break;
+    }
+    for j in sizable {
+        let js = &mut joints[j];
+        js.chosen = js.ranked.get(pick[j]).copied();
+        // the runner-up: the next candidate that passed its own simulation, else the next ranked
+        js.runner_up = js.ranked.iter().skip(pick[j] + 1).copied().find(|&c| js.simulated.iter().any(|s| s.candidate == c && s.passed)).or_else(|| js.ranked.get(pick[j] + 1).copied());
+        js.nearest_rejected = nearest_rejected(js);
+    }
+    Ok(SizeReport {
+        model: model.name.clone(),
+        motions: request.motions.iter().map(|(name, _)| name.clone()).collect(),
+        payload_kg: request.payload_kg,
+        margin: request.margin,
+        efficiency: request.efficiency,
+        microsteps: request.microsteps,
+        motors: request.motors.clone(),
+        joints,
+        rounds,
+        verified,
+        simulations,
+    })
+}
+
+fn check(candidate: usize, (lost, share, diverged): &(u64, f64, Option<String>), margin: f64) -> SimulatedCheck {
+    let allowed = 1.0 / (1.0 + margin);
+    let note = if let Some(message) = diverged {
+        Some(message.clone())
+    } else if *lost > 0 {
+        Some(format!("lost {lost} full steps"))
+    } else if *share > allowed {
+        Some(format!("used {:.0} % of the torque available at its speed (the margin allows {:.0} %)", 100.0 * share, 100.0 * allowed))
+    } else {
+        None
+    };
+    SimulatedCheck { candidate, lost_steps: *lost, peak_torque_share: *share, passed: note.is_none(), note }
+}
+
+/// The motor set of per-joint candidates (None: the joint keeps its URDF effort).
+pub fn motor_set(request: &SizeRequest, joints: &[JointSizing], set: &[Option<usize>]) -> Result<MotorSet, Error> {
+    let n = set.len();
+    let mut motors = MotorSet { joints: (0..n).map(|_| None).collect(), microsteps: vec![None; n], acceleration: vec![None; n], source: "armscope size".into() };
+    for (j, choice) in set.iter().enumerate() {
+        if let Some(c) = choice {
+            let candidate = &joints[j].candidates[*c];
+            motors.joints[j] = Some(drive_train(&request.catalogue, &candidate.motor, candidate.ratio, request.efficiency)?);
+            motors.microsteps[j] = Some(request.microsteps);
+        }
+    }
+    Ok(motors)
+}
+
+/// Simulate every motion with the set; per joint: full steps lost, peak torque share, and the
+/// divergence message if the run diverged on this joint.
+fn simulate_set(request: &SizeRequest, joints: &[JointSizing], set: &[Option<usize>]) -> Result<Vec<(u64, f64, Option<String>)>, Error> {
+    let n = set.len();
+    let mut out = vec![(0u64, 0.0f64, None); n];
+    for (_, config) in &request.motions {
+        let motors = motor_set(request, joints, set)?;
+        let experiment = Experiment::with_motors(config.clone(), request.model.clone(), Some(motors))?;
+        let summary = crate::sim::simulate(&experiment, &mut [], None)?;
+        for j in 0..n {
+            out[j].0 += summary.lost_steps.get(j).copied().unwrap_or(0);
+            out[j].1 = out[j].1.max(summary.peak_torque_share.get(j).copied().unwrap_or(0.0));
+        }
+        if let crate::summary::RunStatus::Diverged { joint, message, .. } = &summary.status {
+            if let Some(j) = request.model.joint_index(joint) {
+                out[j].2 = Some(message.clone());
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// The rejected candidates nearest the choice (see [`JointSizing::nearest_rejected`]).
+fn nearest_rejected(js: &JointSizing) -> Vec<usize> {
+    let Some(chosen) = js.chosen.or(js.ranked.first().copied()) else {
+        // nothing feasible: the closest miss
+        return (0..js.candidates.len()).min_by(|&a, &b| js.candidates[a].share.total_cmp(&js.candidates[b].share)).into_iter().collect();
+    };
+    let c = &js.candidates[chosen];
+    let same_motor: Vec<usize> = (0..js.candidates.len()).filter(|&i| js.candidates[i].motor == c.motor).collect();
+    let mut out = Vec::new();
+    if let Some(&below) = same_motor.iter().rev().find(|&&i| js.candidates[i].ratio < c.ratio && !js.candidates[i].feasible()) {
+        out.push(below);
+    }
+    if let Some(&above) = same_motor.iter().find(|&&i| js.candidates[i].ratio > c.ratio && !js.candidates[i].feasible()) {
+        out.push(above);
+    }
+    // the next lighter motor, where it comes closest
+    let lighter = js.candidates.iter().filter(|x| x.mass_kg < c.mass_kg).map(|x| x.mass_kg).fold(f64::NEG_INFINITY, f64::max);
+    if let Some(best) = (0..js.candidates.len()).filter(|&i| js.candidates[i].mass_kg == lighter).min_by(|&a, &b| js.candidates[a].share.total_cmp(&js.candidates[b].share)) {
+        out.push(best);
+    }
+    out
+}

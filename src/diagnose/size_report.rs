@@ -1,0 +1,182 @@
+//! What `armscope size` shows: the console and Markdown table, the motor file of the choice, and per
+//! joint a chart of motor × ratio with the feasible region and the choice marked.
+
+use super::heatmap::{Canvas, ratio_color};
+use super::size::{Candidate, JointSizing, SizeReport};
+
+/// A headroom factor for people: 2.4×, 37×, ∞.
+fn times(x: f64) -> String {
+    if !x.is_finite() {
+        "∞".into()
+    } else if x >= 10.0 {
+        format!("{x:.0}×")
+    } else {
+        format!("{x:.2}×")
+    }
+}
+
+fn ratio_text(r: f64) -> String {
+    if r.fract() == 0.0 { format!("{r:.0}") } else { format!("{r}") }
+}
+
+impl JointSizing {
+    fn describe(&self, c: usize) -> String {
+        let x = &self.candidates[c];
+        let sim = self.simulated.iter().rev().find(|s| s.candidate == c).map_or(String::new(), |s| match &s.note {
+            None => format!(", simulated: 0 lost steps, {:.0} % of its torque", 100.0 * s.peak_torque_share),
+            Some(note) => format!(", simulated: {note}"),
+        });
+        let fit = match &x.shortfall {
+            None => format!("{} the torque, {} the speed needed", times(x.torque_headroom), times(x.speed_headroom)),
+            Some(s) => s.describe(),
+        };
+        format!("{} at {}:1 ({:.2} N·m at rest, {fit}{sim})", x.motor, ratio_text(x.ratio), x.torque_at_rest)
+    }
+
+    fn candidate(&self, c: Option<usize>) -> Option<&Candidate> {
+        c.map(|c| &self.candidates[c])
+    }
+}
+
+impl SizeReport {
+    /// Markdown: per joint the choice, the runner-up and why the nearest rejected ones fail.
+    pub fn markdown(&self) -> String {
+        let mut md = format!(
+            "# Motor sizing for {}\n\nMotion: {}; payload {} kg at the tool; margin {:.0} % on torque and speed; the chosen reduction {:.0} % efficient; {} microsteps.\nCandidates: {}.\n\n",
+            self.model,
+            self.motions.join(", "),
+            self.payload_kg,
+            100.0 * self.margin,
+            100.0 * self.efficiency,
+            self.microsteps,
+            self.motors.join(", ")
+        );
+        md += "| joint | motor | ratio | at rest (N·m) | torque to spare | speed to spare | simulated | runner-up |\n|---|---|---|---|---|---|---|---|\n";
+        for js in &self.joints {
+            if js.candidates.is_empty() {
+                continue;
+            }
+            let Some(c) = js.candidate(js.chosen) else {
+                md += &format!("| {} | none fits | | | | | | |\n", js.joint);
+                continue;
+            };
+            let sim = js.simulated.iter().rev().find(|s| Some(s.candidate) == js.chosen).map_or("–".to_string(), |s| match &s.note {
+                None => format!("0 lost steps, {:.0} % of its torque", 100.0 * s.peak_torque_share),
+                Some(note) => note.clone(),
+            });
+            let runner = js.candidate(js.runner_up).map_or("–".to_string(), |r| format!("{} at {}:1", r.motor, ratio_text(r.ratio)));
+            let top = js.candidates.iter().filter(|x| x.motor == c.motor).map(|x| x.ratio).fold(0.0, f64::max);
+            let edge = if c.ratio == top { " (the largest tried)" } else { "" };
+            md += &format!("| {} | {} | {}{edge} | {:.2} | {} | {} | {sim} | {runner} |\n", js.joint, c.motor, ratio_text(c.ratio), c.torque_at_rest, times(c.torque_headroom), times(c.speed_headroom));
+        }
+        md += &format!(
+            "\n{} ({} simulation rounds, {} simulations).\n\nWhy not the nearest rejected candidates:\n\n",
+            if self.verified { "The chosen set passed its full simulation, every joint at once" } else { "**The chosen set did not pass its full simulation**" },
+            self.rounds,
+            self.simulations
+        );
+        for js in &self.joints {
+            if js.candidates.is_empty() {
+                continue;
+            }
+            if let Some(c) = js.chosen {
+                md += &format!("- {}: chosen {}", js.joint, js.describe(c));
+                if let Some(r) = js.runner_up {
+                    md += &format!("; runner-up {}", js.describe(r));
+                }
+                md += "\n";
+            } else {
+                md += &format!("- {}: no candidate fits\n", js.joint);
+            }
+            for &r in &js.nearest_rejected {
+                md += &format!("  - {}\n", js.describe(r));
+            }
+        }
+        md
+    }
+
+    /// The choice as a motor file for `armscope run --motors`.
+    pub fn motor_file(&self, catalogue: Option<&str>) -> String {
+        let mut toml = format!(
+            "# Written by `armscope size` for {}: motion {}, payload {} kg, margin {:.0} %.\n# Each joint's motor and the reduction after it; run it with `armscope run --motors THIS_FILE`.\n",
+            self.model,
+            self.motions.join(", "),
+            self.payload_kg,
+            100.0 * self.margin
+        );
+        if let Some(path) = catalogue {
+            toml += &format!("catalogue = {:?}\n", path);
+        }
+        toml += &format!("description = \"armscope size: payload {} kg, margin {:.0} %\"\n", self.payload_kg, 100.0 * self.margin);
+        for js in &self.joints {
+            let Some(c) = js.candidate(js.chosen) else { continue };
+            toml += &format!("\n[joints.{}]\nmotor = {:?}\ngear_ratio = {}\nefficiency = {}\nmicrosteps = {}\n", toml_key(&js.joint), c.motor, c.ratio, if c.ratio == 1.0 { 1.0 } else { self.efficiency }, self.microsteps);
+        }
+        toml
+    }
+
+    /// Joint `j`'s chart: a cell per motor (rows, lightest at the bottom) and ratio (columns),
+    /// coloured by need / available with the margin (red above 1: infeasible); the choice framed in
+    /// black, the runner-up in grey.
+    pub fn chart(&self, j: usize) -> Canvas {
+        let js = &self.joints[j];
+        let mut motors: Vec<&str> = Vec::new();
+        for c in &js.candidates {
+            if !motors.contains(&c.motor.as_str()) {
+                motors.push(&c.motor);
+            }
+        }
+        let ratios: Vec<f64> = js.candidates.iter().filter(|c| c.motor == motors[0]).map(|c| c.ratio).collect();
+        let cw = (900 / ratios.len().max(1)).clamp(12, 64);
+        let ch = 40;
+        let (left, bottom, top, right) = (230, 110, 70, 30);
+        let (cols, rows) = (ratios.len(), motors.len());
+        let mut canvas = Canvas::new(left + cols * cw + right, top + rows * ch + bottom, [250, 250, 250]);
+        let dark = [30, 30, 30];
+        let title = format!("{}: NEED X {:.1} / AVAILABLE{}", js.joint, 1.0 + self.margin, if self.payload_kg > 0.0 { format!(", PAYLOAD {} KG", self.payload_kg) } else { String::new() });
+        canvas.text(left.min(20), 18, &title, 3, dark);
+        for (c, cand) in js.candidates.iter().enumerate() {
+            let (Some(row), Some(col)) = (motors.iter().position(|m| *m == cand.motor), ratios.iter().position(|r| *r == cand.ratio)) else { continue };
+            let (x, y) = (left + col * cw, top + (rows - 1 - row) * ch);
+            let frame = if Some(c) == js.chosen { Some(dark) } else if Some(c) == js.runner_up { Some([120, 120, 120]) } else { None };
+            match frame {
+                Some(f) => {
+                    canvas.fill(x.saturating_sub(3), y.saturating_sub(3), cw + 4, ch + 4, f);
+                    canvas.fill(x + 2, y + 2, cw - 6, ch - 6, ratio_color(cand.share));
+                }
+                None => canvas.fill(x + 1, y + 1, cw - 4, ch - 4, ratio_color(cand.share)),
+            }
+            // feasible on the motion's inverse dynamics, but failed in the full simulation
+            if cand.feasible() && Some(c) != js.chosen && js.simulated.iter().any(|s| s.candidate == c && !s.passed) && !js.simulated.iter().any(|s| s.candidate == c && s.passed) {
+                let d = (cw / 3).max(4);
+                canvas.fill(x + (cw - 2 - d) / 2, y + (ch - 2 - d) / 2, d, d, [110, 20, 20]);
+            }
+        }
+        for (r, motor) in motors.iter().enumerate() {
+            let y = top + (rows - 1 - r) * ch + ch / 2 - 5;
+            canvas.text(left - 12 - Canvas::text_width(motor, 2), y, motor, 2, dark);
+        }
+        let every = ratios.len().div_ceil(18).max(1);
+        for (col, ratio) in ratios.iter().enumerate() {
+            if col % every == 0 || (col + 1 == ratios.len() && col % every >= every / 2 + 1) {
+                let tick = ratio_text(*ratio);
+                let x = (left + col * cw + cw / 2).saturating_sub(Canvas::text_width(&tick, 2) / 2);
+                canvas.text(x, top + rows * ch + 8, &tick, 2, dark);
+            }
+        }
+        let x_label = "GEAR RATIO AFTER THE MOTOR";
+        canvas.text(left + (cols * cw).saturating_sub(Canvas::text_width(x_label, 2)) / 2, top + rows * ch + 36, x_label, 2, dark);
+        canvas.text(8, top - 22, "MOTOR (LIGHTEST AT THE BOTTOM)", 2, dark);
+        let legend = match js.candidate(js.chosen) {
+            Some(c) => format!("BLACK FRAME: CHOSEN {} AT {}. GREY: RUNNER-UP. RED: INFEASIBLE (ABOVE 1). DOT: FAILED IN SIMULATION", c.motor, ratio_text(c.ratio)),
+            None => "NO CANDIDATE FITS. RED: INFEASIBLE (ABOVE 1). DOT: FAILED IN SIMULATION".to_string(),
+        };
+        canvas.text(8, top + rows * ch + 70, &legend, 2, dark);
+        canvas
+    }
+}
+
+/// A TOML key: bare when it can be, quoted otherwise.
+fn toml_key(name: &str) -> String {
+    if !name.is_empty() && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-') { name.to_string() } else { format!("{name:?}") }
+}
