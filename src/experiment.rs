@@ -265,14 +265,8 @@ fn gains(config: &RunConfig, model: &Model, start: &[f64], trajectory: &dyn Traj
         Gains { kp: TUTORIAL_KP.to_vec(), kd: TUTORIAL_KD.to_vec(), source: "tutorial".into(), effective_inertia: None, spectral_radius: None }
     } else {
         // the poses the command goes through: the start and 24 along its first period (or the run)
-        let period = if config.freq > 0.0 { std::f64::consts::TAU / config.freq } else { config.duration };
-        let span = period.min(config.duration);
-        let (mut cmd, mut cmd_dot) = (vec![0.0; n], vec![0.0; n]);
         let mut poses = vec![start.to_vec()];
-        for i in 0..24 {
-            trajectory.sample(span * i as f64 / 24.0, &mut cmd, &mut cmd_dot);
-            poses.push(cmd.iter().zip(&model.joints).map(|(&c, j)| c.clamp(j.lower, j.upper)).collect());
-        }
+        poses.extend(along_first_period(config, model, trajectory, 0..24, 24).into_iter().map(|(pose, _)| pose));
         let loop_plant = match plant {
             PlantSpec::Discrete { .. } => LoopPlant::Discrete,
             PlantSpec::Continuous { .. } => LoopPlant::Continuous,
@@ -380,12 +374,8 @@ fn stepper_substeps(steppers: &OpenLoopSteppers, model: &Model, trajectory: &dyn
     let n = model.dof();
     let mut inertia = inertia_diagonal(model, pose);
     let mut top_speed = vec![0.0f64; n];
-    let span = if config.freq > 0.0 { (std::f64::consts::TAU / config.freq).min(config.duration) } else { config.duration };
-    let (mut cmd, mut cmd_dot) = (vec![0.0; n], vec![0.0; n]);
-    for i in 0..=32 {
-        trajectory.sample(span * i as f64 / 32.0, &mut cmd, &mut cmd_dot);
-        let clamped: Vec<f64> = cmd.iter().zip(&model.joints).map(|(&c, j)| c.clamp(j.lower, j.upper)).collect();
-        for (m, x) in inertia.iter_mut().zip(inertia_diagonal(model, &clamped)) {
+    for (pose, cmd_dot) in along_first_period(config, model, trajectory, 0..33, 32) {
+        for (m, x) in inertia.iter_mut().zip(inertia_diagonal(model, &pose)) {
             *m = m.min(x);
         }
         for (t, v) in top_speed.iter_mut().zip(&cmd_dot) {
@@ -397,6 +387,21 @@ fn stepper_substeps(steppers: &OpenLoopSteppers, model: &Model, trajectory: &dyn
     let by_dynamics = omega.max(rate) * config.dt / 0.2;
     let by_field = steppers.electrical_speed(&top_speed) * config.dt / (std::f64::consts::TAU / 32.0);
     (by_dynamics.max(by_field).ceil() as usize).max(1)
+}
+
+/// The command at times span·i/`parts` for i in `points`, span its first period (or the whole run,
+/// if shorter or not a wave): each pose clamped into the joints' ranges, and the commanded speed.
+fn along_first_period(config: &RunConfig, model: &Model, trajectory: &dyn Trajectory, points: std::ops::Range<usize>, parts: usize) -> Vec<(Vec<f64>, Vec<f64>)> {
+    let n = model.dof();
+    let period = if config.freq > 0.0 { std::f64::consts::TAU / config.freq } else { config.duration };
+    let span = period.min(config.duration);
+    let (mut cmd, mut cmd_dot) = (vec![0.0; n], vec![0.0; n]);
+    points
+        .map(|i| {
+            trajectory.sample(span * i as f64 / parts as f64, &mut cmd, &mut cmd_dot);
+            (cmd.iter().zip(&model.joints).map(|(&c, j)| c.clamp(j.lower, j.upper)).collect(), cmd_dot.clone())
+        })
+        .collect()
 }
 
 /// The mass matrix's diagonal at `q` (each joint's inertia with the others held).

@@ -38,11 +38,6 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
     let mut torque_limit = vec![0.0; n];
     // stepper mode: the open-loop steppers, their load angles and lost steps
     let mut steppers = experiment.open_loop_steppers();
-    // the step pulses advance once per plant step (the continuous plant takes the torque once per period)
-    let plant_step = match experiment.plant {
-        crate::experiment::PlantSpec::Discrete { time_step, .. } => time_step,
-        crate::experiment::PlantSpec::Continuous { .. } => dt,
-    };
     let (mut load_angle, mut lost_steps, mut lost_events) = (vec![0.0; n], vec![0i64; n], Vec::new());
     let (mut chatter, mut previous_u, mut previous_saturated) = (vec![false; n], vec![0.0; n], vec![false; n]);
     let mut at_limit = vec![false; n];
@@ -118,8 +113,8 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
                 model,
                 &mut data,
                 &mut u,
-                &mut |q, v, u| {
-                    s.advance(plant_step);
+                &mut |h, q, v, u| {
+                    s.advance(h);
                     s.torques(q, v, u)
                 },
                 &mut q,

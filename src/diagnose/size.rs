@@ -269,7 +269,7 @@ pub fn size(request: &SizeRequest) -> Result<SizeReport, Error> {
     'passes: loop {
     while rounds < max_rounds && sizable.iter().all(|&j| pick[j] < joints[j].ranked.len()) {
         rounds += 1;
-        let current: Vec<Option<usize>> = (0..n).map(|j| joints[j].ranked.get(pick[j]).copied()).collect();
+        let current = picked(&joints, &pick);
         let mut sets: Vec<(Option<usize>, Vec<Option<usize>>)> = vec![(None, current.clone())];
         for &j in &sizable {
             if let Some(&next) = joints[j].ranked.get(pick[j] + 1) {
@@ -325,7 +325,7 @@ pub fn size(request: &SizeRequest) -> Result<SizeReport, Error> {
         let before = pick.clone();
         let mut open: Vec<usize> = sizable.iter().copied().filter(|&j| pick[j] > 0).collect();
         while !open.is_empty() {
-            let current: Vec<Option<usize>> = (0..n).map(|j| joints[j].ranked.get(pick[j]).copied()).collect();
+            let current = picked(&joints, &pick);
             let probes: Vec<(usize, Vec<Option<usize>>)> = open
                 .iter()
                 .map(|&j| {
@@ -352,7 +352,7 @@ pub fn size(request: &SizeRequest) -> Result<SizeReport, Error> {
             open = still;
         }
         if pick != before {
-            let set: Vec<Option<usize>> = (0..n).map(|j| joints[j].ranked.get(pick[j]).copied()).collect();
+            let set = picked(&joints, &pick);
             let whole = simulate_set(request, &joints, &set)?;
             simulations += 1;
             let checks: Vec<SimulatedCheck> = sizable.iter().map(|&j| check(set[j].expect("sizable"), &whole[j], request.margin)).collect();
@@ -396,6 +396,11 @@ pub fn size(request: &SizeRequest) -> Result<SizeReport, Error> {
         verified,
         simulations,
     })
+}
+
+/// Each joint's candidate at its place `pick` in its ranking (None past the end, or with no candidates).
+fn picked(joints: &[JointSizing], pick: &[usize]) -> Vec<Option<usize>> {
+    joints.iter().zip(pick).map(|(js, &p)| js.ranked.get(p).copied()).collect()
 }
 
 fn check(candidate: usize, (lost, share, diverged): &(u64, f64, Option<String>), margin: f64) -> SimulatedCheck {

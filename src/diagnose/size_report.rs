@@ -20,12 +20,17 @@ fn ratio_text(r: f64) -> String {
 }
 
 impl JointSizing {
+    /// The last simulation of candidate `c`, in words.
+    fn simulation(&self, c: usize) -> Option<String> {
+        self.simulated.iter().rev().find(|s| s.candidate == c).map(|s| match &s.note {
+            None => format!("0 lost steps, {:.0} % of its torque", 100.0 * s.peak_torque_share),
+            Some(note) => note.clone(),
+        })
+    }
+
     fn describe(&self, c: usize) -> String {
         let x = &self.candidates[c];
-        let sim = self.simulated.iter().rev().find(|s| s.candidate == c).map_or(String::new(), |s| match &s.note {
-            None => format!(", simulated: 0 lost steps, {:.0} % of its torque", 100.0 * s.peak_torque_share),
-            Some(note) => format!(", simulated: {note}"),
-        });
+        let sim = self.simulation(c).map_or(String::new(), |s| format!(", simulated: {s}"));
         let fit = match &x.shortfall {
             None => format!("{} the torque, {} the speed needed", times(x.torque_headroom), times(x.speed_headroom)),
             Some(s) => s.describe(),
@@ -60,10 +65,7 @@ impl SizeReport {
                 md += &format!("| {} | none fits | | | | | | |\n", js.joint);
                 continue;
             };
-            let sim = js.simulated.iter().rev().find(|s| Some(s.candidate) == js.chosen).map_or("–".to_string(), |s| match &s.note {
-                None => format!("0 lost steps, {:.0} % of its torque", 100.0 * s.peak_torque_share),
-                Some(note) => note.clone(),
-            });
+            let sim = js.chosen.and_then(|c| js.simulation(c)).unwrap_or_else(|| "–".to_string());
             let runner = js.candidate(js.runner_up).map_or("–".to_string(), |r| format!("{} at {}:1", r.motor, ratio_text(r.ratio)));
             let top = js.candidates.iter().filter(|x| x.motor == c.motor).map(|x| x.ratio).fold(0.0, f64::max);
             let edge = if c.ratio == top { " (the largest tried)" } else { "" };

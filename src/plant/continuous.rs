@@ -122,6 +122,12 @@ impl ContinuousPlant {
 }
 
 impl Plant for ContinuousPlant {
+    /// The torque once per period (the adaptive steps integrate it held).
+    fn advance_driven(&mut self, model: &Model, data: &mut Data, u: &mut [f64], torque: &mut dyn FnMut(f64, &[f64], &[f64], &mut [f64]), q: &mut [f64], v: &mut [f64]) {
+        torque(self.period, q, v, u);
+        self.advance(model, data, u, q, v);
+    }
+
     fn advance(&mut self, model: &Model, data: &mut Data, u: &[f64], q: &mut [f64], v: &mut [f64]) {
         let n = self.n;
         self.y[..n].copy_from_slice(q);

@@ -172,9 +172,9 @@ impl Plant for DiscretePlant {
         self.over_substeps(model, data, q, v, |plant, data, q, v| plant.step(model, data, u, q, v));
     }
 
-    fn advance_driven(&mut self, model: &Model, data: &mut Data, u: &mut [f64], torque: &mut dyn FnMut(&[f64], &[f64], &mut [f64]), q: &mut [f64], v: &mut [f64]) {
+    fn advance_driven(&mut self, model: &Model, data: &mut Data, u: &mut [f64], torque: &mut dyn FnMut(f64, &[f64], &[f64], &mut [f64]), q: &mut [f64], v: &mut [f64]) {
         self.over_substeps(model, data, q, v, |plant, data, q, v| {
-            torque(q, v, u);
+            torque(plant.time_step, q, v, u);
             plant.step(model, data, u, q, v)
         });
     }

@@ -15,12 +15,10 @@ pub trait Plant: Send {
     /// computed them for the controller); on exit it is stale.
     fn advance(&mut self, model: &Model, data: &mut Data, u: &[f64], q: &mut [f64], v: &mut [f64]);
 
-    /// Like `advance`, but `torque(q, q̇, u)` updates u from the state at every plant step (a
-    /// stepper's torque follows its rotor within a control period). By default once per period.
-    fn advance_driven(&mut self, model: &Model, data: &mut Data, u: &mut [f64], torque: &mut dyn FnMut(&[f64], &[f64], &mut [f64]), q: &mut [f64], v: &mut [f64]) {
-        torque(q, v, u);
-        self.advance(model, data, u, q, v);
-    }
+    /// Like `advance`, but `torque(h, q, q̇, u)` updates u from the state before every plant step,
+    /// h the time that step covers (a stepper's torque follows its rotor within a control period,
+    /// and its driver's pulses advance by h).
+    fn advance_driven(&mut self, model: &Model, data: &mut Data, u: &mut [f64], torque: &mut dyn FnMut(f64, &[f64], &[f64], &mut [f64]), q: &mut [f64], v: &mut [f64]);
 
     /// Per joint: whether it was stopped at a position limit during the last `advance`.
     fn limit_active(&self) -> &[bool];

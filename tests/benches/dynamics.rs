@@ -114,7 +114,6 @@ fn motors(c: &mut Criterion) {
         let mut plant = experiment.make_plant();
         let controller = experiment.controller();
         let mut steppers = experiment.open_loop_steppers();
-        let plant_step = 0.001; // time_step above
         let (q0, v0, _) = state();
         let (cmd, cmd_dot) = (vec![0.1; 6], vec![0.2; 6]);
         let (mut u, mut sat, mut limit) = (vec![0.0; 6], vec![false; 6], vec![0.0; 6]);
@@ -132,8 +131,8 @@ fn motors(c: &mut Criterion) {
                                 model,
                                 &mut data,
                                 &mut u,
-                                &mut |q, v, u| {
-                                    s.advance(plant_step);
+                                &mut |h, q, v, u| {
+                                    s.advance(h);
                                     s.torques(q, v, u)
                                 },
                                 q,
