@@ -1,12 +1,13 @@
 //! The simulation loop: controller and plant at the control rate, every sample to every recorder.
 
-use crate::dynamics::{Data, body_poses, forward_kinematics, frame_pose, frame_pose_in, gravity_and_bias_from_kinematics};
+use crate::dynamics::{Data, body_poses, forward_kinematics, frame_pose, frame_pose_in, gravity_and_bias_from_kinematics, kinetic_energy_from_velocities, potential_energy_from_kinematics};
+use crate::model::Model;
 use crate::error::Error;
 use crate::experiment::Experiment;
 use crate::control::controller::ControlOutput;
 use crate::recorder::{Recorder, RunInfo};
 use crate::sample::Sample;
-use crate::summary::{RunStatus, Summary, SummaryBuilder};
+use crate::summary::{EnergyBalance, RunStatus, Summary, SummaryBuilder};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
@@ -103,24 +104,31 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
             }
             break;
         }
-        let potential = audit.as_mut().map(|a| {
-            a.remember(&v);
-            a.potential_energy(model, &data)
-        });
-        match steppers.as_mut() {
-            // the stepper torque follows the rotor within the control period: at every plant step
-            Some(s) => plant.advance_driven(
-                model,
-                &mut data,
-                &mut u,
-                &mut |h, q, v, u| {
+        if let Some(a) = audit.as_mut() {
+            // the loop's passes left the kinematics and body velocities at (q_k, q̇_k) in data
+            if let Some(diverged) = a.period_start(model, &data, &v, t) {
+                status = diverged;
+                break;
+            }
+        }
+        if steppers.is_none() && audit.is_none() {
+            plant.advance(model, &mut data, &u, &mut q, &mut v);
+        } else {
+            // the stepper torque follows the rotor within the control period, and the audit books
+            // the work of every plant step: both see each plant step's start
+            let mut drive = |h: f64, q: &[f64], v: &[f64], u: &mut [f64]| {
+                if let Some(s) = steppers.as_mut() {
                     s.advance(h);
-                    s.torques(q, v, u)
-                },
-                &mut q,
-                &mut v,
-            ),
-            None => plant.advance(model, &mut data, &u, &mut q, &mut v),
+                    s.torques(q, v, u);
+                }
+                if let Some(a) = audit.as_mut() {
+                    a.plant_step(model, h, v, u);
+                }
+            };
+            plant.advance_driven(model, &mut data, &mut u, &mut drive, &mut q, &mut v);
+            if let Some(a) = audit.as_mut() {
+                a.period_end(model, &v);
+            }
         }
         if let Some(s) = steppers.as_mut() {
             s.update(&q, t + dt, &mut lost_events);
@@ -133,98 +141,93 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
             status = diverged;
             break;
         }
-        if let (Some(a), Some(pe)) = (audit.as_mut(), potential) {
-            // the discrete step left M(q_k) in data.mass_matrix
-            if let Some(diverged) = a.step(model, &data, pe, &u, &v, t + dt) {
-                status = diverged;
-                break;
-            }
-        }
     }
-    let summary = stats.finish(status, started.elapsed().as_secs_f64());
+    let mut summary = stats.finish(status, started.elapsed().as_secs_f64());
+    summary.energy_balance = audit.map(|a| EnergyBalance { created: a.created, work: a.work });
     for r in recorders.iter_mut() {
         r.finish(&info, &summary)?;
     }
     Ok(summary)
 }
 
-/// Numerical energy audit of the discrete plant. Over a step the arm's mechanical energy
-/// E = ½ q̇ᵀM(q)q̇ + potential may change only by the work of the held torque and the damping. A
-/// numerically unstable plant creates energy that nothing supplied; more than 1 J, and more than
-/// 1 % of all the work done on the arm so far, is divergence. (On the box model's chattering default
-/// run the books balance to 5 mJ over 5 s; on the mesh model's discrete run 540 J appear.)
+/// Numerical energy audit of the discrete plant. Between control steps the arm's mechanical energy
+/// E = ½ q̇ᵀM(q)q̇ + potential may change only by the work of the torques and the damping over its
+/// plant steps (a stepper's torque changes at each). A numerically unstable plant creates energy that
+/// nothing supplied; more than 1 J, and more than 1 % of all the work done on the arm so far, is
+/// divergence. (On the box model's chattering default run the books balance to 5 mJ over 5 s; on the
+/// mesh model's discrete run 540 J appear.)
 struct EnergyAudit {
-    dt: f64,
-    gravity: nalgebra::Vector3<f64>,
+    /// The last plant step's start: its length, q̇ and torque (booked once the next state is known).
+    step: Option<f64>,
     v_before: Vec<f64>,
+    u_before: Vec<f64>,
     previous_energy: Option<f64>,
-    previous_work: f64,
-    created: f64,
+    /// Work over the control period under way, and the absolute work so far.
+    period_work: f64,
     work: f64,
+    created: f64,
 }
 
 impl EnergyAudit {
-    /// Only for the discrete plant with one step per control period (its step computes M(q_k)); the
-    /// continuous plant controls its own error.
+    /// Only for the discrete plant; the continuous plant controls its own error.
     fn new(experiment: &Experiment) -> Option<Self> {
-        match experiment.plant {
-            crate::experiment::PlantSpec::Discrete { substeps: 1, .. } => Some(Self {
-                dt: experiment.dt(),
-                gravity: experiment.model.gravity,
-                v_before: vec![0.0; experiment.model.dof()],
-                previous_energy: None,
-                previous_work: 0.0,
-                created: 0.0,
-                work: 0.0,
-            }),
-            _ => None,
-        }
+        let n = experiment.model.dof();
+        matches!(experiment.plant, crate::experiment::PlantSpec::Discrete { .. }).then(|| Self {
+            step: None,
+            v_before: vec![0.0; n],
+            u_before: vec![0.0; n],
+            previous_energy: None,
+            period_work: 0.0,
+            work: 0.0,
+            created: 0.0,
+        })
     }
 
-    fn potential_energy(&self, model: &crate::model::Model, data: &Data) -> f64 {
-        model.bodies.iter().enumerate().map(|(i, j)| -j.inertia.mass * self.gravity.dot(&data.body_pose[i].transform_point(&j.inertia.com))).sum()
-    }
-
-    fn remember(&mut self, v: &[f64]) {
-        self.v_before.copy_from_slice(v);
-    }
-
-    /// After the step from (q_k, v_k) to v_{k+1}: books the energy at step k and the work over it.
-    fn step(&mut self, model: &crate::model::Model, data: &Data, potential: f64, u: &[f64], v_after: &[f64], time: f64) -> Option<RunStatus> {
-        let m = &data.mass_matrix;
-        let n = model.dof();
-        let mut kinetic = 0.0;
-        for i in 0..n {
-            let mut row = 0.0;
-            for j in 0..n {
-                row += m[(i, j)] * self.v_before[j];
-            }
-            kinetic += 0.5 * self.v_before[i] * row;
-        }
-        let energy = kinetic + potential;
+    /// At control step k: books E_k against E_{k−1} and the work in between.
+    fn period_start(&mut self, model: &Model, data: &Data, v: &[f64], time: f64) -> Option<RunStatus> {
+        let energy = kinetic_energy_from_velocities(model, data, v) + potential_energy_from_kinematics(model, data);
         if let Some(previous) = self.previous_energy {
-            self.created += energy - previous - self.previous_work;
+            self.created += energy - previous - self.period_work;
         }
         self.previous_energy = Some(energy);
-        let mut work = 0.0;
-        for i in 0..n {
-            let mean = 0.5 * (self.v_before[i] + v_after[i]);
-            work += self.dt * (u[i] - model.joints[i].damping * mean) * mean;
-        }
-        self.previous_work = work;
-        self.work += work.abs();
+        self.period_work = 0.0;
         if self.created > 1.0 && self.created > 0.01 * self.work {
-            let fastest = (0..n).max_by(|&a, &b| v_after[a].abs().total_cmp(&v_after[b].abs())).unwrap_or(0);
+            let fastest = (0..v.len()).max_by(|&a, &b| v[a].abs().total_cmp(&v[b].abs())).unwrap_or(0);
             let joint = model.joints[fastest].name.clone();
             let message = format!(
                 "simulation diverged at t = {time:.3} s: the discrete plant created {:.1} J of energy that no torque supplied \
                  (joint {joint} at q̇ = {:.3e}); the plant is numerically unstable for this model, gains and step: \
                  try the continuous plant with --time-step 0",
-                self.created, v_after[fastest]
+                self.created, v[fastest]
             );
             return Some(RunStatus::Diverged { joint, time, message });
         }
         None
+    }
+
+    /// At the start of a plant step of length h from q̇ with torque u: books the previous plant step.
+    fn plant_step(&mut self, model: &Model, h: f64, v: &[f64], u: &[f64]) {
+        self.book(model, v);
+        self.step = Some(h);
+        self.v_before.copy_from_slice(v);
+        self.u_before.copy_from_slice(u);
+    }
+
+    /// After the control period's last plant step, at q̇_{k+1}.
+    fn period_end(&mut self, model: &Model, v: &[f64]) {
+        self.book(model, v);
+    }
+
+    /// The work of the held torque and the damping over the last plant step, at its mean speed.
+    fn book(&mut self, model: &Model, v_after: &[f64]) {
+        let Some(h) = self.step.take() else { return };
+        let mut work = 0.0;
+        for i in 0..v_after.len() {
+            let mean = 0.5 * (self.v_before[i] + v_after[i]);
+            work += h * (self.u_before[i] - model.joints[i].damping * mean) * mean;
+        }
+        self.period_work += work;
+        self.work += work.abs();
     }
 }
 

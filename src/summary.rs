@@ -26,6 +26,16 @@ pub struct ToolRange {
     pub z: Range,
 }
 
+/// The discrete plant's energy books over a run (see the simulation loop's audit).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct EnergyBalance {
+    /// Mechanical energy that appeared with no torque to supply it, J (negative: lost, as in an
+    /// inelastic stop at a joint limit or the plant's numerical damping).
+    pub created: f64,
+    /// All the work the torques and the damping did on the arm, in absolute value, J.
+    pub work: f64,
+}
+
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Summary {
     pub status: RunStatus,
@@ -57,7 +67,8 @@ pub struct Summary {
     /// its pull-out torque its field gives, sin of the load angle (1 from 90° on).
     #[serde(default)]
     pub peak_torque_share: Vec<f64>,
-    /// Stepper mode: full steps each joint lost over the run (0 where none, or not a stepper).
+    /// Stepper mode: full steps each joint's rotor slipped over the run, either way (0 where none, or not
+    /// a stepper); the recordings carry the net offset the slips left, signed.
     #[serde(default)]
     pub lost_steps: Vec<u64>,
     /// Stepper mode: when each joint first lost steps, s (null if never).
@@ -66,6 +77,9 @@ pub struct Summary {
     /// Steps at which the joint was stopped at a position limit.
     pub limit_hits: Vec<u64>,
     pub tool_range: ToolRange,
+    /// The discrete plant's energy books (null for the continuous plant, which controls its own error).
+    #[serde(default)]
+    pub energy_balance: Option<EnergyBalance>,
     pub wall_time: f64,
 }
 
@@ -202,6 +216,7 @@ impl SummaryBuilder {
             first_lost_step_time: self.first_lost.clone(),
             limit_hits: self.limit_hits.clone(),
             tool_range: ToolRange { x: range(0), y: range(1), z: range(2) },
+            energy_balance: None,
             wall_time,
         }
     }
@@ -226,7 +241,7 @@ impl Summary {
             }
             if chat >= 0.5 * sat {
                 out.push(format!(
-                    "{name}: saturated {sat:.0}% of steps, and the torque flips sign on {chat:.0}% — mostly numerical chatter (the sampled loop is unstable), not torque demand; `armscope analyze` finds stable gains"
+                    "{name}: saturated {sat:.0}% of steps, and the torque flips sign on {chat:.0}% — mostly numerical chatter (the sampled loop is unstable), not torque demand; `armscope analyze` (with the run's --motors) finds stable gains"
                 ));
             } else {
                 out.push(format!("{name}: saturated {sat:.0}% of steps with little chatter ({chat:.0}%) — real torque demand beyond the motor's limit"));

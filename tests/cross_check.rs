@@ -6,7 +6,7 @@
 
 mod common;
 
-use armscope::dynamics::{Data, aba, bias_forces, body_poses, crba, forward_kinematics, frame_jacobian, frame_pose, frame_pose_in, gravity_forces, rnea};
+use armscope::dynamics::{Data, aba, bias_forces, body_poses, crba, forward_kinematics, frame_jacobian, frame_pose, frame_pose_in, gravity_forces, kinetic_energy, kinetic_energy_from_velocities, rnea};
 use armscope::model::load_urdf_str;
 use common::random_tree::{tree, urdf};
 use nalgebra::{DMatrix, DVector};
@@ -69,10 +69,12 @@ proptest! {
         let m = crba(&model, &mut data, &q).clone();
         let vd = DVector::from_vec(v.clone());
         let from_m = 0.5 * vd.dot(&(&m * &vd));
-        // body velocities from RNEA's forward pass
+        let from_bodies = kinetic_energy(&model, &mut data, &q, &v);
+        prop_assert!((from_m - from_bodies).abs() <= 1e-10 * from_m.abs().max(1.0), "½q̇ᵀMq̇ {from_m} vs bodies {from_bodies}");
+        // and from the velocities RNEA's forward pass leaves
         rnea(&model, &mut data, &q, &v, &vec![0.0; v.len()]);
-        let from_bodies: f64 = (0..model.dof()).map(|i| 0.5 * data.velocity[i].dot(&(data.body_inertia[i] * data.velocity[i]))).sum();
-        prop_assert!((from_m - from_bodies).abs() <= 1e-10 * from_m.abs().max(1.0));
+        let after_rnea = kinetic_energy_from_velocities(&model, &data, &v);
+        prop_assert!((from_m - after_rnea).abs() <= 1e-10 * from_m.abs().max(1.0));
     }
 
     #[test]

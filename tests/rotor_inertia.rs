@@ -5,7 +5,7 @@
 
 mod common;
 
-use armscope::dynamics::{Data, aba, bias_forces, crba, gravity_forces, rnea};
+use armscope::dynamics::{Data, aba, bias_forces, crba, gravity_forces, kinetic_energy, rnea};
 use armscope::model::{Model, load_urdf, load_urdf_str};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
@@ -66,7 +66,7 @@ fn aba_crba_and_rnea_agree_with_rotors() {
     let (q, v, tau) = ([0.3, -0.5, 0.8, -1.1, 0.6, 0.2], [0.4, 0.9, -1.2, 0.5, -2.0, 1.0], [1.0, -2.0, 0.5, 0.3, -0.2, 0.1]);
     let m = crba(&model, &mut data, &q).clone();
     let rhs: Vec<f64> = (0..6).map(|i| tau[i] + gravity_forces(&model, &mut Data::new(&model), &q)[i] - bias_forces(&model, &mut Data::new(&model), &q, &v)[i]).collect();
-    let want = m.cholesky().unwrap().solve(&nalgebra::DVector::from_row_slice(&rhs));
+    let want = m.clone().cholesky().unwrap().solve(&nalgebra::DVector::from_row_slice(&rhs));
     let qdd = aba(&model, &mut data, &q, &v, &tau).to_vec();
     for i in 0..6 {
         assert!((qdd[i] - want[i]).abs() <= 1e-10 * want.amax(), "q̈[{i}] {} vs {}", qdd[i], want[i]);
@@ -75,6 +75,11 @@ fn aba_crba_and_rnea_agree_with_rotors() {
     for i in 0..6 {
         assert!((back[i] - tau[i]).abs() <= 1e-10, "RNEA(ABA) τ[{i}] {} vs {}", back[i], tau[i]);
     }
+    // the kinetic energy from the bodies and rotors is ½ q̇ᵀ M q̇ with the rotors on M's diagonal
+    let vd = nalgebra::DVector::from_row_slice(&v);
+    let from_m = 0.5 * vd.dot(&(&m * &vd));
+    let from_bodies = kinetic_energy(&model, &mut data, &q, &v);
+    assert!((from_bodies - from_m).abs() <= 1e-12 * from_m, "kinetic energy {from_bodies} vs ½q̇ᵀMq̇ {from_m}");
 }
 
 /// A passive run (u = 0) from Drake's start pose reproduces Drake's discrete plant step by step:
