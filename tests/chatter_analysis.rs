@@ -102,3 +102,40 @@ fn gains_stable_along_the_wave_run_the_whole_wave_without_chatter() {
         assert!(s["summary"]["max_abs_error"][j].as_f64().unwrap() < 1e-3, "J{} tracks", j + 1);
     }
 }
+
+/// `analyze --motors FILE`: the loop as `run --motors FILE --drive pd` runs it, the rotors' J_r·N²
+/// on M's diagonal (1.8e-3 kg·m² behind J1–J3's 15:1 — more than the box model's wrist links). The
+/// tutorial's gains chatter J4 on most steps on the tutorial's motors; the derivative gains `analyze
+/// --motors --along-command` suggests stop it (under 1 % on every joint: what is left is a burst on
+/// J1 while J2 catches up with the wave's start, 0.45 rad away). Without `--motors` the suggestion
+/// ignores the rotors and is another one.
+#[test]
+fn analyze_with_motors_suggests_gains_that_run_the_motors_without_chatter() {
+    let motors = common::repo().join("assets/motors/tutorial.toml");
+    let motors = motors.to_str().unwrap();
+    let run = |kd: Option<&str>| {
+        let dir = tempfile::tempdir().unwrap();
+        let json = dir.path().join("s.json");
+        let mut args = vec!["run", "--quiet", "--duration", "10", "--motors", motors, "--drive", "pd", "--summary-json", json.to_str().unwrap()];
+        if let Some(kd) = kd {
+            args.extend(["--kd", kd]);
+        }
+        assert_eq!(armscope(&args), 0);
+        let s: Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+        (0..6).map(|j| s["summary"]["chatter_percent"][j].as_f64().unwrap()).collect::<Vec<f64>>()
+    };
+    let tutorial = run(None);
+    assert!(tutorial[3] > 50.0, "the tutorial gains chatter J4 on the motors: {tutorial:?}");
+
+    let doc = analyze(&["--motors", motors, "--along-command"]);
+    assert!(doc["spectral_radius"].as_f64().unwrap() > 1.0, "the tutorial gains are unstable with the rotors");
+    assert!(doc["stable_kd_spectral_radius"].as_f64().unwrap() < 1.0);
+    assert!(doc["run_with_stable_kd"].as_str().unwrap().contains("--motors") && doc["run_with_stable_kd"].as_str().unwrap().contains("--drive pd"));
+    let kd: Vec<f64> = doc["stable_kd"].as_array().unwrap().iter().map(|k| k.as_f64().unwrap()).collect();
+    let listed = kd.iter().map(|k| format!("{k}")).collect::<Vec<_>>().join(",");
+    let suggested = run(Some(&listed));
+    assert!(suggested.iter().all(|&c| c < 1.0), "chatter with kd {listed}: {suggested:?}");
+
+    let bare: Vec<f64> = analyze(&["--along-command"])["stable_kd"].as_array().unwrap().iter().map(|k| k.as_f64().unwrap()).collect();
+    assert!(kd.iter().zip(&bare).any(|(a, b)| (a - b).abs() > 0.1 * a.abs().max(b.abs())), "with rotors {kd:?}, without {bare:?}");
+}

@@ -9,12 +9,12 @@ pub struct AnalyzeArgs {
     /// Control period, s.
     #[arg(long, default_value_t = 0.001)]
     pub dt: f64,
-    #[arg(long, value_delimiter = ',', num_args = 1)]
-    pub kp: Option<Vec<f64>>,
-    #[arg(long, value_delimiter = ',', num_args = 1)]
-    pub kd: Option<Vec<f64>>,
-    #[arg(long)]
-    pub auto_tune: bool,
+    #[command(flatten)]
+    pub gains: GainArgs,
+    /// A motor file: the loop with those motors' rotors (J_r·N² on M's diagonal), as `run --motors
+    /// FILE --drive pd` runs it (an open-loop stepper has no loop to analyse).
+    #[arg(long, value_name = "FILE")]
+    pub motors: Option<PathBuf>,
     #[arg(long)]
     pub no_ff: bool,
     #[arg(long)]
@@ -26,10 +26,8 @@ pub struct AnalyzeArgs {
     /// and suggest kd that is stable at all of them (inertia changes with pose).
     #[arg(long)]
     pub along_command: bool,
-    #[arg(long, default_value_t = 0.5, allow_negative_numbers = true)]
-    pub freq: f64,
-    #[arg(long, default_value_t = 30.0, allow_negative_numbers = true)]
-    pub amp_deg: f64,
+    #[command(flatten)]
+    pub wave: WaveArgs,
     /// The plant in the loop.
     #[arg(long, value_enum, default_value = "discrete")]
     pub plant: crate::diagnose::analysis::LoopPlant,
@@ -41,16 +39,16 @@ pub struct AnalyzeArgs {
 
 /// `armscope analyze`.
 pub fn analyze(args: &AnalyzeArgs) -> Result<i32, Error> {
-    let config = RunConfig {
+    let mut config = RunConfig {
         urdf: args.urdf.clone(),
         dt: args.dt,
-        kp: args.kp.clone(),
-        kd: args.kd.clone(),
-        auto_tune: args.auto_tune,
         no_ff: args.no_ff,
         no_gravity: args.no_gravity,
+        motors: args.motors.clone(),
+        drive: crate::config::DriveMode::Pd,
         ..RunConfig::default()
     };
+    args.gains.apply(&mut config);
     let experiment = Experiment::prepare(config)?;
     let n = experiment.model.dof();
     let pose = args.pose.clone().unwrap_or_else(|| vec![0.0; n]);
@@ -59,8 +57,8 @@ pub fn analyze(args: &AnalyzeArgs) -> Result<i32, Error> {
     }
     // the given pose first, then (--along-command) 12 poses along one period of the wave
     let poses: Vec<Vec<f64>> = if args.along_command {
-        let wave = crate::control::trajectory::Wave { amplitude_rad: args.amp_deg.to_radians(), omega: args.freq };
-        let period = 2.0 * std::f64::consts::PI / args.freq.abs().max(1e-6);
+        let wave = crate::control::trajectory::Wave { amplitude_rad: args.wave.amp_deg.to_radians(), omega: args.wave.freq };
+        let period = 2.0 * std::f64::consts::PI / args.wave.freq.abs().max(1e-6);
         let (mut q, mut qd) = (vec![0.0; n], vec![0.0; n]);
         std::iter::once(pose.clone())
             .chain((0..12).map(|i| {
@@ -71,7 +69,7 @@ pub fn analyze(args: &AnalyzeArgs) -> Result<i32, Error> {
     } else {
         vec![pose]
     };
-    let report = crate::diagnose::loop_report::LoopReport::new(&experiment, &args.urdf, &poses, args.dt, !args.no_ff, args.plant);
+    let report = crate::diagnose::loop_report::LoopReport::new(&experiment, &args.urdf, args.motors.as_deref(), &poses, args.dt, !args.no_ff, args.plant);
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report.to_json(&args.urdf)).unwrap_or_default());
     } else {

@@ -16,10 +16,8 @@ pub struct EnvelopeArgs {
     #[arg(long, default_value_t = 0.0)]
     pub payload: f64,
     /// Gains (default: the model's, with kd made stable by `analyze` at the start pose).
-    #[arg(long, value_delimiter = ',', num_args = 1)]
-    pub kp: Option<Vec<f64>>,
-    #[arg(long, value_delimiter = ',', num_args = 1)]
-    pub kd: Option<Vec<f64>>,
+    #[command(flatten)]
+    pub gains: GainArgs,
     #[arg(long, default_value_t = 0.001)]
     pub dt: f64,
     /// Output folder.
@@ -28,12 +26,9 @@ pub struct EnvelopeArgs {
     /// Cells simulated at once (default: all cores).
     #[arg(long)]
     pub jobs: Option<usize>,
-    /// A motor file: the need is compared with what each motor gives at the joint's speed.
-    #[arg(long, value_name = "FILE")]
-    pub motors: Option<PathBuf>,
-    /// Stepper joints open loop or under PD in the simulated cells (as `run`).
-    #[arg(long, value_enum, default_value = "stepper")]
-    pub drive: crate::config::DriveMode,
+    /// The need is compared with what each motor gives at the joint's speed.
+    #[command(flatten)]
+    pub motors: MotorArgs,
 }
 
 
@@ -50,12 +45,14 @@ pub fn envelope(args: &EnvelopeArgs) -> Result<i32, Error> {
         return Err(Error::flag("--payload", "must be a mass in kg, not negative"));
     }
     let model = with_payload(crate::model::load_urdf(&args.urdf)?, args.payload);
-    let mut config = RunConfig { urdf: args.urdf.clone(), dt: args.dt, kp: args.kp.clone(), kd: args.kd.clone(), motors: args.motors.clone(), drive: args.drive, ..RunConfig::default() };
+    let mut config = RunConfig { urdf: args.urdf.clone(), dt: args.dt, motors: args.motors.motors.clone(), drive: args.motors.drive, ..RunConfig::default() };
+    args.gains.apply(&mut config);
     let probe = Experiment::with_model(config.clone(), model.clone())?;
     let (kp, kd) = probe.controller().effective_gains();
-    let lin = Linearization::at(&model, &vec![0.0; model.dof()]);
+    // the loop as it runs: the probe's model has the motors' rotors on M's diagonal
+    let lin = Linearization::at(&probe.model, &vec![0.0; model.dof()]);
     let (rho, _) = spectral_radius(&lin.closed_loop(&kp, &kd, args.dt, true, LoopPlant::Discrete));
-    if args.kd.is_none() && rho >= 1.0 {
+    if args.gains.kd.is_none() && rho >= 1.0 {
         let (kd, stable) = stabilizing_kd(&lin, &kp, &kd, args.dt, true, LoopPlant::Discrete);
         println!("gains {} are unstable at dt = {} ms (spectral radius {rho:.2}); using kd = {kd:.4?} (spectral radius {stable:.3})", probe.gains.source, args.dt * 1e3);
         config.kd = Some(kd);
@@ -76,7 +73,7 @@ pub fn envelope(args: &EnvelopeArgs) -> Result<i32, Error> {
             continue;
         }
         let values: Vec<Vec<f64>> = (0..amps.len()).map(|a| (0..freqs.len()).map(|f| env.cell(a, f).demand[j]).collect()).collect();
-        let limit = if args.motors.is_some() { "AT SPEED".to_string() } else { format!("{} NM", env.effort[j]) };
+        let limit = if args.motors.motors.is_some() { "AT SPEED".to_string() } else { format!("{} NM", env.effort[j]) };
         let title = format!("{name} NEEDED TORQUE / LIMIT ({limit}){}", if args.payload > 0.0 { format!(", PAYLOAD {} KG", args.payload) } else { String::new() });
         let canvas = crate::diagnose::heatmap::heatmap(&title, "WAVE FREQUENCY (RAD/S)", &x_ticks, "AMPLITUDE (DEG)", &y_ticks, &values);
         let png = args.out.join(format!("envelope_{name}.png"));

@@ -6,6 +6,7 @@ mod compare;
 mod envelope;
 mod model;
 mod run;
+mod shared;
 mod size;
 mod trajectory;
 
@@ -15,6 +16,7 @@ pub use compare::{CompareArgs, compare};
 pub use envelope::{EnvelopeArgs, envelope};
 pub use model::{ModelArgs, model};
 pub use run::{RunArgs, default_run_name, run};
+pub use shared::{GainArgs, MotorArgs, WaveArgs};
 pub use size::{SizeArgs, parse_ratios, size};
 pub use trajectory::{TrajectoryArgs, trajectory};
 

@@ -29,21 +29,10 @@ pub struct RunArgs {
     /// Absolute tolerance of the continuous plant.
     #[arg(long, default_value_t = defaults().atol)]
     pub atol: f64,
-    /// Wave frequency ω, rad/s.
-    #[arg(long, allow_negative_numbers = true, default_value_t = defaults().freq)]
-    pub freq: f64,
-    /// Wave amplitude, degrees.
-    #[arg(long, allow_negative_numbers = true, default_value_t = defaults().amp_deg)]
-    pub amp_deg: f64,
-    /// Proportional gains: one value for every joint or a comma list, one per joint.
-    #[arg(long, value_delimiter = ',', num_args = 1)]
-    pub kp: Option<Vec<f64>>,
-    /// Derivative gains: one value for every joint or a comma list, one per joint.
-    #[arg(long, value_delimiter = ',', num_args = 1)]
-    pub kd: Option<Vec<f64>>,
-    /// Tune gains from the mass matrix (default for models without tutorial gains).
-    #[arg(long)]
-    pub auto_tune: bool,
+    #[command(flatten)]
+    pub wave: WaveArgs,
+    #[command(flatten)]
+    pub gains: GainArgs,
     /// Interval of the --csv rows, s.
     #[arg(long, value_name = "SECONDS", default_value_t = defaults().print_every)]
     pub print_every: f64,
@@ -87,15 +76,8 @@ pub struct RunArgs {
     /// (default: each joint's 0 clamped into its range). The default wave swings around them.
     #[arg(long, value_name = "LIST", allow_hyphen_values = true)]
     pub q0: Option<String>,
-    /// A motor file (TOML): each joint's motor from the catalogue (assets/motors/catalogue.toml, built
-    /// in) and its gearbox (ratio, efficiency, rated torque); the torque a joint can get then falls
-    /// with its speed. E.g. assets/motors/tutorial.toml.
-    #[arg(long, value_name = "FILE")]
-    pub motors: Option<PathBuf>,
-    /// Joints whose motor is a stepper: `stepper` drives them open loop (the command in microsteps;
-    /// steps can be lost), `pd` runs the tutorial's PD controller on their pull-out torque.
-    #[arg(long, value_enum, default_value = "stepper")]
-    pub drive: crate::config::DriveMode,
+    #[command(flatten)]
+    pub motors: MotorArgs,
 
     /// Write the tutorial's CSV (t, q, tool xyz every --print-every).
     #[arg(long, value_name = "PATH")]
@@ -198,11 +180,11 @@ impl RunArgs {
             integrator: self.integrator,
             rtol: self.rtol,
             atol: self.atol,
-            freq: self.freq,
-            amp_deg: self.amp_deg,
-            kp: self.kp.clone(),
-            kd: self.kd.clone(),
-            auto_tune: self.auto_tune,
+            freq: self.wave.freq,
+            amp_deg: self.wave.amp_deg,
+            kp: self.gains.kp.clone(),
+            kd: self.gains.kd.clone(),
+            auto_tune: self.gains.auto_tune,
             print_every: self.print_every,
             hold: self.hold,
             no_ff: self.no_ff,
@@ -217,8 +199,8 @@ impl RunArgs {
             divergence_speed: self.divergence_speed,
             strict_inertia: self.strict_inertia,
             q0: self.q0.clone(),
-            motors: self.motors.clone(),
-            drive: self.drive,
+            motors: self.motors.motors.clone(),
+            drive: self.motors.drive,
         }
     }
 }

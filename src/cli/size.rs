@@ -8,12 +8,9 @@ use crate::diagnose::size::{SizeRequest, size as size_joints};
 pub struct SizeArgs {
     #[arg(long, value_name = "PATH", default_value = crate::config::DEFAULT_URDF)]
     pub urdf: PathBuf,
-    /// The motion: the wave's frequency ω, rad/s (as `run`).
-    #[arg(long, default_value_t = RunConfig::default().freq)]
-    pub freq: f64,
-    /// The wave's amplitude, degrees.
-    #[arg(long, default_value_t = RunConfig::default().amp_deg)]
-    pub amp_deg: f64,
+    /// The motion: the wave (as `run`), …
+    #[command(flatten)]
+    pub wave: WaveArgs,
     /// The motion: a joint schedule (CSV or .npy, as `run --trajectory`) instead of the wave.
     #[arg(long, value_name = "FILE")]
     pub trajectory: Option<PathBuf>,
@@ -121,8 +118,8 @@ pub fn parse_ratios(specs: &[String], joints: &[String]) -> Result<Vec<Vec<f64>>
 fn motions(args: &SizeArgs) -> Result<Vec<(String, RunConfig)>, Error> {
     let base = RunConfig {
         urdf: args.urdf.clone(),
-        freq: args.freq,
-        amp_deg: args.amp_deg,
+        freq: args.wave.freq,
+        amp_deg: args.wave.amp_deg,
         trajectory: args.trajectory.clone(),
         duration: args.duration,
         dt: args.dt,
@@ -136,7 +133,7 @@ fn motions(args: &SizeArgs) -> Result<Vec<(String, RunConfig)>, Error> {
         ..RunConfig::default()
     };
     let Some(path) = &args.manifest else {
-        let name = if args.trajectory.is_some() { "trajectory".to_string() } else { format!("wave ω = {} rad/s, {}°, {} s", args.freq, args.amp_deg, args.duration) };
+        let name = if args.trajectory.is_some() { "trajectory".to_string() } else { format!("wave ω = {} rad/s, {}°, {} s", args.wave.freq, args.wave.amp_deg, args.duration) };
         return Ok(vec![(name, base)]);
     };
     let manifest = crate::batch::load_manifest(path)?;
@@ -260,7 +257,7 @@ pub fn size(args: &SizeArgs) -> Result<i32, Error> {
         }
         match &args.trajectory {
             Some(t) => command += &format!(" --trajectory {}", t.display()),
-            None => command += &format!(" --freq {} --amp-deg {}", args.freq, args.amp_deg),
+            None => command += &format!(" --freq {} --amp-deg {}", args.wave.freq, args.wave.amp_deg),
         }
         if args.duration != RunConfig::default().duration {
             command += &format!(" --duration {}", args.duration);

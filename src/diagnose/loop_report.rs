@@ -31,7 +31,8 @@ pub struct LoopReport {
 }
 
 impl LoopReport {
-    pub fn new(experiment: &Experiment, urdf: &Path, poses: &[Vec<f64>], dt: f64, feed_forward: bool, plant: LoopPlant) -> Self {
+    /// `motors`: the motor file the experiment has (the loop then runs as `run --motors FILE --drive pd`).
+    pub fn new(experiment: &Experiment, urdf: &Path, motors: Option<&Path>, poses: &[Vec<f64>], dt: f64, feed_forward: bool, plant: LoopPlant) -> Self {
         let model = &*experiment.model;
         let (kp, kd) = experiment.controller().effective_gains();
         let lins: Vec<Linearization> = poses.iter().map(|p| Linearization::at(model, p)).collect();
@@ -41,8 +42,9 @@ impl LoopReport {
         let (stable_kd, stable_kd_radius) = stabilizing_kd_over(&lins, &kp, &kd, dt, feed_forward, plant);
         let kd_list = stable_kd.iter().map(|k| format!("{k:.4}")).collect::<Vec<_>>().join(",");
         let run_hint = format!(
-            "armscope run --urdf {}{} --kp {} --kd {kd_list}{}",
+            "armscope run --urdf {}{}{} --kp {} --kd {kd_list}{}",
             urdf.display(),
+            motors.map_or(String::new(), |m| format!(" --motors {} --drive pd", m.display())),
             if plant == LoopPlant::Continuous { " --time-step 0" } else { "" },
             kp.iter().map(|k| format!("{k}")).collect::<Vec<_>>().join(","),
             if dt != 0.001 { format!(" --dt {dt}") } else { String::new() }
