@@ -344,6 +344,7 @@ fn stepper_setup(config: &RunConfig, model: &mut Model, motors: &MotorSet, traje
     let biggest = (0..model.dof()).map(|j| (sagged[j] - energized[j]).abs()).fold(0.0, f64::max);
     *start = sagged;
     model.notices.push(format!("stepper mode: the arm starts at rest, held by its steppers, each lagging by the load angle that carries its weight (at most {biggest:.2e} rad at a joint)"));
+    generator_lag_notices(&steppers, model, trajectory, config, motors);
     if let PlantSpec::Discrete { substeps, .. } = *plant {
         let needed = stepper_substeps(&steppers, model, trajectory, start, config);
         if needed > substeps {
@@ -363,6 +364,25 @@ fn stepper_setup(config: &RunConfig, model: &mut Model, motors: &MotorSet, traje
         }
     }
     Some(steppers)
+}
+
+/// A step generator accelerates no faster than its bound: where the command accelerates faster, the
+/// joint falls behind its command without losing a step — say so, or the tracking error reads as a fault.
+fn generator_lag_notices(steppers: &OpenLoopSteppers, model: &mut Model, trajectory: &dyn Trajectory, config: &RunConfig, motors: &MotorSet) {
+    const PARTS: usize = 64;
+    let samples = along_first_period(config, model, trajectory, 0..PARTS + 1, PARTS);
+    let period = if config.freq > 0.0 { std::f64::consts::TAU / config.freq } else { config.duration };
+    let interval = period.min(config.duration) / PARTS as f64;
+    for (j, bound) in steppers.generator_accelerations() {
+        let peak = samples.windows(2).map(|w| ((w[1].1[j] - w[0].1[j]) / interval).abs()).fold(0.0, f64::max);
+        if peak > bound {
+            let whose = if motors.acceleration[j].is_some() { "the motor file's `acceleration`" } else { "by default half of what its motor spares beyond the weight; the motor file's `acceleration` sets it" };
+            model.notices.push(format!(
+                "stepper mode: joint '{}': the command accelerates at up to {peak:.3} rad/s², its step generator at most {bound:.3} rad/s² ({whose}): the joint will lag its command",
+                model.joints[j].name
+            ));
+        }
+    }
 }
 
 /// Plant steps per control period that keep every stepper joint's oscillation about its stable

@@ -202,6 +202,11 @@ impl OpenLoopSteppers {
         self.joints.iter().map(|s| (s.joint, s.stepper.damping * s.gear_ratio * s.gear_ratio)).collect()
     }
 
+    /// Each stepper joint's step-generator acceleration bound, rad/s² at the joint.
+    pub fn generator_accelerations(&self) -> Vec<(usize, f64)> {
+        self.joints.iter().map(|s| (s.joint, s.max_acceleration)).collect()
+    }
+
     /// The stiffness of each stepper joint about its stable position at rest, η·N²·T_H·N_r (N·m/rad).
     pub fn stiffness(&self) -> Vec<(usize, f64)> {
         self.joints.iter().map(|s| (s.joint, s.efficiency * s.gear_ratio * s.gear_ratio * s.stepper.holding_torque * s.teeth)).collect()
