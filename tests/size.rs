@@ -15,15 +15,19 @@ const MARGIN: f64 = 0.3;
 
 /// Run `armscope size` on the box model; returns its report (size.json) and the motor file.
 fn size(dir: &Path, freq: f64, payload: f64) -> (Value, PathBuf) {
-    let out = dir.join(format!("size_f{freq}_p{payload}"));
+    size_with(dir, &format!("size_f{freq}_p{payload}"), &["--freq", &freq.to_string(), "--payload", &payload.to_string()])
+}
+
+/// `armscope size` on the box model with the steppers and the margin, and the motion of `motion`.
+fn size_with(dir: &Path, label: &str, motion: &[&str]) -> (Value, PathBuf) {
+    let out = dir.join(label);
     let motors = out.join("chosen.toml");
-    let args: Vec<String> = [
-        "armscope", "size", "--urdf", common::box_urdf().to_str().unwrap(), "--freq", &freq.to_string(), "--payload", &payload.to_string(),
-        "--candidates", STEPPERS, "--margin", &MARGIN.to_string(), "--out", out.to_str().unwrap(), "--motors-out", motors.to_str().unwrap(),
-    ]
-    .iter()
-    .map(|s| s.to_string())
-    .collect();
+    let args: Vec<String> = ["armscope", "size", "--urdf", common::box_urdf().to_str().unwrap()]
+        .iter()
+        .chain(motion)
+        .chain(&["--candidates", STEPPERS, "--margin", &MARGIN.to_string(), "--out", out.to_str().unwrap(), "--motors-out", motors.to_str().unwrap()])
+        .map(|s| s.to_string())
+        .collect();
     assert_eq!(armscope::cli::main_with_args(args), 0, "size must find a verified set");
     let report: Value = serde_json::from_str(&std::fs::read_to_string(out.join("size.json")).unwrap()).unwrap();
     for j in 1..=6 {
@@ -115,6 +119,71 @@ fn the_recommendation_is_monotone_in_payload_and_in_speed() {
     }
     // and it does respond: the heaviest payload needs more than none on the shoulder
     assert!(strength(&by_payload[2]["joints"][1]) > strength(&by_payload[0]["joints"][1]));
+}
+
+/// `--trajectory`: a joint schedule that samples the wave every millisecond (followed by cubic Hermite
+/// interpolation) is the same motion, and gets the same motors: per joint the same motor, and the
+/// same ratio or one next to it (the schedule's acceleration is the interpolation's, piecewise linear,
+/// within 1e-4 of the wave's at 1 ms).
+#[test]
+fn a_schedule_sampling_the_wave_is_sized_as_the_wave() {
+    let dir = tempfile::tempdir().unwrap();
+    let (freq, payload, duration) = (1.2, 0.5, 10.0);
+    let wave = Experiment::prepare(RunConfig { urdf: common::box_urdf(), freq, duration, ..RunConfig::default() }).unwrap();
+    let mut csv = String::from("t,q1,q2,q3,q4,q5,q6\n");
+    let (mut q, mut qd) = (vec![0.0; 6], vec![0.0; 6]);
+    for k in 0..=(duration * 1000.0) as usize {
+        let t = k as f64 * 1e-3;
+        wave.trajectory.sample(t, &mut q, &mut qd);
+        csv += &format!("{t},{}\n", q.iter().map(|x| format!("{x:e}")).collect::<Vec<_>>().join(","));
+    }
+    let schedule = dir.path().join("wave.csv");
+    std::fs::write(&schedule, csv).unwrap();
+    let (d, p) = (duration.to_string(), payload.to_string());
+    let (by_wave, _) = size_with(dir.path(), "wave", &["--freq", &freq.to_string(), "--payload", &p, "--duration", &d]);
+    let (by_schedule, motors) = size_with(dir.path(), "schedule", &["--trajectory", schedule.to_str().unwrap(), "--payload", &p, "--duration", &d]);
+    assert_eq!(by_schedule["verified"], Value::Bool(true));
+    for j in 0..6 {
+        let (a, b) = (chosen(&by_wave["joints"][j]), chosen(&by_schedule["joints"][j]));
+        assert_eq!(a["motor"], b["motor"], "J{}", j + 1);
+        let (ra, rb) = (a["ratio"].as_f64().unwrap(), b["ratio"].as_f64().unwrap());
+        assert!((ra - rb).abs() <= 1.0, "J{}: {ra}:1 for the wave, {rb}:1 for its schedule", j + 1);
+    }
+    // and the file it wrote carries the schedule in a full run
+    let config = RunConfig { urdf: common::box_urdf(), motors: Some(motors), trajectory: Some(schedule), duration, payload, ..RunConfig::default() };
+    let summary = simulate(&Experiment::prepare(config).unwrap(), &mut [], None).unwrap();
+    assert_eq!(summary.lost_steps, [0; 6]);
+}
+
+/// `--manifest`: every experiment must pass. A slow wave with a heavy tool and a fast wave with none
+/// ask different joints for different things; the set sized for both is on every joint at least as
+/// strong as the set sized for either alone, and carries each of them in a full run (no lost steps,
+/// within the margin); a rejection names the experiment where it fell short.
+#[test]
+fn a_manifest_is_sized_for_every_experiment_in_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let manifest = dir.path().join("both.toml");
+    std::fs::write(&manifest, "name = \"both\"\n\n[[experiment]]\nname = \"slow-heavy\"\nfreq = 0.3\npayload = 1.0\nduration = 10\n\n[[experiment]]\nname = \"fast\"\nfreq = 1.2\nduration = 10\n").unwrap();
+    let (slow, _) = size_with(dir.path(), "slow", &["--freq", "0.3", "--payload", "1.0", "--duration", "10"]);
+    let (fast, _) = size_with(dir.path(), "fast", &["--freq", "1.2", "--duration", "10"]);
+    let (both, motors) = size_with(dir.path(), "both", &["--manifest", manifest.to_str().unwrap()]);
+    assert_eq!(both["verified"], Value::Bool(true));
+    for j in 0..6 {
+        let (s, f, b) = (strength(&slow["joints"][j]), strength(&fast["joints"][j]), strength(&both["joints"][j]));
+        assert!(b >= s && b >= f, "J{}: both {b:?}, slow-heavy alone {s:?}, fast alone {f:?}", j + 1);
+    }
+    let allowed = 1.0 / (1.0 + MARGIN);
+    for (freq, payload) in [(0.3, 1.0), (1.2, 0.0)] {
+        let config = RunConfig { urdf: common::box_urdf(), motors: Some(motors.clone()), freq, payload, duration: 10.0, ..RunConfig::default() };
+        let summary = simulate(&Experiment::prepare(config).unwrap(), &mut [], None).unwrap();
+        for j in 0..6 {
+            assert_eq!(summary.lost_steps[j], 0, "J{} at ω = {freq}", j + 1);
+            assert!(summary.peak_torque_share[j] <= allowed, "J{} at ω = {freq}: {:.3}", j + 1, summary.peak_torque_share[j]);
+        }
+    }
+    let md = std::fs::read_to_string(dir.path().join("both/size.md")).unwrap();
+    assert!(md.contains("slow-heavy") && md.contains("fast"), "the report names the experiments");
+    assert!(md.contains(" of 'slow-heavy'") || md.contains(" of 'fast'"), "a rejection says in which experiment it fell short:\n{md}");
 }
 
 /// Ratio specs: ranges, steps, lists and per-joint overrides; bad ones name the flag.

@@ -17,9 +17,9 @@ pub struct SizeArgs {
     /// The motion: every experiment of a batch manifest (each must pass; their `motors` are replaced).
     #[arg(long, value_name = "FILE", conflicts_with_all = ["trajectory"])]
     pub manifest: Option<PathBuf>,
-    /// Simulated time of the wave or schedule, s.
-    #[arg(long, default_value_t = RunConfig::default().duration)]
-    pub duration: f64,
+    /// Simulated time of the wave or schedule, s (default: the schedule's length, or as `run`).
+    #[arg(long, value_name = "SECONDS")]
+    pub duration: Option<f64>,
     #[arg(long, default_value_t = RunConfig::default().dt)]
     pub dt: f64,
     /// Initial joint positions (as `run --q0`).
@@ -114,14 +114,30 @@ pub fn parse_ratios(specs: &[String], joints: &[String]) -> Result<Vec<Vec<f64>>
     Ok(per_joint.into_iter().map(|r| r.unwrap_or_else(|| all.clone())).collect())
 }
 
+/// The simulated time: `--duration`, else a schedule's own length (held after its end, it would
+/// stop dead), else `run`'s default.
+fn duration(args: &SizeArgs) -> Result<f64, Error> {
+    if let Some(d) = args.duration {
+        return Ok(d);
+    }
+    match &args.trajectory {
+        Some(path) => {
+            let dof = crate::model::load_urdf(&args.urdf)?.dof();
+            Ok(crate::control::trajectory::JointSchedule::load(path, dof)?.duration())
+        }
+        None => Ok(RunConfig::default().duration),
+    }
+}
+
 /// The motions to size for: the wave or schedule of the flags, or every experiment of the manifest.
 fn motions(args: &SizeArgs) -> Result<Vec<(String, RunConfig)>, Error> {
+    let duration = duration(args)?;
     let base = RunConfig {
         urdf: args.urdf.clone(),
         freq: args.wave.freq,
         amp_deg: args.wave.amp_deg,
         trajectory: args.trajectory.clone(),
-        duration: args.duration,
+        duration,
         dt: args.dt,
         q0: args.q0.clone(),
         tool: args.tool.clone(),
@@ -133,7 +149,7 @@ fn motions(args: &SizeArgs) -> Result<Vec<(String, RunConfig)>, Error> {
         ..RunConfig::default()
     };
     let Some(path) = &args.manifest else {
-        let name = if args.trajectory.is_some() { "trajectory".to_string() } else { format!("wave ω = {} rad/s, {}°, {} s", args.wave.freq, args.wave.amp_deg, args.duration) };
+        let name = if args.trajectory.is_some() { "trajectory".to_string() } else { format!("wave ω = {} rad/s, {}°, {duration} s", args.wave.freq, args.wave.amp_deg) };
         return Ok(vec![(name, base)]);
     };
     let manifest = crate::batch::load_manifest(path)?;
@@ -259,8 +275,9 @@ pub fn size(args: &SizeArgs) -> Result<i32, Error> {
             Some(t) => command += &format!(" --trajectory {}", t.display()),
             None => command += &format!(" --freq {} --amp-deg {}", args.wave.freq, args.wave.amp_deg),
         }
-        if args.duration != RunConfig::default().duration {
-            command += &format!(" --duration {}", args.duration);
+        let duration = request.motions[0].1.duration;
+        if args.manifest.is_none() && duration != RunConfig::default().duration {
+            command += &format!(" --duration {duration}");
         }
         if args.payload > 0.0 {
             command += &format!(" --payload {}", args.payload);

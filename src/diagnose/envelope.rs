@@ -76,7 +76,9 @@ pub fn need(model: &Model, trajectory: &dyn Trajectory, duration: f64, dt: f64, 
 
 /// Walk the commanded motion every `dt` from 0 to `duration`: `visit(t, q̇, q̈, τ)` with τ the
 /// inverse dynamics of following it exactly (RNEA plus the joints' damping) — what a perfect
-/// controller must supply. q̈ is the central difference of the commanded velocity.
+/// controller must supply. q̈ is the central difference of the commanded velocity, one-sided at the
+/// ends: a command that starts (or stops) moving at full speed steps its velocity there, which no
+/// drive follows and no drive is sized for (the controller or step generator ramps it).
 pub fn along_commanded_motion(model: &Model, trajectory: &dyn Trajectory, duration: f64, dt: f64, mut visit: impl FnMut(f64, &[f64], &[f64], &[f64])) {
     let n = model.dof();
     let mut data = Data::new(model);
@@ -86,10 +88,15 @@ pub fn along_commanded_motion(model: &Model, trajectory: &dyn Trajectory, durati
     let steps = (duration / dt).ceil() as usize;
     for k in 0..=steps {
         let t = k as f64 * dt;
-        trajectory.sample(t + eps, &mut q, &mut qd_after);
-        trajectory.sample(t - eps, &mut q, &mut qd_before);
+        let (before, after) = match k {
+            0 => (t + eps, t + 3.0 * eps),
+            _ if k == steps => (t - 3.0 * eps, t - eps),
+            _ => (t - eps, t + eps),
+        };
+        trajectory.sample(after, &mut q, &mut qd_after);
+        trajectory.sample(before, &mut q, &mut qd_before);
         for j in 0..n {
-            qdd[j] = (qd_after[j] - qd_before[j]) / (2.0 * eps);
+            qdd[j] = (qd_after[j] - qd_before[j]) / (after - before);
         }
         trajectory.sample(t, &mut q, &mut qd);
         let tau = rnea(model, &mut data, &q, &qd, &qdd);

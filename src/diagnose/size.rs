@@ -55,28 +55,63 @@ pub struct SizeRequest {
 #[serde(tag = "reason", rename_all = "snake_case")]
 pub enum Shortfall {
     /// Not enough torque even where the motor gives its full torque (low speed).
-    Torque { t: f64, need: f64, available: f64 },
+    Torque { at: Instant, need: f64, available: f64 },
     /// The motor's torque has fallen with speed (pull-out curve, servo line): too fast for this ratio.
-    Speed { t: f64, motor_rev_s: f64, need: f64, available: f64 },
+    Speed { at: Instant, motor_rev_s: f64, need: f64, available: f64 },
     /// The gearbox's rated output torque is the limit.
-    Gearbox { t: f64, need: f64, rated: f64 },
+    Gearbox { at: Instant, need: f64, rated: f64 },
     /// Without its own rotor's J_r·N² the motion would fit: the reflected inertia breaks it.
-    ReflectedInertia { t: f64, reflected: f64, need: f64, available: f64 },
+    ReflectedInertia { at: Instant, reflected: f64, need: f64, available: f64 },
+}
+
+/// An instant of the motion: a time in one of its experiments (named when the motion has several).
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct Instant {
+    pub t: f64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub experiment: Option<String>,
+}
+
+impl std::fmt::Display for Instant {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "t = {:.2} s", self.t)?;
+        match &self.experiment {
+            Some(name) => write!(f, " of '{name}'"),
+            None => Ok(()),
+        }
+    }
 }
 
 impl Shortfall {
     pub fn describe(&self) -> String {
         match self {
-            Shortfall::Torque { t, need, available } => format!("torque at low speed: needs {need:.2} N·m with the margin at t = {t:.2} s, gets {available:.2}"),
-            Shortfall::Speed { t, motor_rev_s, need, available } => {
-                format!("speed: at {motor_rev_s:.1} rev/s (with the margin) the motor's torque has fallen, {available:.2} N·m for {need:.2} needed at t = {t:.2} s")
+            Shortfall::Torque { at, need, available } => {
+                let (need, available) = distinct(*need, *available);
+                format!("torque at low speed: needs {need} N·m with the margin at {at}, gets {available}")
             }
-            Shortfall::Gearbox { t, need, rated } => format!("gearbox rating: {need:.2} N·m needed at t = {t:.2} s, rated {rated:.2}"),
-            Shortfall::ReflectedInertia { t, reflected, need, available } => {
-                format!("reflected inertia: the rotor's J_r·N² = {reflected:.3} kg·m² raises the need to {need:.2} N·m at t = {t:.2} s, gets {available:.2}")
+            Shortfall::Speed { at, motor_rev_s, need, available } => {
+                let (need, available) = distinct(*need, *available);
+                format!("speed: at {motor_rev_s:.1} rev/s (with the margin) the motor's torque has fallen, {available} N·m for {need} needed at {at}")
+            }
+            Shortfall::Gearbox { at, need, rated } => {
+                let (need, rated) = distinct(*need, *rated);
+                format!("gearbox rating: {need} N·m needed at {at}, rated {rated}")
+            }
+            Shortfall::ReflectedInertia { at, reflected, need, available } => {
+                let (need, available) = distinct(*need, *available);
+                format!("reflected inertia: the rotor's J_r·N² = {reflected:.3} kg·m² raises the need to {need} N·m at {at}, gets {available}")
             }
         }
     }
+}
+
+/// Two torques printed with as many decimals (2 to 4) as it takes to show that they differ.
+fn distinct(a: f64, b: f64) -> (String, String) {
+    let mut digits = 2;
+    while digits < 4 && format!("{a:.digits$}") == format!("{b:.digits$}") {
+        digits += 1;
+    }
+    (format!("{a:.digits$}"), format!("{b:.digits$}"))
 }
 
 /// One (motor, ratio) for one joint, rated on the commanded motion.
@@ -156,6 +191,10 @@ pub struct SizeReport {
 /// any rotor (the rotor's share differs per candidate).
 struct Motion {
     t: Vec<f64>,
+    /// Per sample, the experiment it belongs to (an index into `names`).
+    experiment: Vec<usize>,
+    /// The experiments' names; empty for a single motion.
+    names: Vec<String>,
     speed: Vec<Vec<f64>>,
     acceleration: Vec<Vec<f64>>,
     torque: Vec<Vec<f64>>,
@@ -163,14 +202,16 @@ struct Motion {
 
 fn commanded_motion(request: &SizeRequest) -> Result<Motion, Error> {
     let n = request.model.dof();
-    let mut motion = Motion { t: Vec::new(), speed: vec![Vec::new(); n], acceleration: vec![Vec::new(); n], torque: vec![Vec::new(); n] };
-    for (_, config) in &request.motions {
+    let names = if request.motions.len() > 1 { request.motions.iter().map(|(name, _)| name.clone()).collect() } else { Vec::new() };
+    let mut motion = Motion { t: Vec::new(), experiment: Vec::new(), names, speed: vec![Vec::new(); n], acceleration: vec![Vec::new(); n], torque: vec![Vec::new(); n] };
+    for (index, (_, config)) in request.motions.iter().enumerate() {
         let experiment = Experiment::with_model(RunConfig { motors: None, ..config.clone() }, request.model.clone())?;
         let mut model = (*experiment.model).clone();
         model.armature = vec![0.0; n];
         let dt = config.dt;
         along_commanded_motion(&model, experiment.trajectory.as_ref(), config.duration, dt, |t, qd, qdd, tau| {
             motion.t.push(t);
+            motion.experiment.push(index);
             for j in 0..n {
                 motion.speed[j].push(qd[j]);
                 motion.acceleration[j].push(qdd[j]);
@@ -208,7 +249,7 @@ fn rate(drive: &DriveTrain, motion: &Motion, j: usize, margin: f64) -> (f64, f64
     if worst <= 1.0 {
         return (worst, torque_headroom, speed_headroom, None);
     }
-    let t = motion.t[at];
+    let instant = Instant { t: motion.t[at], experiment: motion.names.get(motion.experiment[at]).cloned() };
     let speed = k * motion.speed[j][at];
     let torque = motion.torque[j][at] + reflected * motion.acceleration[j][at];
     let need = k * torque.abs();
@@ -220,13 +261,13 @@ fn rate(drive: &DriveTrain, motion: &Motion, j: usize, margin: f64) -> (f64, f64
         k * torque.abs() <= drive.available(torque, k * motion.speed[j][i])
     });
     let shortfall = if drive.rated_torque < motor_torque {
-        Shortfall::Gearbox { t, need, rated: drive.rated_torque }
+        Shortfall::Gearbox { at: instant, need, rated: drive.rated_torque }
     } else if without_rotor && reflected > 0.0 {
-        Shortfall::ReflectedInertia { t, reflected, need, available }
+        Shortfall::ReflectedInertia { at: instant, reflected, need, available }
     } else if !braking && drive.motor.torque_at(drive.gear_ratio * speed) < 0.9 * drive.motor.torque_at(0.0) {
-        Shortfall::Speed { t, motor_rev_s: (drive.gear_ratio * speed).abs() / std::f64::consts::TAU, need, available }
+        Shortfall::Speed { at: instant, motor_rev_s: (drive.gear_ratio * speed).abs() / std::f64::consts::TAU, need, available }
     } else {
-        Shortfall::Torque { t, need, available }
+        Shortfall::Torque { at: instant, need, available }
     };
     (worst, torque_headroom, speed_headroom, Some(shortfall))
 }
@@ -278,7 +319,7 @@ pub fn size(request: &SizeRequest) -> Result<SizeReport, Error> {
                 sets.push((Some(j), set));
             }
         }
-        let results: Vec<Result<Vec<(u64, f64, Option<String>)>, Error>> = pool.install(|| sets.par_iter().map(|(_, set)| simulate_set(request, &joints, set)).collect());
+        let results: Vec<Result<Vec<JointRun>, Error>> = pool.install(|| sets.par_iter().map(|(_, set)| simulate_set(request, &joints, set)).collect());
         simulations += sets.len();
         let mut results = results.into_iter();
         let whole = results.next().expect("the whole set is always simulated")?;
@@ -334,7 +375,7 @@ pub fn size(request: &SizeRequest) -> Result<SizeReport, Error> {
                     (j, set)
                 })
                 .collect();
-            let results: Vec<Result<Vec<(u64, f64, Option<String>)>, Error>> = pool.install(|| probes.par_iter().map(|(_, set)| simulate_set(request, &joints, set)).collect());
+            let results: Vec<Result<Vec<JointRun>, Error>> = pool.install(|| probes.par_iter().map(|(_, set)| simulate_set(request, &joints, set)).collect());
             simulations += probes.len();
             let mut still = Vec::new();
             for ((j, set), result) in probes.into_iter().zip(results) {
@@ -403,18 +444,31 @@ fn picked(joints: &[JointSizing], pick: &[usize]) -> Vec<Option<usize>> {
     joints.iter().zip(pick).map(|(js, &p)| js.ranked.get(p).copied()).collect()
 }
 
-fn check(candidate: usize, (lost, share, diverged): &(u64, f64, Option<String>), margin: f64) -> SimulatedCheck {
+/// One joint in the simulations of a set over every motion.
+#[derive(Clone, Debug, Default)]
+struct JointRun {
+    lost_steps: u64,
+    peak_torque_share: f64,
+    /// The divergence message, if a run diverged at this joint.
+    diverged: Option<String>,
+    /// Where it did worst, when the motion has several experiments: the first that lost steps, else
+    /// the one with the largest torque share.
+    worst_experiment: Option<String>,
+}
+
+fn check(candidate: usize, run: &JointRun, margin: f64) -> SimulatedCheck {
     let allowed = 1.0 / (1.0 + margin);
-    let note = if let Some(message) = diverged {
+    let inside = run.worst_experiment.as_ref().map_or(String::new(), |name| format!(" (in '{name}')"));
+    let note = if let Some(message) = &run.diverged {
         Some(message.clone())
-    } else if *lost > 0 {
-        Some(format!("lost {lost} full steps"))
-    } else if *share > allowed {
-        Some(format!("used {:.0} % of the torque available at its speed (the margin allows {:.0} %)", 100.0 * share, 100.0 * allowed))
+    } else if run.lost_steps > 0 {
+        Some(format!("lost {} full steps{inside}", run.lost_steps))
+    } else if run.peak_torque_share > allowed {
+        Some(format!("used {:.0} % of the torque available at its speed (the margin allows {:.0} %){inside}", 100.0 * run.peak_torque_share, 100.0 * allowed))
     } else {
         None
     };
-    SimulatedCheck { candidate, lost_steps: *lost, peak_torque_share: *share, passed: note.is_none(), note }
+    SimulatedCheck { candidate, lost_steps: run.lost_steps, peak_torque_share: run.peak_torque_share, passed: note.is_none(), note }
 }
 
 /// The motor set of per-joint candidates (None: the joint keeps its URDF effort).
@@ -433,20 +487,27 @@ pub fn motor_set(request: &SizeRequest, joints: &[JointSizing], set: &[Option<us
 
 /// Simulate every motion with the set; per joint: full steps lost, peak torque share, and the
 /// divergence message if the run diverged on this joint.
-fn simulate_set(request: &SizeRequest, joints: &[JointSizing], set: &[Option<usize>]) -> Result<Vec<(u64, f64, Option<String>)>, Error> {
+fn simulate_set(request: &SizeRequest, joints: &[JointSizing], set: &[Option<usize>]) -> Result<Vec<JointRun>, Error> {
     let n = set.len();
-    let mut out = vec![(0u64, 0.0f64, None); n];
-    for (_, config) in &request.motions {
+    let mut out = vec![JointRun::default(); n];
+    let several = request.motions.len() > 1;
+    for (name, config) in &request.motions {
         let motors = motor_set(request, joints, set)?;
         let experiment = Experiment::with_motors(config.clone(), request.model.clone(), Some(motors))?;
         let summary = crate::sim::simulate(&experiment, &mut [], None)?;
-        for j in 0..n {
-            out[j].0 += summary.lost_steps.get(j).copied().unwrap_or(0);
-            out[j].1 = out[j].1.max(summary.peak_torque_share.get(j).copied().unwrap_or(0.0));
+        for (j, run) in out.iter_mut().enumerate() {
+            let lost = summary.lost_steps.get(j).copied().unwrap_or(0);
+            let share = summary.peak_torque_share.get(j).copied().unwrap_or(0.0);
+            let first_loss = lost > 0 && run.lost_steps == 0;
+            if several && (first_loss || (run.lost_steps == 0 && share > run.peak_torque_share)) {
+                run.worst_experiment = Some(name.clone());
+            }
+            run.lost_steps += lost;
+            run.peak_torque_share = run.peak_torque_share.max(share);
         }
         if let crate::summary::RunStatus::Diverged { joint, message, .. } = &summary.status {
             if let Some(j) = request.model.joint_index(joint) {
-                out[j].2 = Some(message.clone());
+                out[j].diverged = Some(if several { format!("'{name}': {message}") } else { message.clone() });
             }
         }
     }

@@ -70,8 +70,10 @@ impl JointSchedule {
 impl Trajectory for JointSchedule {
     fn sample(&self, t: f64, cmd: &mut [f64], cmd_dot: &mut [f64]) {
         let last = self.times.len() - 1;
-        if t <= self.times[0] || t >= self.times[last] {
-            let k = if t <= self.times[0] { 0 } else { last };
+        // before its start and from its end on the schedule holds still; at its first point it is
+        // already moving (the derivative from the right), as a wave is at t = 0
+        if t < self.times[0] || t >= self.times[last] {
+            let k = if t < self.times[0] { 0 } else { last };
             cmd.copy_from_slice(&self.positions[k]);
             cmd_dot.fill(0.0);
             return;
