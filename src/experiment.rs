@@ -139,16 +139,22 @@ impl Experiment {
     }
 
     /// Where the command puts the tool over the run (forward kinematics of the command), sampled
-    /// every `interval` seconds: the shape the recordings draw as the commanded path.
+    /// every `interval` seconds: the shape the recordings draw as the commanded path. A command
+    /// that repeats itself is drawn over one period (the rest would retrace it), and at most
+    /// `COMMANDED_PATH_POINTS` points are drawn (the interval widens): a drawing, whose size must
+    /// not grow with the run.
     pub fn commanded_tool_path(&self, interval: f64) -> Vec<Vector3<f64>> {
+        const COMMANDED_PATH_POINTS: usize = 20_000;
         let model = &*self.model;
         let n = model.dof();
         let mut poses = vec![crate::spatial::Pose::identity(); model.bodies.len()];
         let (mut cmd, mut cmd_dot) = (vec![0.0; n], vec![0.0; n]);
-        let samples = (self.config.duration / interval).ceil() as usize;
+        let span = self.trajectory.period().map_or(self.config.duration, |p| p.min(self.config.duration));
+        let samples = ((span / interval).ceil() as usize).min(COMMANDED_PATH_POINTS);
+        let interval = span / samples.max(1) as f64;
         (0..=samples)
             .map(|i| {
-                self.trajectory.sample((i as f64 * interval).min(self.config.duration), &mut cmd, &mut cmd_dot);
+                self.trajectory.sample((i as f64 * interval).min(span), &mut cmd, &mut cmd_dot);
                 crate::dynamics::body_poses(model, &cmd, &mut poses);
                 crate::dynamics::frame_pose_in(model, &poses, model.tool_frame).translation
             })
@@ -371,8 +377,7 @@ fn stepper_setup(config: &RunConfig, model: &mut Model, motors: &MotorSet, traje
 fn generator_lag_notices(steppers: &OpenLoopSteppers, model: &mut Model, trajectory: &dyn Trajectory, config: &RunConfig, motors: &MotorSet) {
     const PARTS: usize = 64;
     let samples = along_first_period(config, model, trajectory, 0..PARTS + 1, PARTS);
-    let period = if config.freq > 0.0 { std::f64::consts::TAU / config.freq } else { config.duration };
-    let interval = period.min(config.duration) / PARTS as f64;
+    let interval = trajectory.period().map_or(config.duration, |p| p.min(config.duration)) / PARTS as f64;
     for (j, bound) in steppers.generator_accelerations() {
         let peak = samples.windows(2).map(|w| ((w[1].1[j] - w[0].1[j]) / interval).abs()).fold(0.0, f64::max);
         if peak > bound {
@@ -410,11 +415,10 @@ fn stepper_substeps(steppers: &OpenLoopSteppers, model: &Model, trajectory: &dyn
 }
 
 /// The command at times span·i/`parts` for i in `points`, span its first period (or the whole run,
-/// if shorter or not a wave): each pose clamped into the joints' ranges, and the commanded speed.
+/// if shorter or not periodic): each pose clamped into the joints' ranges, and the commanded speed.
 fn along_first_period(config: &RunConfig, model: &Model, trajectory: &dyn Trajectory, points: std::ops::Range<usize>, parts: usize) -> Vec<(Vec<f64>, Vec<f64>)> {
     let n = model.dof();
-    let period = if config.freq > 0.0 { std::f64::consts::TAU / config.freq } else { config.duration };
-    let span = period.min(config.duration);
+    let span = trajectory.period().map_or(config.duration, |p| p.min(config.duration));
     let (mut cmd, mut cmd_dot) = (vec![0.0; n], vec![0.0; n]);
     points
         .map(|i| {

@@ -4,6 +4,7 @@
 //! [`sample::Sample`]s → [`recorder::Recorder`]s (console, CSV, trace, JSON, …).
 
 pub mod actuator;
+pub mod allocator;
 pub mod batch;
 pub mod builtin;
 pub mod cli;

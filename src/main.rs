@@ -1,4 +1,5 @@
 fn main() {
+    armscope::allocator::return_freed_memory_at_once();
     // before anything else, so that Ctrl-C during start-up also ends the run cleanly
     armscope::cli::install_interrupt_handler();
     std::process::exit(armscope::cli::main_with_args(std::env::args_os()));
@@ -8,3 +9,4 @@ fn main() {
 // glibc's per-thread arenas spend much of that in the kernel (mprotect/madvise).
 #[global_allocator]
 static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+

@@ -373,3 +373,24 @@ fn mcap_tool_path_comes_in_pieces_each_point_once_with_a_bounded_overview_for_se
     assert_eq!(last_overview.first(), want.first());
     assert!(last_overview.len() > 256 && last_overview.iter().all(|p| want.contains(p)));
 }
+
+/// The commanded path the recordings draw does not grow with the run: the default wave repeats
+/// every 2π/ω, so an hour's path is one period's (a closed loop, every 10 ms: 1257 points), as the
+/// 30 s run's; a command that does not repeat (a step) is drawn with at most 20,000 points.
+#[test]
+fn the_commanded_path_drawn_is_bounded_whatever_the_duration() {
+    use armscope::config::RunConfig;
+    use armscope::experiment::Experiment;
+    let path = |extra: fn(&mut RunConfig)| {
+        let mut config = RunConfig { urdf: common::box_urdf(), duration: 3600.0, ..RunConfig::default() };
+        extra(&mut config);
+        Experiment::prepare(config).unwrap().commanded_tool_path(0.01)
+    };
+    let hour = path(|_| {});
+    let short = path(|c| c.duration = 30.0);
+    assert_eq!(hour.len(), short.len());
+    assert_eq!(hour.len(), (std::f64::consts::TAU / 0.5 / 0.01).ceil() as usize + 1);
+    assert!((hour[0] - hour[hour.len() - 1]).norm() < 1e-12, "one whole period: the loop closes");
+    let stepped = path(|c| c.test_joint = Some("2".into()));
+    assert!(stepped.len() <= 20_001, "{}", stepped.len());
+}

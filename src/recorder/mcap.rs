@@ -22,6 +22,7 @@ use foxglove::messages::{
     Point3, PoseInFrame, Quaternion, SceneEntity, SceneUpdate, SpherePrimitive, Timestamp, Vector3,
 };
 use foxglove::Encode;
+use super::overview::Overview;
 use mcap::records::MessageHeader;
 use std::collections::BTreeMap;
 use std::fs::File;
@@ -252,29 +253,22 @@ const PATH_OVERVIEW_POINTS: usize = 512;
 /// of everything so far thinned to at most `PATH_OVERVIEW_POINTS` (one entity, replaced), which is
 /// what a viewer shows after seeking (it shows a topic's latest message). So the topic's size grows
 /// linearly with the duration.
-#[derive(Default)]
 struct ToolPath {
     /// The points since the last piece, starting with the last piece's last point (no gap).
     piece: Vec<Point3>,
     pieces: usize,
-    overview: Vec<Point3>,
-    /// Every `stride`-th point goes into the overview; doubled (and the overview halved) when full.
-    stride: usize,
-    seen: usize,
+    overview: Overview<Point3>,
+}
+
+impl Default for ToolPath {
+    fn default() -> Self {
+        Self { piece: Vec::new(), pieces: 0, overview: Overview::new(PATH_OVERVIEW_POINTS) }
+    }
 }
 
 impl ToolPath {
     fn push(&mut self, p: Point3) {
-        let stride = self.stride.max(1);
-        if self.seen.is_multiple_of(stride) {
-            self.overview.push(p.clone());
-            if self.overview.len() > PATH_OVERVIEW_POINTS {
-                // keep every other point: the overview then holds every (2·stride)-th point
-                self.overview = self.overview.iter().step_by(2).cloned().collect();
-                self.stride = stride * 2;
-            }
-        }
-        self.seen += 1;
+        self.overview.push(p.clone());
         self.piece.push(p);
     }
 
@@ -291,7 +285,7 @@ impl ToolPath {
         let red = color([1.0, 0.25, 0.2, 1.0]);
         let last = self.piece.last().cloned().expect("two points");
         let piece = std::mem::replace(&mut self.piece, vec![last.clone()]);
-        let mut overview = self.overview.clone();
+        let mut overview = self.overview.points().to_vec();
         if overview.last() != Some(&last) {
             overview.push(last);
         }

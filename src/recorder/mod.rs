@@ -6,6 +6,7 @@ pub mod foxglove_layout;
 pub mod foxglove_live;
 mod mcap;
 mod output_file;
+mod overview;
 mod pacer;
 pub mod rrd;
 mod robot_description;

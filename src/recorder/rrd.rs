@@ -3,7 +3,7 @@
 //! are buffered and sent as one chunk per entity and block (per-step `log` calls cost ~170 µs
 //! here; a block of 4096 steps costs ~2.5 µs per step), to the `.rrd` and/or a live viewer.
 
-use super::rrd_file::RrdFile;
+use super::rrd_file::{FOOTER_UP_TO_SECONDS, RrdFile};
 use super::{Recorder, RunInfo};
 use crate::dynamics::frame_pose_in;
 use crate::error::Error;
@@ -15,6 +15,7 @@ use rerun::blueprint::{Blueprint, BlueprintActivation, BlueprintPanel, Grid, Hor
 use rerun::blueprint::components::{PanelState, PlayState};
 use rerun::{RecordingStream, TimeColumn};
 use std::collections::VecDeque;
+use super::overview::Overview;
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -120,7 +121,8 @@ pub struct RerunRecorder {
     /// The trail as it was at each of its updates in this block (sent with the block).
     trail_times: Vec<f64>,
     trail_strips: Vec<Vec<[f32; 3]>>,
-    path: Vec<[f32; 3]>,
+    /// The whole tool path, thinned to at most `PATH_POINTS` (logged once, at the end).
+    path: Overview<[f32; 3]>,
     steps_per_trail_point: usize,
     live: bool,
     last_flush: Instant,
@@ -137,6 +139,9 @@ const BYTES_IN_FLIGHT: u64 = 4 << 20;
 /// A live viewer gets a block at least this often.
 const LIVE_FLUSH: Duration = Duration::from_millis(40);
 const TRAIL_SECONDS: f64 = 2.0;
+/// Points of the whole tool path drawn at the end at most (every trail point up to 6.5 simulated
+/// minutes; evenly thinned beyond: a drawing whose size must not grow with the run).
+const PATH_POINTS: usize = 20_000;
 const TRAIL_RATE_HZ: f64 = 50.0;
 
 impl RerunRecorder {
@@ -160,7 +165,7 @@ impl RerunRecorder {
             trail: VecDeque::new(),
             trail_times: Vec::new(),
             trail_strips: Vec::new(),
-            path: Vec::new(),
+            path: Overview::new(PATH_POINTS),
             steps_per_trail_point: 20,
             live: false,
             last_flush: Instant::now(),
@@ -179,11 +184,22 @@ impl RerunRecorder {
         Error::output(&path, e)
     }
 
-    fn open_stream(&mut self) -> Result<RecordingStream, Error> {
+    /// The stream to the file and the live viewer; `duration` the run's simulated time (a long run's
+    /// file goes without the footer, see [`FOOTER_UP_TO_SECONDS`]).
+    fn open_stream(&mut self, duration: f64) -> Result<RecordingStream, Error> {
         use rerun::sink::{GrpcSink, LogSink};
         let mut sinks: Vec<Box<dyn LogSink>> = Vec::new();
         if let Some(path) = &self.options.file {
-            let file = RrdFile::create(path).map_err(|e| Error::output(path, e))?;
+            let footer = duration <= FOOTER_UP_TO_SECONDS;
+            if !footer {
+                self.notices.push(format!(
+                    "{}: no footer (Rerun's index of the chunks, kept in memory until the end: ~20 MB an hour) for a run over {} simulated minutes; `rerun rrd optimize {} -o OUT.rrd` adds one",
+                    path.display(),
+                    FOOTER_UP_TO_SECONDS / 60.0,
+                    path.display()
+                ));
+            }
+            let file = RrdFile::create(path, footer).map_err(|e| Error::output(path, e))?;
             sinks.push(file.sink());
             self.file = Some(file);
         }
@@ -595,7 +611,7 @@ impl Recorder for RerunRecorder {
     fn start(&mut self, run: &RunInfo) -> Result<(), Error> {
         let e = run.experiment;
         let model = &*e.model;
-        let rec = self.open_stream()?;
+        let rec = self.open_stream(run.experiment.config.duration)?;
         self.joint_names = model.joints.iter().map(|j| j.name.clone()).collect();
         self.effort = e.controller().effort;
         self.stepped = e.stepped_joints();
@@ -698,8 +714,8 @@ impl Recorder for RerunRecorder {
     fn finish(&mut self, _run: &RunInfo, summary: &Summary) -> Result<(), Error> {
         self.flush_block(true)?;
         let Some(rec) = self.rec.take() else { return Ok(()) };
-        if self.path.len() > 1 {
-            rec.log_static("world/tool/path", &rerun::LineStrips3D::new([self.path.clone()]).with_colors([rerun::Color::from_rgb(230, 60, 60)]).with_radii([0.001]))
+        if self.path.points().len() > 1 {
+            rec.log_static("world/tool/path", &rerun::LineStrips3D::new([self.path.points().to_vec()]).with_colors([rerun::Color::from_rgb(230, 60, 60)]).with_radii([0.001]))
                 .map_err(|x| self.err(x))?;
         }
         rec.log_static("summary", &rerun::TextDocument::from_markdown(summary_markdown(summary))).map_err(|x| self.err(x))?;

@@ -50,6 +50,10 @@ impl Trajectory for JointWave {
         }
     }
 
+    fn period(&self) -> Option<f64> {
+        super::wave_period(self.omega)
+    }
+
     fn describe(&self) -> String {
         let list = |v: &[f64]| v.iter().map(|x| format!("{x:.4}")).collect::<Vec<_>>().join(", ");
         format!("wave fitted to the joints: c_i + A_i·sin(ω·t + i·π/3), A = [{}], c = [{}], ω = {} rad/s", list(&self.amplitude), list(&self.centre), self.omega)

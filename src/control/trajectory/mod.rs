@@ -17,4 +17,13 @@ pub trait Trajectory: Send + Sync {
     fn sample(&self, t: f64, cmd: &mut [f64], cmd_dot: &mut [f64]);
     /// One line for the console and the recordings' configuration.
     fn describe(&self) -> String;
+    /// The time after which the command repeats itself, if it does (a wave's 2π/ω).
+    fn period(&self) -> Option<f64> {
+        None
+    }
+}
+
+/// 2π/ω for a wave of angular frequency ω (none for ω = 0: it stands still).
+pub(crate) fn wave_period(omega: f64) -> Option<f64> {
+    (omega != 0.0 && omega.is_finite()).then(|| std::f64::consts::TAU / omega.abs())
 }

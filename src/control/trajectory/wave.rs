@@ -18,6 +18,10 @@ impl Trajectory for Wave {
         }
     }
 
+    fn period(&self) -> Option<f64> {
+        super::wave_period(self.omega)
+    }
+
     fn describe(&self) -> String {
         format!("wave: A·sin(ω·t + i·π/3), A = {:.4} rad ({:.1}°), ω = {} rad/s", self.amplitude_rad, self.amplitude_rad.to_degrees(), self.omega)
     }
