@@ -88,6 +88,7 @@ impl Experiment {
             Some(motors) if config.drive == DriveMode::Stepper && motors.has_steppers() => stepper_setup(&config, &mut model, motors, trajectory.as_ref(), &mut start, &mut plant),
             _ => None,
         };
+        weight_notices(&mut model, &start);
         let gains = gains(&config, &model, &start, trajectory.as_ref(), &plant)?;
         let steps = (config.duration / config.dt - 1e-9).ceil() as usize;
         Ok(Self { config, model: Arc::new(model), gains, plant, trajectory, steps, start, motors, steppers })
@@ -303,6 +304,23 @@ fn gains(config: &RunConfig, model: &Model, start: &[f64], trajectory: &dyn Traj
         (false, true) => format!("kp {}, kd from flags", base.source),
     };
     Ok(Gains { kp, kd, source, effective_inertia: base.effective_inertia, spectral_radius: base.spectral_radius })
+}
+
+/// A joint whose motor cannot carry the arm's weight at the start pose saturates from the first step
+/// on, whatever the controller does: say so before the run, naming the joint and both torques.
+fn weight_notices(model: &mut Model, start: &[f64]) {
+    let tau_g = crate::dynamics::gravity_forces(model, &mut crate::dynamics::Data::new(model), start).to_vec();
+    let effort = model.effort_limits();
+    for j in 0..model.dof() {
+        if model.is_actuated(j) && effort[j] > 0.0 && tau_g[j].abs() > effort[j] {
+            let name = model.joints[j].name.clone();
+            model.notices.push(format!(
+                "joint '{name}': holding the start pose against gravity takes {:.3} N·m, more than its {} N·m: it cannot hold the arm there and will sag (an arm whose real counterbalance springs its URDF leaves out? --q0 starts elsewhere)",
+                tau_g[j].abs(),
+                effort[j]
+            ));
+        }
+    }
 }
 
 /// Give each joint of a motor set its motor: an actuator whose effort is the torque the drive train

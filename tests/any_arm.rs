@@ -347,3 +347,21 @@ fn a_differential_transmission_is_a_notice_and_its_joints_are_driven_directly() 
     assert_eq!(driven, [0, 1]);
     assert_eq!(model.effort_limits(), [5.0, 5.0]);
 }
+
+/// An arm that cannot hold its start pose against gravity is told so before the run, per joint with
+/// both torques: Baxter's shoulders (s1) need 56.4 N·m at every joint's 0, their URDF allows 50 (the
+/// real arm carries counterbalance springs the URDF leaves out); no other joint of it, and nothing on
+/// the tutorial's arm, whose J2 needs 4.43 of its 12 N·m.
+#[test]
+fn an_arm_that_cannot_hold_its_start_pose_is_told_so_per_joint() {
+    use armscope::config::RunConfig;
+    use armscope::experiment::Experiment;
+    let baxter = Experiment::prepare(RunConfig { urdf: common::repo().join("tests/fixtures/robots/baxter.urdf"), ..RunConfig::default() }).unwrap();
+    let said: Vec<&String> = baxter.model.notices.iter().filter(|n| n.contains("against gravity")).collect();
+    assert_eq!(said.len(), 2, "{said:?}");
+    for (notice, joint) in said.iter().zip(["right_s1", "left_s1"]) {
+        assert!(notice.contains(&format!("joint '{joint}'")) && notice.contains("56.4") && notice.contains("50 N·m"), "{notice}");
+    }
+    let tutorial = Experiment::prepare(RunConfig { urdf: common::box_urdf(), ..RunConfig::default() }).unwrap();
+    assert!(!tutorial.model.notices.iter().any(|n| n.contains("against gravity")), "{:?}", tutorial.model.notices);
+}
