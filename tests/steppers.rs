@@ -116,11 +116,12 @@ fn energy_balances(summary: &Summary) {
 }
 
 /// The default wave (0.5 rad/s) is within every joint's pull-out curve and loses nothing; at
-/// `--freq 5.5` J2, whose demand reaches 82 % of its curve, loses steps — already below 100 %: the
-/// rotor rings about its mean load angle whenever the motion's acceleration changes, which is why
-/// steppers are sized with ~30 % headroom — and the joints that need less than half their torque
-/// lose none of their own accord (once J2 slips and the arm swings off its command, others can be
-/// dragged out of step too).
+/// `--freq 5.5` J2, whose demand reaches 82 % of its curve, loses steps — already below 100 %, and
+/// early, as its step generator starts the wave from rest: the rotor rings about its mean load angle
+/// whenever the motion's acceleration changes, which is why steppers are sized with ~30 % headroom
+/// (J2 slips there from 3 rad/s, 57 % of its curve) — and the joints that need less than half their
+/// torque lose none of their own accord (once J2 slips and the arm swings off its command, others can
+/// be dragged out of step too).
 #[test]
 fn a_slow_wave_within_the_pull_out_curve_loses_nothing_a_fast_one_loses_steps_where_demand_exceeds_it() {
     let slow = Experiment::prepare(config("tutorial.toml", |c| c.duration = 10.0)).unwrap();
