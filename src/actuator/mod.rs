@@ -56,19 +56,25 @@ impl DriveTrain {
         (self.efficiency * self.gear_ratio * self.motor.torque_at(self.gear_ratio * speed)).min(self.rated_torque)
     }
 
+    /// What the motor gives at the joint in the direction of `torque` at joint speed `speed`, before
+    /// the gearbox's rating caps it: η·N·T with the motion (its torque–speed curve), η·N·T_braking
+    /// against it. At rest a positive torque counts as with the motion.
+    pub fn motor_torque(&self, torque: f64, speed: f64) -> f64 {
+        let shaft = self.gear_ratio * speed;
+        let braking = if speed >= 0.0 { torque < 0.0 } else { torque >= 0.0 };
+        self.efficiency * self.gear_ratio * if braking { self.motor.braking_torque_at(shaft) } else { self.motor.torque_at(shaft) }
+    }
+
+    /// The torque available in the direction of `torque` at joint speed `speed` (≥ 0): what the
+    /// motor gives there, capped by the gearbox's rating.
+    pub fn available(&self, torque: f64, speed: f64) -> f64 {
+        self.motor_torque(torque, speed).min(self.rated_torque)
+    }
+
     /// The range of torque the joint can get at joint speed `speed`: (lowest ≤ 0, highest ≥ 0). With
     /// the motion the motor's torque–speed curve holds; against it (braking) the motor's braking torque.
     pub fn torque_range(&self, speed: f64) -> (f64, f64) {
-        let at_joint = |t: f64| (self.efficiency * self.gear_ratio * t).min(self.rated_torque);
-        let motoring = at_joint(self.motor.torque_at(self.gear_ratio * speed));
-        let braking = at_joint(self.motor.braking_torque_at(self.gear_ratio * speed));
-        if speed >= 0.0 { (-braking, motoring) } else { (-motoring, braking) }
-    }
-
-    /// The torque available in the direction of `torque` at joint speed `speed` (≥ 0).
-    pub fn available(&self, torque: f64, speed: f64) -> f64 {
-        let (lowest, highest) = self.torque_range(speed);
-        if torque >= 0.0 { highest } else { -lowest }
+        (-self.available(-1.0, speed), self.available(1.0, speed))
     }
 
     /// This drive train followed by a further reduction (a belt or gearbox after a gearmotor): the

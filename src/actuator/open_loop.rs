@@ -43,6 +43,11 @@ struct SteppedJoint {
 }
 
 impl SteppedJoint {
+    /// The holding torque at the joint, η·N·T_H capped by the gearbox's rating.
+    fn holding_at_joint(&self) -> f64 {
+        (self.efficiency * self.gear_ratio * self.stepper.holding_torque).min(self.rated_torque)
+    }
+
     fn lag(&self, q: f64) -> f64 {
         self.command - self.gear_ratio * (q - self.start)
     }
@@ -87,7 +92,7 @@ impl OpenLoopSteppers {
             let Some(DriveTrain { motor, gear_ratio, efficiency, rated_torque }) = drive else { continue };
             let Some(stepper) = motor.as_stepper() else { continue };
             let micro = motors.microsteps.get(j).copied().flatten().unwrap_or(1) as f64;
-            joints.push(SteppedJoint {
+            let mut joint = SteppedJoint {
                 joint: j,
                 gear_ratio: *gear_ratio,
                 efficiency: *efficiency,
@@ -98,16 +103,18 @@ impl OpenLoopSteppers {
                 start: start[j],
                 generator_position: 0.0,
                 generator_velocity: 0.0,
-                max_acceleration: motors.acceleration.get(j).copied().flatten().unwrap_or_else(|| {
-                    // half of what the motor has to spare beyond carrying the weight (at least a tenth
-                    // of its torque): a generator that accelerates with the whole holding torque
-                    // leaves a loaded joint nothing to hold it with
-                    let at_rest = (efficiency * gear_ratio * stepper.holding_torque).min(*rated_torque);
-                    0.5 * (at_rest - load[j].abs()).max(0.2 * at_rest) / inertia[j]
-                }),
+                max_acceleration: 0.0,
                 command: 0.0,
                 lost_steps: 0,
+            };
+            joint.max_acceleration = motors.acceleration.get(j).copied().flatten().unwrap_or_else(|| {
+                // half of what the motor has to spare beyond carrying the weight (at least a tenth
+                // of its torque): a generator that accelerates with the whole holding torque
+                // leaves a loaded joint nothing to hold it with
+                let at_rest = joint.holding_at_joint();
+                0.5 * (at_rest - load[j].abs()).max(0.2 * at_rest) / inertia[j]
             });
+            joints.push(joint);
         }
         if joints.is_empty() {
             return None;
@@ -150,7 +157,7 @@ impl OpenLoopSteppers {
         self.joints
             .iter()
             .map(|s| {
-                let ratio = tau_g[s.joint] / (s.efficiency * s.gear_ratio * s.stepper.holding_torque.min(s.rated_torque / (s.efficiency * s.gear_ratio)));
+                let ratio = tau_g[s.joint] / s.holding_at_joint();
                 (s.joint, (ratio.abs() < 1.0).then(|| ratio.asin() / (s.teeth * s.gear_ratio)))
             })
             .collect()

@@ -254,8 +254,8 @@ fn rate(drive: &DriveTrain, motion: &Motion, j: usize, margin: f64) -> (f64, f64
     let torque = motion.torque[j][at] + reflected * motion.acceleration[j][at];
     let need = k * torque.abs();
     let braking = torque * speed < 0.0;
-    let motor_torque = drive.efficiency * drive.gear_ratio * if braking { drive.motor.braking_torque_at(drive.gear_ratio * speed) } else { drive.motor.torque_at(drive.gear_ratio * speed) };
-    let available = motor_torque.min(drive.rated_torque);
+    let motor_torque = drive.motor_torque(torque, speed);
+    let available = drive.available(torque, speed);
     let without_rotor = (0..motion.t.len()).all(|i| {
         let torque = motion.torque[j][i];
         k * torque.abs() <= drive.available(torque, k * motion.speed[j][i])
