@@ -79,7 +79,7 @@ impl Experiment {
         if !(config.payload >= 0.0 && config.payload.is_finite()) {
             return Err(Error::flag("--payload", format!("must be a mass in kg, not negative (got {})", config.payload)));
         }
-        let mut model = crate::diagnose::envelope::with_payload(model, config.payload);
+        let mut model = model.with_payload(config.payload);
         let motors = motors.map(|set| Arc::new(apply_motor_set(set, &mut model)));
         let mut plant = plant_spec(&config)?;
         let mut start = start_pose(&config, &model)?;
@@ -150,7 +150,7 @@ impl Experiment {
         let n = model.dof();
         let mut poses = vec![crate::spatial::Pose::identity(); model.bodies.len()];
         let (mut cmd, mut cmd_dot) = (vec![0.0; n], vec![0.0; n]);
-        let span = self.trajectory.period().map_or(self.config.duration, |p| p.min(self.config.duration));
+        let span = first_period(self.trajectory.as_ref(), self.config.duration);
         let samples = ((span / interval).ceil() as usize).min(COMMANDED_PATH_POINTS);
         let interval = span / samples.max(1) as f64;
         (0..=samples)
@@ -395,7 +395,7 @@ fn stepper_setup(config: &RunConfig, model: &mut Model, motors: &MotorSet, traje
 fn generator_lag_notices(steppers: &OpenLoopSteppers, model: &mut Model, trajectory: &dyn Trajectory, config: &RunConfig, motors: &MotorSet) {
     const PARTS: usize = 64;
     let samples = along_first_period(config, model, trajectory, 0..PARTS + 1, PARTS);
-    let interval = trajectory.period().map_or(config.duration, |p| p.min(config.duration)) / PARTS as f64;
+    let interval = first_period(trajectory, config.duration) / PARTS as f64;
     for (j, bound) in steppers.generator_accelerations() {
         let peak = samples.windows(2).map(|w| ((w[1].1[j] - w[0].1[j]) / interval).abs()).fold(0.0, f64::max);
         if peak > bound {
@@ -432,11 +432,16 @@ fn stepper_substeps(steppers: &OpenLoopSteppers, model: &Model, trajectory: &dyn
     (by_dynamics.max(by_field).ceil() as usize).max(1)
 }
 
+/// The span of a command worth sampling: its first period, or the whole run if shorter or not periodic.
+fn first_period(trajectory: &dyn Trajectory, duration: f64) -> f64 {
+    trajectory.period().map_or(duration, |p| p.min(duration))
+}
+
 /// The command at times span·i/`parts` for i in `points`, span its first period (or the whole run,
 /// if shorter or not periodic): each pose clamped into the joints' ranges, and the commanded speed.
 fn along_first_period(config: &RunConfig, model: &Model, trajectory: &dyn Trajectory, points: std::ops::Range<usize>, parts: usize) -> Vec<(Vec<f64>, Vec<f64>)> {
     let n = model.dof();
-    let span = trajectory.period().map_or(config.duration, |p| p.min(config.duration));
+    let span = first_period(trajectory, config.duration);
     let (mut cmd, mut cmd_dot) = (vec![0.0; n], vec![0.0; n]);
     points
         .map(|i| {

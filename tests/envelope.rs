@@ -5,7 +5,7 @@ mod common;
 
 use armscope::config::RunConfig;
 use armscope::dynamics::{Data, gravity_forces};
-use armscope::diagnose::envelope::{required_torque, sweep, with_payload};
+use armscope::diagnose::envelope::{required_torque, sweep};
 use armscope::model::load_urdf;
 use armscope::control::trajectory::{Trajectory, Wave};
 use common::{armscope, box_urdf};
@@ -33,7 +33,7 @@ fn a_slow_wave_needs_the_gravity_torque_and_j1_needs_grow_with_frequency() {
     let (a, b) = (j1(1.0), j1(2.0));
     assert!(b > 3.0 * a && b < 5.0 * a, "J1 need at ω = 1: {a}, ω = 2: {b}");
     // a payload at the tool adds its weight times its lever arm to J2 at the stretched pose
-    let heavy = with_payload(model.clone(), 0.5);
+    let heavy = model.clone().with_payload(0.5);
     let still = Wave { amplitude_rad: 0.0, omega: 1.0 };
     let (base, loaded) = (required_torque(&model, &still, 0.1, 0.001), required_torque(&heavy, &still, 0.1, 0.001));
     assert!((loaded[1] - base[1] - 0.5 * 9.81 * 0.62).abs() < 1e-9, "J2: {} → {}", base[1], loaded[1]);
@@ -43,7 +43,7 @@ fn a_slow_wave_needs_the_gravity_torque_and_j1_needs_grow_with_frequency() {
 fn beyond_the_envelope_the_stable_loop_saturates_for_real_and_inside_it_does_not() {
     let model = load_urdf(&box_urdf()).unwrap();
     let config = RunConfig { urdf: box_urdf(), kd: Some(vec![12.0, 14.1254, 0.4297, 0.0016, 0.3733, 0.1]), ..RunConfig::default() };
-    let env = sweep(&config, &model, &[0.5, 12.0], &[10.0, 60.0], 0.0, 2).unwrap();
+    let env = sweep(&config, &model, &[0.5, 12.0], &[10.0, 60.0], 2).unwrap();
     let inside = env.cell(0, 0);
     let outside = env.cell(1, 1);
     for j in 0..6 {
@@ -81,14 +81,14 @@ fn envelope_command_writes_heatmaps_recording_and_table() {
 fn the_demand_is_the_need_over_the_limit_at_speed() {
     let model = armscope::model::load_urdf(&common::box_urdf()).unwrap();
     let plain = RunConfig { urdf: common::box_urdf(), ..RunConfig::default() };
-    let env = sweep(&plain, &model, &[0.5, 8.0], &[30.0], 0.0, 2).unwrap();
+    let env = sweep(&plain, &model, &[0.5, 8.0], &[30.0], 2).unwrap();
     for c in &env.cells {
         for j in 0..6 {
             assert!((c.demand[j] - c.required[j] / env.effort[j]).abs() <= 1e-12 * c.demand[j].max(1.0));
         }
     }
     let motors = RunConfig { motors: Some(common::repo().join("assets/motors/tutorial.toml")), drive: armscope::config::DriveMode::Pd, ..plain };
-    let env = sweep(&motors, &model, &[0.5, 8.0], &[30.0], 0.0, 2).unwrap();
+    let env = sweep(&motors, &model, &[0.5, 8.0], &[30.0], 2).unwrap();
     for c in &env.cells {
         for j in 0..6 {
             assert!(c.demand[j] >= c.required[j] / env.effort[j] - 1e-12, "J{} at ω = {}", j + 1, c.freq);

@@ -35,17 +35,15 @@ pub struct EnvelopeArgs {
 /// `armscope envelope`.
 pub fn envelope(args: &EnvelopeArgs) -> Result<i32, Error> {
     use crate::diagnose::analysis::{Linearization, LoopPlant, spectral_radius, stabilizing_kd};
-    use crate::diagnose::envelope::{sweep, with_payload};
+    use crate::diagnose::envelope::sweep;
     let freqs = args.freqs.clone().unwrap_or_else(|| (0..10).map(|i| 0.25 * 64f64.powf(i as f64 / 9.0)).map(|f| (f * 100.0).round() / 100.0).collect());
     let amps = args.amps.clone().unwrap_or_else(|| (0..10).map(|i| 5.0 + 55.0 * i as f64 / 9.0).map(|a| a.round()).collect());
     if freqs.iter().chain(&amps).any(|x| !(x.is_finite() && *x > 0.0)) {
         return Err(Error::flag("--freqs/--amps", "values must be positive"));
     }
-    if !(args.payload >= 0.0 && args.payload.is_finite()) {
-        return Err(Error::flag("--payload", "must be a mass in kg, not negative"));
-    }
-    let model = with_payload(crate::model::load_urdf(&args.urdf)?, args.payload);
-    let mut config = RunConfig { urdf: args.urdf.clone(), dt: args.dt, motors: args.motors.motors.clone(), drive: args.motors.drive, ..RunConfig::default() };
+    let model = crate::model::load_urdf(&args.urdf)?;
+    // the payload as `run --payload` carries it (the experiment checks it)
+    let mut config = RunConfig { urdf: args.urdf.clone(), dt: args.dt, payload: args.payload, motors: args.motors.motors.clone(), drive: args.motors.drive, ..RunConfig::default() };
     args.gains.apply(&mut config);
     let probe = Experiment::with_model(config.clone(), model.clone())?;
     let (kp, kd) = probe.controller().effective_gains();
@@ -61,7 +59,7 @@ pub fn envelope(args: &EnvelopeArgs) -> Result<i32, Error> {
     }
     let jobs = args.jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
     let started = std::time::Instant::now();
-    let env = sweep(&config, &model, &freqs, &amps, args.payload, jobs)?;
+    let env = sweep(&config, &model, &freqs, &amps, jobs)?;
     std::fs::create_dir_all(&args.out).map_err(|e| Error::output(&args.out, e))?;
     let x_ticks: Vec<String> = freqs.iter().map(|f| format!("{f}")).collect();
     let y_ticks: Vec<String> = amps.iter().map(|a| format!("{a}")).collect();

@@ -41,18 +41,6 @@ pub struct Envelope {
     pub cells: Vec<Cell>,
 }
 
-/// Add a point mass at the tool frame's origin.
-pub fn with_payload(mut model: Model, kg: f64) -> Model {
-    if kg > 0.0 {
-        let frame = &model.frames[model.tool_frame];
-        if let Some(body) = frame.body {
-            let point = crate::spatial::RigidInertia { mass: kg, com: frame.placement.translation, inertia_com: nalgebra::Matrix3::zeros() };
-            model.bodies[body].inertia = model.bodies[body].inertia.combined(&point);
-        }
-    }
-    model
-}
-
 /// Peak |τ| per joint to follow `trajectory` exactly for `duration` seconds.
 pub fn required_torque(model: &Model, trajectory: &dyn Trajectory, duration: f64, dt: f64) -> Vec<f64> {
     need(model, trajectory, duration, dt, &|_, _, _| 1.0).0
@@ -107,10 +95,9 @@ pub fn along_commanded_motion(model: &Model, trajectory: &dyn Trajectory, durati
     }
 }
 
-/// Sweep the grid. `base` supplies the gains and everything else; `model` carries the payload
-/// `payload_kg` already (see [`with_payload`]; the number is recorded in the result). Each cell
-/// runs for the settle time plus one period of the wave (at most 30 s).
-pub fn sweep(base: &RunConfig, model: &Model, freqs: &[f64], amps_deg: &[f64], payload_kg: f64, jobs: usize) -> Result<Envelope, Error> {
+/// Sweep the grid. `base` supplies the gains, the payload and everything else; `model` is the
+/// model as loaded. Each cell runs for the settle time plus one period of the wave (at most 30 s).
+pub fn sweep(base: &RunConfig, model: &Model, freqs: &[f64], amps_deg: &[f64], jobs: usize) -> Result<Envelope, Error> {
     let cells_in: Vec<(f64, f64)> = amps_deg.iter().flat_map(|&a| freqs.iter().map(move |&f| (f, a))).collect();
     let pool = rayon::ThreadPoolBuilder::new().num_threads(jobs.max(1)).build().map_err(|e| Error::flag("--jobs", e.to_string()))?;
     let first = Experiment::with_model(base.clone(), model.clone())?;
@@ -141,7 +128,7 @@ pub fn sweep(base: &RunConfig, model: &Model, freqs: &[f64], amps_deg: &[f64], p
         effort,
         freqs: freqs.to_vec(),
         amps_deg: amps_deg.to_vec(),
-        payload_kg,
+        payload_kg: base.payload,
         kp: first.gains.kp.clone(),
         kd: first.gains.kd.clone(),
         cells: cells?,

@@ -223,4 +223,15 @@ impl Model {
         }
     }
 
+    /// The model with a point mass of `kg` at the tool frame's origin (a payload; none for 0).
+    pub fn with_payload(mut self, kg: f64) -> Model {
+        if kg > 0.0 {
+            let frame = &self.frames[self.tool_frame];
+            if let Some(body) = frame.body {
+                let point = RigidInertia { mass: kg, com: frame.placement.translation, inertia_com: nalgebra::Matrix3::zeros() };
+                self.bodies[body].inertia = self.bodies[body].inertia.combined(&point);
+            }
+        }
+        self
+    }
 }
