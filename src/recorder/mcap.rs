@@ -7,6 +7,7 @@
 //! thread of its own (see `Out`).
 
 use super::foxglove_live::FoxgloveLive;
+use super::overview::Overview;
 use super::robot_description::RobotDescription;
 use super::telemetry::ControllerTelemetry;
 use super::worker::{BatchWorker, Reusable};
@@ -22,7 +23,6 @@ use foxglove::messages::{
     Point3, PoseInFrame, Quaternion, SceneEntity, SceneUpdate, SpherePrimitive, Timestamp, Vector3,
 };
 use foxglove::Encode;
-use super::overview::Overview;
 use mcap::records::MessageHeader;
 use std::collections::BTreeMap;
 use std::fs::File;

@@ -3,6 +3,7 @@
 //! are buffered and sent as one chunk per entity and block (per-step `log` calls cost ~170 µs
 //! here; a block of 4096 steps costs ~2.5 µs per step), to the `.rrd` and/or a live viewer.
 
+use super::overview::Overview;
 use super::rrd_file::{FOOTER_UP_TO_SECONDS, RrdFile};
 use super::{Recorder, RunInfo};
 use crate::dynamics::frame_pose_in;
@@ -15,7 +16,6 @@ use rerun::blueprint::{Blueprint, BlueprintActivation, BlueprintPanel, Grid, Hor
 use rerun::blueprint::components::{PanelState, PlayState};
 use rerun::{RecordingStream, TimeColumn};
 use std::collections::VecDeque;
-use super::overview::Overview;
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -611,7 +611,7 @@ impl Recorder for RerunRecorder {
     fn start(&mut self, run: &RunInfo) -> Result<(), Error> {
         let e = run.experiment;
         let model = &*e.model;
-        let rec = self.open_stream(run.experiment.config.duration)?;
+        let rec = self.open_stream(e.config.duration)?;
         self.joint_names = model.joints.iter().map(|j| j.name.clone()).collect();
         self.effort = e.controller().effort;
         self.stepped = e.stepped_joints();
