@@ -269,7 +269,7 @@ pub fn resolve_joint(spec: &str, model: &Model) -> Result<usize, Error> {
 fn gains(config: &RunConfig, model: &Model, start: &[f64], trajectory: &dyn Trajectory, plant: &PlantSpec) -> Result<Gains, Error> {
     let n = model.dof();
     let base = if is_tutorial_model(model) && !config.auto_tune {
-        Gains { kp: TUTORIAL_KP.to_vec(), kd: TUTORIAL_KD.to_vec(), source: "tutorial".into(), effective_inertia: None, spectral_radius: None }
+        Gains { kp: TUTORIAL_KP.to_vec(), kd: TUTORIAL_KD.to_vec(), source: "tutorial".into(), effective_inertia: None, spectral_radius: None, bandwidth: None, damping_ratio: None }
     } else {
         // the poses the command goes through: the start and 24 along its first period (or the run)
         let mut poses = vec![start.to_vec()];
@@ -303,7 +303,7 @@ fn gains(config: &RunConfig, model: &Model, start: &[f64], trajectory: &dyn Traj
         (true, false) => format!("kp from flags, kd {}", base.source),
         (false, true) => format!("kp {}, kd from flags", base.source),
     };
-    Ok(Gains { kp, kd, source, effective_inertia: base.effective_inertia, spectral_radius: base.spectral_radius })
+    Ok(Gains { kp, kd, source, ..base })
 }
 
 /// A joint whose motor cannot carry the arm's weight at the start pose saturates from the first step

@@ -1,6 +1,6 @@
 //! Controller gains: the tutorial's for its box model, otherwise tuned from the mass matrix.
 
-use crate::diagnose::analysis::{Linearization, LoopPlant, worst_radius};
+use crate::diagnose::analysis::{Linearization, LoopPlant, worst_mode, worst_radius};
 use crate::model::Model;
 use serde::Serialize;
 
@@ -18,6 +18,9 @@ pub struct Gains {
     pub effective_inertia: Option<Vec<f64>>,
     /// The worst spectral radius of the sampled loop along the command, when auto-tuned.
     pub spectral_radius: Option<f64>,
+    /// Per joint, when auto-tuned: the loop's bandwidth ω (rad/s) and damping ratio ζ.
+    pub bandwidth: Option<Vec<f64>>,
+    pub damping_ratio: Option<Vec<f64>>,
 }
 
 /// Whether this is the tutorial's box model, whose gains are known.
@@ -35,40 +38,75 @@ pub const GAIN_MARGIN: f64 = 2.0;
 /// How far the commanded error may go before the motor saturates: kp ≤ effort / this (rad or m).
 const SATURATION_ERROR: f64 = 0.05;
 
+/// How many times the bandwidths may be lowered in all: each lowering takes one or more joints 0.7×
+/// (from 100 rad/s at 1 kHz to 2.8 rad/s is ten).
+const MAX_LOWERINGS: usize = 60;
+/// A joint takes part in an unstable mode when its share is at least this fraction of the largest.
+const PART_OF_MODE: f64 = 0.25;
+/// The least damping ratio the derivative gain is lowered to before the bandwidth is.
+const MIN_DAMPING_RATIO: f64 = 0.25;
+
 /// Gains for any arm, stable for the sampled loop along the commanded motion with a margin. With
-/// I_i the smallest M_ii over `poses` (the loop of joint i is fastest there), D_i its damping and a
-/// bandwidth ω: kp_i = min(effort_i/0.05, I_i·ω² + D_i·ω), kd_i = 2·√(kp_i·I_i), starting at
-/// ω = 0.1/dt; the sampled loop (plant, zero-order hold, damping, coupling through M) is linearized
-/// at every pose as `armscope analyze` does, and ω is lowered by 0.7× until the loop with both
-/// gains doubled is still stable at every pose (a gain margin of 2), or no less stable than with
-/// them halved (what is unstable then is the plant's own, e.g. a passive joint that falls).
+/// I_i the smallest M_ii over `poses` (the loop of joint i is fastest there), D_i its damping, a
+/// bandwidth ω_i and a damping ratio ζ_i: kp_i = min(effort_i/0.05, I_i·ω_i² + D_i·ω_i),
+/// kd_i = 2·ζ_i·√(kp_i·I_i), starting at ω_i = 0.1/dt, ζ_i = 1. The sampled loop (plant, zero-order
+/// hold, damping, coupling through M) is linearized at every pose as `armscope analyze` does, and
+/// while the loop with both gains doubled is unstable at some pose (a gain margin of 2), the joints
+/// that take part in its unstable mode — only they: a wrist at its singularity (two roll axes
+/// aligned, a light link between them) must be soft, the head and the fingers need not be — get
+/// 0.7× the damping ratio (down to 0.25) if that makes the loop more stable, else 0.7× the
+/// bandwidth. It stops when the loop is stable with the margin, or no less stable than with the
+/// gains halved (what is unstable then is the plant's own, e.g. a passive joint that falls).
 pub fn auto_tune(model: &Model, poses: &[Vec<f64>], dt: f64, feed_forward: bool, plant: LoopPlant) -> Gains {
     let n = model.dof();
     let lins: Vec<Linearization> = poses.iter().map(|q| Linearization::at(model, q)).collect();
     let inertia: Vec<f64> = (0..n).map(|i| lins.iter().map(|l| l.mass[(i, i)]).fold(f64::INFINITY, f64::min)).collect();
     let effort = model.effort_limits();
-    let gains_at = |omega: f64| -> (Vec<f64>, Vec<f64>) {
+    let gains_at = |omega: &[f64], zeta: &[f64]| -> (Vec<f64>, Vec<f64>) {
         // I·ω² puts the loop at ω; D·ω does the same where the joint's damping dominates its inertia
         let kp: Vec<f64> = (0..n)
-            .map(|i| if effort[i] > 0.0 { (effort[i] / SATURATION_ERROR).min(inertia[i] * omega * omega + model.joints[i].damping * omega) } else { 0.0 })
+            .map(|i| if effort[i] > 0.0 { (effort[i] / SATURATION_ERROR).min(inertia[i] * omega[i] * omega[i] + model.joints[i].damping * omega[i]) } else { 0.0 })
             .collect();
-        let kd = kp.iter().zip(&inertia).map(|(&kp, &i)| 2.0 * (kp * i).sqrt()).collect();
+        let kd = (0..n).map(|i| 2.0 * zeta[i] * (kp[i] * inertia[i]).sqrt()).collect();
         (kp, kd)
     };
-    let scaled = |v: &[f64]| v.iter().map(|x| x * GAIN_MARGIN).collect::<Vec<_>>();
-    let mut omega = START_BANDWIDTH_PER_STEP / dt;
-    let (mut kp, mut kd) = gains_at(omega);
-    let halved = |v: &[f64]| v.iter().map(|x| x / GAIN_MARGIN).collect::<Vec<_>>();
-    for _ in 0..30 {
-        let doubled = worst_radius(&lins, &scaled(&kp), &scaled(&kd), dt, feed_forward, plant);
+    let scaled = |v: &[f64], factor: f64| v.iter().map(|x| x * factor).collect::<Vec<_>>();
+    let radius_with_margin = |kp: &[f64], kd: &[f64]| worst_mode(&lins, &scaled(kp, GAIN_MARGIN), &scaled(kd, GAIN_MARGIN), dt, feed_forward, plant);
+    let mut omega = vec![START_BANDWIDTH_PER_STEP / dt; n];
+    let mut zeta = vec![1.0; n];
+    let (mut kp, mut kd) = gains_at(&omega, &zeta);
+    let (mut doubled, mut shares) = radius_with_margin(&kp, &kd);
+    for _ in 0..MAX_LOWERINGS {
         // stable with the margin; or what is unstable is not the controller's doing (a passive joint
         // falling, a mode the gains do not reach): larger gains make it no worse than smaller ones
-        if doubled < 1.0 || doubled <= worst_radius(&lins, &halved(&kp), &halved(&kd), dt, feed_forward, plant) + 1e-9 {
+        if doubled < 1.0 || doubled <= worst_radius(&lins, &scaled(&kp, 1.0 / GAIN_MARGIN), &scaled(&kd, 1.0 / GAIN_MARGIN), dt, feed_forward, plant) + 1e-9 {
             break;
         }
-        omega *= 0.7;
-        (kp, kd) = gains_at(omega);
+        let driven = |i: &usize| kp[*i] > 0.0;
+        let largest = (0..n).filter(driven).map(|i| shares[i]).fold(0.0, f64::max);
+        let in_mode: Vec<usize> = (0..n).filter(driven).filter(|&i| shares[i] >= PART_OF_MODE * largest && largest > 0.0).collect();
+        // a mode on joints without a motor, made unstable by the others' gains: lower them all
+        let lowered = if in_mode.is_empty() { (0..n).filter(driven).collect() } else { in_mode };
+        // first less damping (a light mode between two joints is destabilized by the sampled
+        // derivative term, while stiffness is what tracks), if that helps; else less bandwidth
+        if lowered.iter().any(|&i| zeta[i] > MIN_DAMPING_RATIO) {
+            let mut softer = zeta.clone();
+            for &i in &lowered {
+                softer[i] = (softer[i] * 0.7).max(MIN_DAMPING_RATIO);
+            }
+            let (kp_s, kd_s) = gains_at(&omega, &softer);
+            let (radius, mode) = radius_with_margin(&kp_s, &kd_s);
+            if radius < doubled - 1e-9 {
+                (zeta, kp, kd, doubled, shares) = (softer, kp_s, kd_s, radius, mode);
+                continue;
+            }
+        }
+        for &i in &lowered {
+            omega[i] *= 0.7;
+        }
+        (kp, kd) = gains_at(&omega, &zeta);
+        (doubled, shares) = radius_with_margin(&kp, &kd);
     }
     let rho = worst_radius(&lins, &kp, &kd, dt, feed_forward, plant);
-    Gains { kp, kd, source: "auto-tuned".into(), effective_inertia: Some(inertia), spectral_radius: Some(rho) }
+    Gains { kp, kd, source: "auto-tuned".into(), effective_inertia: Some(inertia), spectral_radius: Some(rho), bandwidth: Some(omega), damping_ratio: Some(zeta) }
 }

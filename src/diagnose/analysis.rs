@@ -178,6 +178,13 @@ pub fn worst_radius(lins: &[Linearization], kp: &[f64], kd: &[f64], h: f64, ff: 
     lins.iter().map(|l| spectral_radius(&l.closed_loop(kp, kd, h, ff, plant)).0).fold(0.0, f64::max)
 }
 
+/// The worst spectral radius over several poses, and per joint its share of that pose's dominant mode.
+pub fn worst_mode(lins: &[Linearization], kp: &[f64], kd: &[f64], h: f64, ff: bool, plant: LoopPlant) -> (f64, Vec<f64>) {
+    lins.iter()
+        .map(|l| spectral_radius(&l.closed_loop(kp, kd, h, ff, plant)))
+        .fold((0.0, vec![0.0; kp.len()]), |worst, mode| if mode.0 > worst.0 { mode } else { worst })
+}
+
 /// As [`stabilizing_kd`], but minimizing the worst radius over all the given poses.
 pub fn stabilizing_kd_over(lins: &[Linearization], kp: &[f64], kd: &[f64], h: f64, ff: bool, plant: LoopPlant) -> (Vec<f64>, f64) {
     let mut best = kd.to_vec();

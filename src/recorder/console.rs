@@ -101,11 +101,13 @@ impl Console {
         .map_err(io)?;
         if let Some(inertia) = &e.gains.effective_inertia {
             let radius = e.gains.spectral_radius.map_or(String::new(), |r| format!(", worst spectral radius of the sampled loop along the command {r:.3}"));
-            writeln!(self.out, "  auto-tuned gains (kp = min(effort/0.05, I·ω² + D·ω), kd = 2·√(kp·I), I = smallest M_ii along the command, ω lowered until the sampled loop is stable with twice the gains{radius}):").map_err(io)?;
+            writeln!(self.out, "  auto-tuned gains (kp = min(effort/0.05, I·ω² + D·ω), kd = 2·ζ·√(kp·I), I = smallest M_ii along the command, ω = 0.1/dt and ζ = 1 lowered for the joints of each mode of the sampled loop unstable with twice the gains{radius}):").map_err(io)?;
             let w = m.joints.iter().map(|j| j.name.chars().count() + 1).max().unwrap_or(0).max(8);
-            writeln!(self.out, "    {:<w$}{:>14}{:>12}{:>12}", "joint", "I (kg·m²)", "kp", "kd").map_err(io)?;
+            writeln!(self.out, "    {:<w$}{:>14}{:>12}{:>8}{:>12}{:>12}", "joint", "I (kg·m²)", "ω (rad/s)", "ζ", "kp", "kd").map_err(io)?;
+            let (omega, zeta) = (e.gains.bandwidth.as_deref().unwrap_or(&[]), e.gains.damping_ratio.as_deref().unwrap_or(&[]));
             for (j, joint) in m.joints.iter().enumerate() {
-                writeln!(self.out, "    {:<w$}{:>14.4e}{:>12.4}{:>12.5}", joint.name, inertia[j], e.gains.kp[j], e.gains.kd[j]).map_err(io)?;
+                let (w_j, z_j) = (omega.get(j).copied().unwrap_or(f64::NAN), zeta.get(j).copied().unwrap_or(f64::NAN));
+                writeln!(self.out, "    {:<w$}{:>14.4e}{:>12.1}{:>8.2}{:>12.4}{:>12.5}", joint.name, inertia[j], w_j, z_j, e.gains.kp[j], e.gains.kd[j]).map_err(io)?;
             }
         }
         writeln!(self.out, "  duration {} s ({} steps)", e.config.duration, e.steps).map_err(io)?;
