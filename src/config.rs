@@ -39,6 +39,9 @@ pub struct RunConfig {
     pub freq: f64,
     /// Wave amplitude, degrees.
     pub amp_deg: f64,
+    /// The wave's size was asked for (`--freq`, `--amp-deg`; `size` and `envelope` always): run as
+    /// asked. Otherwise the default wave is scaled down where the URDF's motors cannot carry it.
+    pub wave_as_asked: bool,
     /// One value for every joint, or one per joint.
     pub kp: Option<Vec<f64>>,
     pub kd: Option<Vec<f64>>,
@@ -89,6 +92,7 @@ impl Default for RunConfig {
             atol: 1e-10,
             freq: 0.5,
             amp_deg: 30.0,
+            wave_as_asked: false,
             kp: None,
             kd: None,
             auto_tune: false,

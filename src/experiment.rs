@@ -4,6 +4,7 @@ use crate::config::{DriveMode, IntegratorKind, RunConfig};
 use crate::control::controller::PdGravityController;
 use crate::error::Error;
 use crate::control::gains::{Gains, TUTORIAL_KD, TUTORIAL_KP, auto_tune, is_tutorial_model};
+use crate::control::within_effort::{MOTION_LOAD, START_LOAD, carried_wave, holdable_pose, overloaded_by_weight};
 use crate::plant::{ContinuousPlant, DiscretePlant, Plant, Tolerances};
 use crate::actuator::{MotorSet, OpenLoopSteppers, load_motor_file};
 use crate::model::{Actuator, LoadOptions, Model, load_urdf_with};
@@ -79,11 +80,13 @@ impl Experiment {
         if !(config.payload >= 0.0 && config.payload.is_finite()) {
             return Err(Error::flag("--payload", format!("must be a mass in kg, not negative (got {})", config.payload)));
         }
+        // the experiment is fitted to the robot as its URDF describes it (ranges, effort limits);
+        // a payload and motors are then tried on it
+        let mut start = start_pose(&config, &model)?;
+        let trajectory = trajectory(&config, &mut model, &mut start)?;
         let mut model = model.with_payload(config.payload);
         let motors = motors.map(|set| Arc::new(apply_motor_set(set, &mut model)));
         let mut plant = plant_spec(&config)?;
-        let mut start = start_pose(&config, &model)?;
-        let trajectory = trajectory(&config, &model, &start)?;
         let steppers = match &motors {
             Some(motors) if config.drive == DriveMode::Stepper && motors.has_steppers() => stepper_setup(&config, &mut model, motors, trajectory.as_ref(), &mut start, &mut plant),
             _ => None,
@@ -227,7 +230,11 @@ fn start_pose(config: &RunConfig, model: &Model) -> Result<Vec<f64>, Error> {
     Ok(q)
 }
 
-fn trajectory(config: &RunConfig, model: &Model, start: &[f64]) -> Result<Box<dyn Trajectory>, Error> {
+/// The command. The default start pose (no `--q0`) and the default wave (no `--amp-deg`, `--freq`)
+/// are fitted to the URDF's effort limits as well as its ranges: the start moved to a pose the
+/// motors can hold, the wave scaled to what they can carry, each with a notice (`within_effort`).
+/// The tutorial's box model needs neither.
+fn trajectory(config: &RunConfig, model: &mut Model, start: &mut Vec<f64>) -> Result<Box<dyn Trajectory>, Error> {
     if let Some(path) = &config.trajectory {
         if config.hold || config.test_joint.is_some() {
             return Err(Error::flag("--trajectory", "cannot be combined with --static or --test-joint"));
@@ -244,12 +251,54 @@ fn trajectory(config: &RunConfig, model: &Model, start: &[f64]) -> Result<Box<dy
     if config.hold {
         return Ok(Box::new(Hold));
     }
-    let fitted = JointWave::fitted(model, start, config.amp_deg, config.freq);
+    if config.q0.is_none() {
+        hold_default_start(model, start);
+    }
+    let fitted = if !config.wave_as_asked {
+        carried_default_wave(model, start, config.amp_deg, config.freq)
+    } else {
+        JointWave::fitted(model, start, config.amp_deg, config.freq)
+    };
     if fitted.is_uniform_about_zero(config.amp_deg.to_radians()) {
         // the tutorial's wave exactly (the box model)
         return Ok(Box::new(Wave { amplitude_rad: config.amp_deg.to_radians(), omega: config.freq }));
     }
     Ok(Box::new(fitted))
+}
+
+/// Move the default start pose (each joint's 0 in its range) where the URDF's motors can hold the
+/// arm, if they cannot there.
+fn hold_default_start(model: &mut Model, start: &mut Vec<f64>) {
+    let over = overloaded_by_weight(model, start, START_LOAD);
+    if over.is_empty() {
+        return;
+    }
+    let needs = over.iter().map(|&(j, tau, e)| format!("{} {tau:.3} N·m of its {e}", model.joints[j].name)).collect::<Vec<_>>().join(", ");
+    let Some(held) = holdable_pose(model, start, START_LOAD) else {
+        model.notices.push(format!("the default start pose (each joint's 0 in its range) takes more than the motors give ({needs}) and no pose nearby takes less: starting there (--q0 starts elsewhere)"));
+        return;
+    };
+    let moved = model.joints.iter().zip(held.iter().zip(start.iter())).filter(|(_, (h, s))| (*h - *s).abs() > 1e-4).map(|(j, (h, _))| format!("{}={h:.3}", j.name)).collect::<Vec<_>>().join(",");
+    model.notices.push(format!(
+        "the default start pose (each joint's 0 in its range) takes more than the motors give ({needs}): starting nearby, where the weight takes at most {:.0} % of every joint's effort: --q0 {moved} (--q0 starts elsewhere)",
+        100.0 * START_LOAD
+    ));
+    *start = held;
+}
+
+/// The default wave, scaled down if the URDF's motors cannot carry it at full size.
+fn carried_default_wave(model: &mut Model, start: &[f64], amp_deg: f64, freq: f64) -> JointWave {
+    let (wave, share, worst) = carried_wave(model, start, amp_deg, freq, MOTION_LOAD);
+    if let Some((j, tau, e)) = worst {
+        model.notices.push(format!(
+            "the default wave at full size ({amp_deg}°) takes more than the motors give ({} {tau:.3} N·m of its {e}): scaled to {:.0} % ({:.1}°), where the motion needs at most {:.0} % of every joint's effort (--amp-deg and --freq set the wave as asked)",
+            model.joints[j].name,
+            100.0 * share,
+            share * amp_deg,
+            100.0 * MOTION_LOAD
+        ));
+    }
+    wave
 }
 
 /// A joint given by number (1-based, as J1..J6) or by name.

@@ -57,7 +57,7 @@ pub fn analyze(args: &AnalyzeArgs) -> Result<i32, Error> {
     }
     // the given pose first, then (--along-command) 12 poses along one period of the wave
     let poses: Vec<Vec<f64>> = if args.along_command {
-        let wave = crate::control::trajectory::Wave { amplitude_rad: args.wave.amp_deg.to_radians(), omega: args.wave.freq };
+        let wave = crate::control::trajectory::Wave { amplitude_rad: args.wave.amp_deg().to_radians(), omega: args.wave.freq() };
         // a wave that stands still (ω = 0) gives the same pose at any time
         let period = crate::control::trajectory::Trajectory::period(&wave).unwrap_or(1.0);
         let (mut q, mut qd) = (vec![0.0; n], vec![0.0; n]);

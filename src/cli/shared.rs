@@ -28,12 +28,28 @@ impl GainArgs {
 /// The tutorial's wave: every joint swings A·sin(ω·t) about its start.
 #[derive(Args, Debug, Clone)]
 pub struct WaveArgs {
-    /// Wave frequency ω, rad/s.
-    #[arg(long, allow_negative_numbers = true, default_value_t = RunConfig::default().freq)]
-    pub freq: f64,
-    /// Wave amplitude, degrees.
-    #[arg(long, allow_negative_numbers = true, default_value_t = RunConfig::default().amp_deg)]
-    pub amp_deg: f64,
+    /// Wave frequency ω, rad/s [default: 0.5]. Either flag runs the wave as asked; without them the
+    /// default wave is scaled down where the URDF's motors cannot carry it (with a notice).
+    #[arg(long, allow_negative_numbers = true)]
+    pub freq: Option<f64>,
+    /// Wave amplitude, degrees [default: 30].
+    #[arg(long, allow_negative_numbers = true)]
+    pub amp_deg: Option<f64>,
+}
+
+impl WaveArgs {
+    pub fn freq(&self) -> f64 {
+        self.freq.unwrap_or(RunConfig::default().freq)
+    }
+
+    pub fn amp_deg(&self) -> f64 {
+        self.amp_deg.unwrap_or(RunConfig::default().amp_deg)
+    }
+
+    /// Whether the wave's size was asked for.
+    pub fn asked(&self) -> bool {
+        self.freq.is_some() || self.amp_deg.is_some()
+    }
 }
 
 /// The motors and how stepper joints are driven.

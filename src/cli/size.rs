@@ -134,8 +134,10 @@ fn motions(args: &SizeArgs) -> Result<Vec<(String, RunConfig)>, Error> {
     let duration = duration(args)?;
     let base = RunConfig {
         urdf: args.urdf.clone(),
-        freq: args.wave.freq,
-        amp_deg: args.wave.amp_deg,
+        freq: args.wave.freq(),
+        amp_deg: args.wave.amp_deg(),
+        // sized for the motion asked, whatever the URDF's own motors could carry
+        wave_as_asked: true,
         trajectory: args.trajectory.clone(),
         duration,
         dt: args.dt,
@@ -149,7 +151,7 @@ fn motions(args: &SizeArgs) -> Result<Vec<(String, RunConfig)>, Error> {
         ..RunConfig::default()
     };
     let Some(path) = &args.manifest else {
-        let name = if args.trajectory.is_some() { "trajectory".to_string() } else { format!("wave ω = {} rad/s, {}°, {duration} s", args.wave.freq, args.wave.amp_deg) };
+        let name = if args.trajectory.is_some() { "trajectory".to_string() } else { format!("wave ω = {} rad/s, {}°, {duration} s", args.wave.freq(), args.wave.amp_deg()) };
         return Ok(vec![(name, base)]);
     };
     let manifest = crate::batch::load_manifest(path)?;
@@ -273,7 +275,7 @@ pub fn size(args: &SizeArgs) -> Result<i32, Error> {
         }
         match &args.trajectory {
             Some(t) => command += &format!(" --trajectory {}", t.display()),
-            None => command += &format!(" --freq {} --amp-deg {}", args.wave.freq, args.wave.amp_deg),
+            None => command += &format!(" --freq {} --amp-deg {}", args.wave.freq(), args.wave.amp_deg()),
         }
         let duration = request.motions[0].1.duration;
         if args.manifest.is_none() && duration != RunConfig::default().duration {

@@ -6,3 +6,4 @@ pub mod controller;
 pub mod gains;
 pub mod ik;
 pub mod trajectory;
+pub mod within_effort;

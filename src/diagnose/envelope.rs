@@ -10,7 +10,7 @@ use crate::error::Error;
 use crate::experiment::Experiment;
 use crate::model::Model;
 use crate::sim::simulate;
-use crate::control::trajectory::{Trajectory, Wave};
+use crate::control::trajectory::Trajectory;
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -114,10 +114,11 @@ pub fn sweep(base: &RunConfig, model: &Model, freqs: &[f64], amps_deg: &[f64], j
             .par_iter()
             .map(|&(freq, amp_deg)| {
                 let duration = (base.settle_time + 2.0 * std::f64::consts::PI / freq.abs().max(1e-3)).min(30.0);
-                let config = RunConfig { freq, amp_deg, duration, hold: false, test_joint: None, trajectory: None, ..base.clone() };
+                let config = RunConfig { freq, amp_deg, wave_as_asked: true, duration, hold: false, test_joint: None, trajectory: None, ..base.clone() };
                 let experiment = Experiment::with_model(config, model.clone())?;
-                let wave = Wave { amplitude_rad: amp_deg.to_radians(), omega: freq };
-                let (required, demand) = need(&dynamics_model, &wave, duration, base.dt, &limit);
+                // the command the run follows (the tutorial's wave on its box model, fitted to the
+                // joint ranges on any other arm)
+                let (required, demand) = need(&dynamics_model, experiment.trajectory.as_ref(), duration, base.dt, &limit);
                 let summary = simulate(&experiment, &mut [], None)?;
                 Ok(Cell { freq, amp_deg, required, demand, saturation_percent: summary.saturation_percent, chatter_percent: summary.chatter_percent })
             })
