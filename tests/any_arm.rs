@@ -248,6 +248,20 @@ fn a_missing_mesh_is_a_notice_and_the_link_is_drawn_from_its_collision_shape_or_
 }
 
 #[test]
+fn a_texture_without_a_filename_is_ignored_with_a_notice() {
+    // iCub's and Romeo's exporters write `<texture />` in every material; urdfdom accepts it
+    let visual = r#"<visual><geometry><box size="0.1 0.1 0.1"/></geometry><material name="grey"><color rgba="0.5 0.5 0.5 1"/><texture /></material></visual>"#;
+    let text = arm(GOOD_FORE, LIMITS, "").replace(r#"<link name="upper">"#, &format!(r#"<link name="upper">{visual}"#));
+    let model = load(&text.replace("</robot>", &format!(r#"<material name="skin"><texture/></material></robot>"#)));
+    assert_eq!(model.dof(), 2);
+    let said: Vec<&String> = model.notices.iter().filter(|n| n.contains("<texture>")).collect();
+    assert!(said.len() == 1 && said[0].contains("2 <texture>"), "{:?}", model.notices);
+    // a texture with its file is no notice
+    let with_file = load(&arm(GOOD_FORE, LIMITS, r#"<material name="m"><texture filename="skin.png"/></material>"#));
+    assert!(!with_file.notices.iter().any(|n| n.contains("texture")), "{:?}", with_file.notices);
+}
+
+#[test]
 fn a_xacro_file_gets_one_line_saying_how_to_expand_it() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("arm.urdf.xacro");

@@ -1,6 +1,6 @@
 //! Controller gains: the tutorial's for its box model, otherwise tuned from the mass matrix.
 
-use crate::diagnose::analysis::{Linearization, LoopPlant, worst_mode, worst_radius};
+use crate::diagnose::analysis::{Linearization, LoopPlant, modes_over, worst_radius};
 use crate::model::Model;
 use serde::Serialize;
 
@@ -52,11 +52,12 @@ const MIN_DAMPING_RATIO: f64 = 0.25;
 /// kd_i = 2·ζ_i·√(kp_i·I_i), starting at ω_i = 0.1/dt, ζ_i = 1. The sampled loop (plant, zero-order
 /// hold, damping, coupling through M) is linearized at every pose as `armscope analyze` does, and
 /// while the loop with both gains doubled is unstable at some pose (a gain margin of 2), the joints
-/// that take part in its unstable mode — only they: a wrist at its singularity (two roll axes
-/// aligned, a light link between them) must be soft, the head and the fingers need not be — get
-/// 0.7× the damping ratio (down to 0.25) if that makes the loop more stable, else 0.7× the
-/// bandwidth. It stops when the loop is stable with the margin, or no less stable than with the
-/// gains halved (what is unstable then is the plant's own, e.g. a passive joint that falls).
+/// that take part in its unstable modes (all of them at once: a large tree has several) — only
+/// they: a wrist at its singularity (two roll axes aligned, a light link between them) must be
+/// soft, the head and the fingers need not be — get 0.7× the damping ratio (down to 0.25) if that
+/// makes the loop more stable, else 0.7× the bandwidth. It stops when the loop is stable with the
+/// margin, or no less stable than with the gains halved (what is unstable then is the plant's own,
+/// e.g. a passive joint that falls).
 pub fn auto_tune(model: &Model, poses: &[Vec<f64>], dt: f64, feed_forward: bool, plant: LoopPlant) -> Gains {
     let n = model.dof();
     let lins: Vec<Linearization> = poses.iter().map(|q| Linearization::at(model, q)).collect();
@@ -71,22 +72,32 @@ pub fn auto_tune(model: &Model, poses: &[Vec<f64>], dt: f64, feed_forward: bool,
         (kp, kd)
     };
     let scaled = |v: &[f64], factor: f64| v.iter().map(|x| x * factor).collect::<Vec<_>>();
-    let radius_with_margin = |kp: &[f64], kd: &[f64]| worst_mode(&lins, &scaled(kp, GAIN_MARGIN), &scaled(kd, GAIN_MARGIN), dt, feed_forward, plant);
+    // the loop with both gains doubled: its worst radius, and the joints of every mode unstable at
+    // some pose (a large tree has several at once: Centauro's four legs and two arms)
+    let with_margin = |kp: &[f64], kd: &[f64]| -> (f64, Vec<usize>) {
+        let (radius, modes) = modes_over(&lins, &scaled(kp, GAIN_MARGIN), &scaled(kd, GAIN_MARGIN), dt, feed_forward, plant, 1.0);
+        let mut joints: Vec<usize> = Vec::new();
+        for (_, shares) in modes.iter().filter(|(z, _)| *z >= 1.0) {
+            let driven = |i: &usize| kp[*i] > 0.0;
+            let largest = (0..n).filter(driven).map(|i| shares[i]).fold(0.0, f64::max);
+            joints.extend((0..n).filter(driven).filter(|&i| largest > 0.0 && shares[i] >= PART_OF_MODE * largest));
+        }
+        joints.sort_unstable();
+        joints.dedup();
+        (radius, joints)
+    };
     let mut omega = vec![START_BANDWIDTH_PER_STEP / dt; n];
     let mut zeta = vec![1.0; n];
     let (mut kp, mut kd) = gains_at(&omega, &zeta);
-    let (mut doubled, mut shares) = radius_with_margin(&kp, &kd);
+    let (mut doubled, mut in_modes) = with_margin(&kp, &kd);
     for _ in 0..MAX_LOWERINGS {
         // stable with the margin; or what is unstable is not the controller's doing (a passive joint
         // falling, a mode the gains do not reach): larger gains make it no worse than smaller ones
         if doubled < 1.0 || doubled <= worst_radius(&lins, &scaled(&kp, 1.0 / GAIN_MARGIN), &scaled(&kd, 1.0 / GAIN_MARGIN), dt, feed_forward, plant) + 1e-9 {
             break;
         }
-        let driven = |i: &usize| kp[*i] > 0.0;
-        let largest = (0..n).filter(driven).map(|i| shares[i]).fold(0.0, f64::max);
-        let in_mode: Vec<usize> = (0..n).filter(driven).filter(|&i| shares[i] >= PART_OF_MODE * largest && largest > 0.0).collect();
-        // a mode on joints without a motor, made unstable by the others' gains: lower them all
-        let lowered = if in_mode.is_empty() { (0..n).filter(driven).collect() } else { in_mode };
+        // modes on joints without a motor, made unstable by the others' gains: lower them all
+        let lowered: Vec<usize> = if in_modes.is_empty() { (0..n).filter(|&i| kp[i] > 0.0).collect() } else { in_modes.clone() };
         // first less damping (a light mode between two joints is destabilized by the sampled
         // derivative term, while stiffness is what tracks), if that helps; else less bandwidth
         if lowered.iter().any(|&i| zeta[i] > MIN_DAMPING_RATIO) {
@@ -95,9 +106,9 @@ pub fn auto_tune(model: &Model, poses: &[Vec<f64>], dt: f64, feed_forward: bool,
                 softer[i] = (softer[i] * 0.7).max(MIN_DAMPING_RATIO);
             }
             let (kp_s, kd_s) = gains_at(&omega, &softer);
-            let (radius, mode) = radius_with_margin(&kp_s, &kd_s);
+            let (radius, modes) = with_margin(&kp_s, &kd_s);
             if radius < doubled - 1e-9 {
-                (zeta, kp, kd, doubled, shares) = (softer, kp_s, kd_s, radius, mode);
+                (zeta, kp, kd, doubled, in_modes) = (softer, kp_s, kd_s, radius, modes);
                 continue;
             }
         }
@@ -105,7 +116,7 @@ pub fn auto_tune(model: &Model, poses: &[Vec<f64>], dt: f64, feed_forward: bool,
             omega[i] *= 0.7;
         }
         (kp, kd) = gains_at(&omega, &zeta);
-        (doubled, shares) = radius_with_margin(&kp, &kd);
+        (doubled, in_modes) = with_margin(&kp, &kd);
     }
     let rho = worst_radius(&lins, &kp, &kd, dt, feed_forward, plant);
     Gains { kp, kd, source: "auto-tuned".into(), effective_inertia: Some(inertia), spectral_radius: Some(rho), bandwidth: Some(omega), damping_ratio: Some(zeta) }

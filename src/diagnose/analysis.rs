@@ -92,37 +92,49 @@ impl Linearization {
 /// (a free joint drifts, it does not blow up); they show as a defective pair split by up to ~1e-5.
 pub fn spectral_radius(a: &DMatrix<f64>) -> (f64, Vec<f64>) {
     let n = a.nrows() / 2;
+    let (rho, modes) = modes_above(a, f64::INFINITY);
+    (rho, modes.into_iter().next().map_or_else(|| vec![1.0 / n as f64; n], |(_, shares)| shares))
+}
+
+/// The spectral radius (as [`spectral_radius`]) and every mode whose eigenvalue's magnitude is at
+/// least `radius` — and the dominant one whatever its magnitude — largest first: (|λ|, per joint
+/// its share of the mode). One eigenvalue of each complex pair.
+pub fn modes_above(a: &DMatrix<f64>, radius: f64) -> (f64, Vec<(f64, Vec<f64>)>) {
+    use nalgebra::Complex;
+    let n = a.nrows() / 2;
     // nalgebra's Schur iteration can stall on badly scaled loops (grams and metres next to
     // micrograms): bounded, with the radius from the growth of Aᵏ as the fallback
     let Some(schur) = nalgebra::linalg::Schur::try_new(a.clone(), 1e-13, 20_000) else {
-        return (power_radius(a), vec![1.0 / n as f64; n]);
+        let rho = power_radius(a);
+        return (rho, vec![(rho, vec![1.0 / n as f64; n])]);
     };
-    let eig = schur.complex_eigenvalues();
-    let (mut rho, mut dominant) = (0.0, nalgebra::Complex::new(0.0, 0.0));
-    for z in eig.iter() {
-        if (z - nalgebra::Complex::new(1.0, 0.0)).norm() < 1e-4 {
-            continue;
-        }
-        if z.norm() > rho {
-            rho = z.norm();
-            dominant = *z;
-        }
-    }
-    // the dominant mode's shape: null vector of (A − λI) by inverse iteration (complex)
-    let c = a.map(|x| nalgebra::Complex::new(x, 0.0)) - DMatrix::<nalgebra::Complex<f64>>::identity(2 * n, 2 * n) * (dominant * nalgebra::Complex::new(1.0 + 1e-9, 0.0));
-    let mut v = DVector::from_element(2 * n, nalgebra::Complex::new(1.0, 0.0));
-    let lu = c.lu();
-    for _ in 0..4 {
-        if let Some(next) = lu.solve(&v) {
-            let norm = next.norm();
-            if norm > 0.0 && norm.is_finite() {
-                v = next / nalgebra::Complex::new(norm, 0.0);
+    let mut eig: Vec<Complex<f64>> = schur.complex_eigenvalues().iter().copied().filter(|z| (z - Complex::new(1.0, 0.0)).norm() >= 1e-4 && z.im >= 0.0).collect();
+    eig.sort_by(|a, b| b.norm().total_cmp(&a.norm()));
+    let rho = eig.first().map_or(0.0, |z| z.norm());
+    let a_c = a.map(|x| Complex::new(x, 0.0));
+    let modes = eig
+        .iter()
+        .enumerate()
+        .take_while(|(k, z)| *k == 0 || z.norm() >= radius)
+        .map(|(_, &z)| {
+            // the mode's shape: null vector of (A − λI) by inverse iteration (complex)
+            let c = &a_c - DMatrix::<Complex<f64>>::identity(2 * n, 2 * n) * (z * Complex::new(1.0 + 1e-9, 0.0));
+            let mut v = DVector::from_element(2 * n, Complex::new(1.0, 0.0));
+            let lu = c.lu();
+            for _ in 0..4 {
+                if let Some(next) = lu.solve(&v) {
+                    let norm = next.norm();
+                    if norm > 0.0 && norm.is_finite() {
+                        v = next / Complex::new(norm, 0.0);
+                    }
+                }
             }
-        }
-    }
-    let weights: Vec<f64> = (0..n).map(|j| v[j].norm_sqr() + v[n + j].norm_sqr() / (1.0 + v[n + j].norm_sqr())).collect();
-    let total: f64 = weights.iter().sum::<f64>().max(f64::MIN_POSITIVE);
-    (rho, weights.iter().map(|w| w / total).collect())
+            let weights: Vec<f64> = (0..n).map(|j| v[j].norm_sqr() + v[n + j].norm_sqr() / (1.0 + v[n + j].norm_sqr())).collect();
+            let total: f64 = weights.iter().sum::<f64>().max(f64::MIN_POSITIVE);
+            (z.norm(), weights.iter().map(|w| w / total).collect())
+        })
+        .collect();
+    (rho, modes)
 }
 
 /// The spectral radius as the growth rate of ‖Aᵏ‖ (k = 512, by repeated squaring, renormalized):
@@ -178,11 +190,13 @@ pub fn worst_radius(lins: &[Linearization], kp: &[f64], kd: &[f64], h: f64, ff: 
     lins.iter().map(|l| spectral_radius(&l.closed_loop(kp, kd, h, ff, plant)).0).fold(0.0, f64::max)
 }
 
-/// The worst spectral radius over several poses, and per joint its share of that pose's dominant mode.
-pub fn worst_mode(lins: &[Linearization], kp: &[f64], kd: &[f64], h: f64, ff: bool, plant: LoopPlant) -> (f64, Vec<f64>) {
-    lins.iter()
-        .map(|l| spectral_radius(&l.closed_loop(kp, kd, h, ff, plant)))
-        .fold((0.0, vec![0.0; kp.len()]), |worst, mode| if mode.0 > worst.0 { mode } else { worst })
+/// The worst spectral radius over several poses, and every mode at any pose whose eigenvalue's
+/// magnitude is at least `radius` (with each pose's dominant one), as [`modes_above`].
+pub fn modes_over(lins: &[Linearization], kp: &[f64], kd: &[f64], h: f64, ff: bool, plant: LoopPlant, radius: f64) -> (f64, Vec<(f64, Vec<f64>)>) {
+    lins.iter().map(|l| modes_above(&l.closed_loop(kp, kd, h, ff, plant), radius)).fold((0.0, Vec::new()), |(worst, mut all), (rho, modes)| {
+        all.extend(modes);
+        (f64::max(worst, rho), all)
+    })
 }
 
 /// As [`stabilizing_kd`], but minimizing the worst radius over all the given poses.
@@ -208,4 +222,28 @@ pub fn stabilizing_kd_over(lins: &[Linearization], kp: &[f64], kd: &[f64], h: f6
         }
     }
     (best, rho)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_mode_above_the_radius_is_found_with_its_joints() {
+        // three decoupled joints (state δq1..3, v1..3): joint 1 grows 1.5×, joint 3 1.2×, joint 2 decays
+        let mut a = DMatrix::zeros(6, 6);
+        for (j, z) in [(0, 1.5), (1, 0.5), (2, 1.2)] {
+            a[(j, j)] = z;
+            a[(3 + j, 3 + j)] = 0.1;
+        }
+        let (rho, modes) = modes_above(&a, 1.0);
+        assert!((rho - 1.5).abs() < 1e-12 && modes.len() == 2, "{rho} {modes:?}");
+        for ((z, shares), (joint, expected)) in modes.iter().zip([(0, 1.5), (2, 1.2)]) {
+            assert!((z - expected).abs() < 1e-12 && shares[joint] > 0.99, "{z} {shares:?}");
+        }
+        // the dominant mode is given whatever its size, and spectral_radius agrees
+        assert_eq!(modes_above(&a, f64::INFINITY).1.len(), 1);
+        let (r, shares) = spectral_radius(&a);
+        assert!((r - 1.5).abs() < 1e-12 && shares[0] > 0.99);
+    }
 }

@@ -45,13 +45,34 @@ fn one_line(s: impl ToString) -> String {
     s.to_string().split_whitespace().collect::<Vec<_>>().join(" ")
 }
 
+/// `<texture/>` without a filename (iCub's and Romeo's exporters write it in every material):
+/// urdfdom, and so Pinocchio and Drake, accept it; urdf-rs requires the filename. Textures play no
+/// part here: the text without those elements, and a notice, or None when there are none.
+fn without_empty_textures(doc: &roxmltree::Document, text: &str, notices: &mut Vec<String>) -> Option<String> {
+    let empty: Vec<std::ops::Range<usize>> =
+        doc.descendants().filter(|n| n.has_tag_name("texture") && n.attribute("filename").is_none()).map(|n| n.range()).collect();
+    if empty.is_empty() {
+        return None;
+    }
+    notices.push(format!("{} <texture> tag(s) without a filename ignored (textures are not drawn)", empty.len()));
+    let mut repaired = String::with_capacity(text.len());
+    let mut from = 0;
+    for range in empty {
+        repaired.push_str(&text[from..range.start]);
+        from = range.end;
+    }
+    repaired.push_str(&text[from..]);
+    Some(repaired)
+}
+
 fn build(text: &str, source: &Path, options: LoadOptions) -> Result<Model, K> {
     let doc = roxmltree::Document::parse(text).map_err(|e| K::Xml(one_line(e)))?;
     if doc.root_element().tag_name().name() != "robot" {
         return Err(K::Urdf(format!("root element is <{}>, expected <robot>", doc.root_element().tag_name().name())));
     }
-    let robot = urdf_rs::read_from_string(text).map_err(|e| K::Urdf(one_line(e)))?;
     let mut notices = Vec::new();
+    let repaired = without_empty_textures(&doc, text, &mut notices);
+    let robot = urdf_rs::read_from_string(repaired.as_deref().unwrap_or(text)).map_err(|e| K::Urdf(one_line(e)))?;
 
     // Names.
     let mut link_index: HashMap<&str, usize> = HashMap::new();
