@@ -5,6 +5,7 @@
 //! show the arm falling. Asked for explicitly (`--q0`, `--amp-deg`, `--freq`) the experiment is run
 //! as asked, with a notice where the motors fall short.
 
+use crate::diagnose::analysis::gravity_stiffness;
 use crate::diagnose::envelope::need;
 use crate::dynamics::{Data, gravity_forces};
 use crate::model::{JointKind, Model};
@@ -39,26 +40,16 @@ pub fn holdable_pose(model: &Model, pose: &[f64], load: f64) -> Option<Vec<f64>>
     let limit = limits(model);
     let mut data = Data::new(model);
     let mut q = pose.to_vec();
-    let (eps, aim) = (1e-6, 0.95 * load);
+    let aim = 0.95 * load;
     for _ in 0..200 {
         let tau_g = gravity_forces(model, &mut data, &q).to_vec();
         let over: Vec<usize> = (0..n).filter(|&j| limit[j].is_some_and(|e| tau_g[j].abs() > load * e)).collect();
         if over.is_empty() {
             return Some(back_where_not_needed(model, pose, q, load));
         }
-        // ∂τ_g/∂q of the overloaded joints, central differences
-        let mut stiffness = DMatrix::zeros(over.len(), n);
-        let mut probe = q.clone();
-        for c in 0..n {
-            probe[c] = q[c] + eps;
-            let plus = gravity_forces(model, &mut data, &probe).to_vec();
-            probe[c] = q[c] - eps;
-            let minus = gravity_forces(model, &mut data, &probe).to_vec();
-            probe[c] = q[c];
-            for (r, &j) in over.iter().enumerate() {
-                stiffness[(r, c)] = (plus[j] - minus[j]) / (2.0 * eps);
-            }
-        }
+        // ∂τ_g/∂q of the overloaded joints
+        let all = gravity_stiffness(model, &mut data, &q);
+        let stiffness = DMatrix::from_fn(over.len(), n, |r, c| all[(over[r], c)]);
         let residual = DVector::from_iterator(over.len(), over.iter().map(|&j| tau_g[j] - tau_g[j].signum() * aim * limit[j].unwrap_or(0.0)));
         // a joint at the end of its range does not move further out: solve without it
         let mut free = vec![true; n];

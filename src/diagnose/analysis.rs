@@ -18,6 +18,25 @@ pub enum LoopPlant {
     Continuous,
 }
 
+/// G = ∂τ_g/∂q at `q`, by central differences (step 1e-6).
+pub fn gravity_stiffness(model: &Model, data: &mut Data, q: &[f64]) -> DMatrix<f64> {
+    let n = model.dof();
+    let eps = 1e-6;
+    let mut stiffness = DMatrix::zeros(n, n);
+    let mut qp = q.to_vec();
+    for j in 0..n {
+        qp[j] = q[j] + eps;
+        let plus = gravity_forces(model, data, &qp).to_vec();
+        qp[j] = q[j] - eps;
+        let minus = gravity_forces(model, data, &qp).to_vec();
+        qp[j] = q[j];
+        for i in 0..n {
+            stiffness[(i, j)] = (plus[i] - minus[i]) / (2.0 * eps);
+        }
+    }
+    stiffness
+}
+
 /// Everything the linearization needs at one pose.
 pub struct Linearization {
     pub mass: DMatrix<f64>,
@@ -27,23 +46,10 @@ pub struct Linearization {
 
 impl Linearization {
     pub fn at(model: &Model, q: &[f64]) -> Self {
-        let n = model.dof();
         let mut data = Data::new(model);
         let mass = crba(model, &mut data, q).clone();
-        let eps = 1e-6;
-        let mut gravity_stiffness = DMatrix::zeros(n, n);
-        let mut qp = q.to_vec();
-        for j in 0..n {
-            qp[j] = q[j] + eps;
-            let plus = gravity_forces(model, &mut data, &qp).to_vec();
-            qp[j] = q[j] - eps;
-            let minus = gravity_forces(model, &mut data, &qp).to_vec();
-            qp[j] = q[j];
-            for i in 0..n {
-                gravity_stiffness[(i, j)] = (plus[i] - minus[i]) / (2.0 * eps);
-            }
-        }
-        Self { mass, gravity_stiffness, damping: DVector::from_iterator(n, model.joints.iter().map(|j| j.damping)) }
+        let gravity_stiffness = gravity_stiffness(model, &mut data, q);
+        Self { mass, gravity_stiffness, damping: DVector::from_iterator(model.dof(), model.joints.iter().map(|j| j.damping)) }
     }
 
     /// The one-period transition matrix of the closed loop (state δq, v).
