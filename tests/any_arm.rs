@@ -422,6 +422,9 @@ fn the_default_experiment_starts_where_the_urdfs_motors_hold_the_arm_and_asks_wh
         (out.status.code(), serde_json::from_str::<serde_json::Value>(&std::fs::read_to_string(&json).unwrap()).unwrap(), String::from_utf8_lossy(&out.stderr).to_string())
     };
     assert_eq!(code, Some(0), "{err}");
+    // what was assumed is in the record, not only on the console
+    let notices: Vec<&str> = doc["notices"].as_array().unwrap().iter().filter_map(|n| n.as_str()).collect();
+    assert!(notices.iter().any(|n| n.contains("default start pose")) && notices.iter().any(|n| n.contains("default wave")), "{notices:?}");
     let s = &doc["summary"];
     for j in 0..model.dof() {
         let (error, chatter) = (s["max_abs_error"][j].as_f64().unwrap(), s["chatter_percent"][j].as_f64().unwrap());

@@ -521,6 +521,7 @@ impl Recorder for McapRecorder {
         meta.insert("urdf".into(), model.source.display().to_string());
         meta.insert("config".into(), serde_json::to_string(&e.config).unwrap_or_default());
         meta.insert("gains".into(), serde_json::to_string(&e.gains).unwrap_or_default());
+        meta.insert("notices".into(), serde_json::to_string(&model.notices).unwrap_or_default());
         meta.insert("plant".into(), run.plant.clone());
         meta.insert("command".into(), run.trajectory.clone());
         meta.insert("start_time_unix_ns".into(), self.start_ns.to_string());

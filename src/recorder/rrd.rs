@@ -581,7 +581,7 @@ pub fn config_markdown(run: &RunInfo) -> String {
     let e = run.experiment;
     let m = &e.model;
     format!(
-        "# armscope run\n\n* model: **{}** (`{}`), {} dof, gravity ({}, {}, {}) m/s²\n* plant: {}\n* command: {}\n* controller: PD{}, control period {} ms\n* gains ({}): kp = {:?}, kd = {:?}\n* duration: {} s ({} steps)\n\n```json\n{}\n```\n",
+        "# armscope run\n\n* model: **{}** (`{}`), {} dof, gravity ({}, {}, {}) m/s²\n* plant: {}\n* command: {}\n* controller: PD{}, control period {} ms\n* gains ({}): kp = {:?}, kd = {:?}\n* duration: {} s ({} steps)\n{}\n```json\n{}\n```\n",
         m.name,
         m.source.display(),
         m.dof(),
@@ -597,6 +597,8 @@ pub fn config_markdown(run: &RunInfo) -> String {
         e.gains.kd,
         e.config.duration,
         e.steps,
+        // what armscope assumed on the user's behalf (a welded root, a moved start pose, …)
+        m.notices.iter().map(|n| format!("* notice: {n}\n")).collect::<String>(),
         serde_json::to_string_pretty(&e.config).unwrap_or_default()
     )
 }

@@ -31,6 +31,7 @@ impl Recorder for SummaryJson {
             "urdf": e.model.source,
             "config": e.config,
             "gains": e.gains,
+            "notices": e.model.notices,
             "plant": run.plant,
             "command": run.trajectory,
             "summary": summary,
