@@ -25,7 +25,7 @@ fn limits(model: &Model) -> Vec<Option<f64>> {
     model.effort_limits().into_iter().enumerate().map(|(j, e)| (model.is_actuated(j) && e > 0.0 && e.is_finite()).then_some(e)).collect()
 }
 
-/// Per joint over its share `load` of its effort at `pose`: (joint, |τ_g|, effort).
+/// The driven joints whose weight at `pose` takes more than `load` of their effort: (joint, |τ_g|, effort).
 pub fn overloaded_by_weight(model: &Model, pose: &[f64], load: f64) -> Vec<(usize, f64, f64)> {
     let tau_g = gravity_forces(model, &mut Data::new(model), pose).to_vec();
     limits(model).into_iter().enumerate().filter_map(|(j, e)| e.filter(|&e| tau_g[j].abs() > load * e).map(|e| (j, tau_g[j].abs(), e))).collect()
