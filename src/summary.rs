@@ -52,6 +52,10 @@ pub struct Summary {
     pub rms_error: Vec<Option<f64>>,
     /// Share of control steps where the controller asked for more than the limit, %.
     pub saturation_percent: Vec<f64>,
+    /// The same share over the control steps from `error_window_start` on, % (null when the run is
+    /// shorter): saturation only before it is the start's catching up, not the motion's demand.
+    #[serde(default)]
+    pub saturation_after_settle_percent: Vec<Option<f64>>,
     /// Share of steps whose torque flipped sign from the previous step with one of the two
     /// saturated, %. Close to the saturation share: the saturation is numerical chatter.
     pub chatter_percent: Vec<f64>,
@@ -93,8 +97,10 @@ pub struct SummaryBuilder {
     sum_sq_err: Vec<f64>,
     window_samples: u64,
     saturated_steps: Vec<u64>,
+    saturated_in_window: Vec<u64>,
     chatter_steps: Vec<u64>,
     control_steps: u64,
+    window_control_steps: u64,
     peak_torque: Vec<f64>,
     effort: Vec<f64>,
     lowest_limit: Vec<f64>,
@@ -120,8 +126,10 @@ impl SummaryBuilder {
             sum_sq_err: vec![0.0; n],
             window_samples: 0,
             saturated_steps: vec![0; n],
+            saturated_in_window: vec![0; n],
             chatter_steps: vec![0; n],
             control_steps: 0,
+            window_control_steps: 0,
             peak_torque: vec![0.0; n],
             lowest_limit: effort.clone(),
             peak_share: vec![0.0; n],
@@ -160,8 +168,11 @@ impl SummaryBuilder {
         }
         if !s.is_final {
             self.control_steps += 1;
+            let in_window = s.k >= self.first_window_step;
+            self.window_control_steps += in_window as u64;
             for i in 0..n {
                 self.saturated_steps[i] += s.saturated[i] as u64;
+                self.saturated_in_window[i] += (in_window && s.saturated[i]) as u64;
                 self.chatter_steps[i] += s.chatter[i] as u64;
                 self.peak_torque[i] = self.peak_torque[i].max(s.u[i].abs());
                 self.lowest_limit[i] = self.lowest_limit[i].min(s.torque_limit[i]);
@@ -207,6 +218,11 @@ impl SummaryBuilder {
                 .map(|&s| in_window.then(|| (s / self.window_samples as f64).sqrt()))
                 .collect(),
             saturation_percent: share_of_control_steps(&self.saturated_steps),
+            saturation_after_settle_percent: self
+                .saturated_in_window
+                .iter()
+                .map(|&c| (self.window_control_steps > 0).then(|| 100.0 * c as f64 / self.window_control_steps as f64))
+                .collect(),
             chatter_percent: share_of_control_steps(&self.chatter_steps),
             peak_abs_torque: self.peak_torque.clone(),
             effort_limit: self.effort.clone(),
@@ -242,6 +258,13 @@ impl Summary {
             if chat >= 0.5 * sat {
                 out.push(format!(
                     "{name}: saturated {sat:.0}% of steps, and the torque flips sign on {chat:.0}% — mostly numerical chatter (the sampled loop is unstable), not torque demand; `armscope analyze` (with the run's --motors) finds stable gains"
+                ));
+            } else if self.saturation_after_settle_percent.get(j).copied().flatten().is_some_and(|after| after < 0.5) {
+                // the command starts away from the start pose (the wave's phases): the controller
+                // catches up at full torque, which says nothing of what the motion needs
+                out.push(format!(
+                    "{name}: saturated {sat:.0}% of steps, nearly all before t = {} s, catching up with the command at the start — not the motion's own demand",
+                    self.error_window_start
                 ));
             } else {
                 out.push(format!("{name}: saturated {sat:.0}% of steps with little chatter ({chat:.0}%) — real torque demand beyond the motor's limit"));

@@ -52,7 +52,21 @@ fn summary_json_holds_the_console_numbers() {
         let saturated = (0..4000).filter(|&k| u[k].abs() == effort).count();
         let pct = s["saturation_percent"][j].as_f64().unwrap();
         assert!((pct - 100.0 * saturated as f64 / 4000.0).abs() < 1e-9, "J{}: {pct} %", j + 1);
+        // and over the control steps from t = 2 s on
+        let after = (2000..4000).filter(|&k| u[k].abs() == effort).count();
+        let pct_after = s["saturation_after_settle_percent"][j].as_f64().unwrap();
+        assert!((pct_after - 100.0 * after as f64 / 2000.0).abs() < 1e-9, "J{}: {pct_after} % after 2 s", j + 1);
     }
+    // the words: saturation all at the start is the catching up, not the motion's demand
+    let mut summary: armscope::summary::Summary = serde_json::from_value(s.clone()).unwrap();
+    summary.chatter_percent = vec![0.0; 6];
+    summary.saturation_percent[0] = 5.0;
+    summary.saturation_after_settle_percent[0] = Some(0.1);
+    let verdict = summary.saturation_verdicts().into_iter().find(|v| v.starts_with("J1:")).unwrap();
+    assert!(verdict.contains("catching up with the command at the start"), "{verdict}");
+    summary.saturation_after_settle_percent[0] = Some(3.0);
+    let verdict = summary.saturation_verdicts().into_iter().find(|v| v.starts_with("J1:")).unwrap();
+    assert!(verdict.contains("real torque demand"), "{verdict}");
     assert!(s["tool_range"]["x"]["max"].as_f64().unwrap() >= 0.62 - 1e-12);
     assert_eq!(doc["gains"]["source"], "tutorial");
 }
