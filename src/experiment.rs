@@ -358,17 +358,11 @@ fn gains(config: &RunConfig, model: &Model, start: &[f64], trajectory: &dyn Traj
 /// A joint whose motor cannot carry the arm's weight at the start pose saturates from the first step
 /// on, whatever the controller does: say so before the run, naming the joint and both torques.
 fn weight_notices(model: &mut Model, start: &[f64]) {
-    let tau_g = crate::dynamics::gravity_forces(model, &mut crate::dynamics::Data::new(model), start).to_vec();
-    let effort = model.effort_limits();
-    for j in 0..model.dof() {
-        if model.is_actuated(j) && effort[j] > 0.0 && tau_g[j].abs() > effort[j] {
-            let name = model.joints[j].name.clone();
-            model.notices.push(format!(
-                "joint '{name}': holding the start pose against gravity takes {:.3} N·m, more than its {} N·m: it cannot hold the arm there and will sag (an arm whose real counterbalance springs its URDF leaves out? --q0 starts elsewhere)",
-                tau_g[j].abs(),
-                effort[j]
-            ));
-        }
+    for (j, tau_g, effort) in overloaded_by_weight(model, start, 1.0) {
+        let name = model.joints[j].name.clone();
+        model.notices.push(format!(
+            "joint '{name}': holding the start pose against gravity takes {tau_g:.3} N·m, more than its {effort} N·m: it cannot hold the arm there and will sag (an arm whose real counterbalance springs its URDF leaves out? --q0 starts elsewhere)"
+        ));
     }
 }
 

@@ -9,4 +9,3 @@ fn main() {
 // glibc's per-thread arenas spend much of that in the kernel (mprotect/madvise).
 #[global_allocator]
 static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
-

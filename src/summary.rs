@@ -100,7 +100,6 @@ pub struct SummaryBuilder {
     saturated_in_window: Vec<u64>,
     chatter_steps: Vec<u64>,
     control_steps: u64,
-    window_control_steps: u64,
     peak_torque: Vec<f64>,
     effort: Vec<f64>,
     lowest_limit: Vec<f64>,
@@ -129,7 +128,6 @@ impl SummaryBuilder {
             saturated_in_window: vec![0; n],
             chatter_steps: vec![0; n],
             control_steps: 0,
-            window_control_steps: 0,
             peak_torque: vec![0.0; n],
             lowest_limit: effort.clone(),
             peak_share: vec![0.0; n],
@@ -169,7 +167,6 @@ impl SummaryBuilder {
         if !s.is_final {
             self.control_steps += 1;
             let in_window = s.k >= self.first_window_step;
-            self.window_control_steps += in_window as u64;
             for i in 0..n {
                 self.saturated_steps[i] += s.saturated[i] as u64;
                 self.saturated_in_window[i] += (in_window && s.saturated[i]) as u64;
@@ -201,6 +198,8 @@ impl SummaryBuilder {
     pub fn finish(&self, status: RunStatus, wall_time: f64) -> Summary {
         let in_window = self.window_samples > 0;
         let range = |a: usize| Range { min: self.tool_min[a], max: self.tool_max[a] };
+        // the control steps k = 0, 1, … from the window's first on
+        let window_control_steps = self.control_steps.saturating_sub(self.first_window_step as u64);
         let share_of_control_steps = |counts: &[u64]| -> Vec<f64> {
             counts.iter().map(|&c| if self.control_steps == 0 { 0.0 } else { 100.0 * c as f64 / self.control_steps as f64 }).collect()
         };
@@ -221,7 +220,7 @@ impl SummaryBuilder {
             saturation_after_settle_percent: self
                 .saturated_in_window
                 .iter()
-                .map(|&c| (self.window_control_steps > 0).then(|| 100.0 * c as f64 / self.window_control_steps as f64))
+                .map(|&c| (window_control_steps > 0).then(|| 100.0 * c as f64 / window_control_steps as f64))
                 .collect(),
             chatter_percent: share_of_control_steps(&self.chatter_steps),
             peak_abs_torque: self.peak_torque.clone(),

@@ -386,7 +386,7 @@ fn an_arm_that_cannot_hold_the_start_pose_asked_for_is_told_so_per_joint() {
 fn the_default_experiment_starts_where_the_urdfs_motors_hold_the_arm_and_asks_what_they_carry() {
     use armscope::config::RunConfig;
     use armscope::control::within_effort::{MOTION_LOAD, START_LOAD};
-    use armscope::diagnose::envelope::need;
+    use armscope::diagnose::envelope::required_torque;
     use armscope::experiment::Experiment;
     let urdf = common::repo().join("tests/fixtures/robots/baxter.urdf");
     let baxter = Experiment::prepare(RunConfig { urdf: urdf.clone(), ..RunConfig::default() }).unwrap();
@@ -407,7 +407,7 @@ fn the_default_experiment_starts_where_the_urdfs_motors_hold_the_arm_and_asks_wh
     let notice = model.notices.iter().find(|n| n.contains("default start pose")).expect("a notice");
     assert!(notice.contains("right_s1 56.424 N·m of its 50") && notice.contains("--q0 right_s1="), "{notice}");
     // the wave: scaled until the motion needs at most 80 % of each joint's effort, and no smaller than that needs
-    let (peak, _) = need(model, baxter.trajectory.as_ref(), 4.0 * std::f64::consts::PI, 0.01, &|_, _, _| 1.0);
+    let peak = required_torque(model, baxter.trajectory.as_ref(), 4.0 * std::f64::consts::PI, 0.01);
     let worst = (0..model.dof()).filter(|&j| model.is_actuated(j)).map(|j| peak[j] / effort[j]).fold(0.0, f64::max);
     assert!(worst <= MOTION_LOAD + 0.005 && worst > MOTION_LOAD - 0.05, "the motion needs {worst} of the effort");
     assert!(model.notices.iter().any(|n| n.contains("default wave") && n.contains("scaled to")), "{:?}", model.notices);

@@ -6,7 +6,7 @@
 //! as asked, with a notice where the motors fall short.
 
 use crate::diagnose::analysis::gravity_stiffness;
-use crate::diagnose::envelope::need;
+use crate::diagnose::envelope::required_torque;
 use crate::dynamics::{Data, gravity_forces};
 use crate::model::{JointKind, Model};
 use nalgebra::{DMatrix, DVector};
@@ -136,13 +136,13 @@ fn back_where_not_needed(model: &Model, pose: &[f64], mut held: Vec<f64>, load: 
 pub fn carried_wave(model: &Model, start: &[f64], amplitude_deg: f64, omega: f64, load: f64) -> (JointWave, f64, Option<(usize, f64, f64)>) {
     let limit = limits(model);
     let wave_at = |share: f64| JointWave::fitted(model, start, amplitude_deg * share, omega);
+    let full = wave_at(1.0);
     // one period, 96 samples (a wave slower than 1/10 Hz: its first 10 s)
-    let period = super::trajectory::Trajectory::period(&wave_at(1.0)).unwrap_or(10.0).min(10.0);
+    let period = super::trajectory::Trajectory::period(&full).unwrap_or(10.0).min(10.0);
     let worst = |wave: &JointWave| -> Option<(usize, f64, f64, f64)> {
-        let (peak, _) = need(model, wave, period, period / 96.0, &|_, _, _| 1.0);
+        let peak = required_torque(model, wave, period, period / 96.0);
         (0..model.dof()).filter_map(|j| limit[j].map(|e| (j, peak[j], e, peak[j] / e))).max_by(|a, b| a.3.total_cmp(&b.3))
     };
-    let full = wave_at(1.0);
     let Some((joint, torque, effort, share)) = worst(&full) else { return (full, 1.0, None) };
     if share <= load {
         return (full, 1.0, None);
@@ -202,7 +202,7 @@ mod tests {
         let start = holdable_pose(&model, &[0.0], START_LOAD).unwrap();
         let (wave, share, worst) = carried_wave(&model, &start, 30.0, 0.5, MOTION_LOAD);
         assert!(share < 1.0 && worst.is_some_and(|(j, tau, e)| j == 0 && tau > MOTION_LOAD * e), "{share} {worst:?}");
-        let peak = |w: &JointWave| need(&model, w, 4.0 * std::f64::consts::PI, 0.005, &|_, _, _| 1.0).0[0];
+        let peak = |w: &JointWave| required_torque(&model, w, 4.0 * std::f64::consts::PI, 0.005)[0];
         assert!(peak(&wave) <= MOTION_LOAD * 10.0 + 1e-3, "needs {}", peak(&wave));
         // 2 % larger needs more than the load: the largest that fits
         assert!(peak(&JointWave::fitted(&model, &start, 30.0 * share * 1.02, 0.5)) > MOTION_LOAD * 10.0);
