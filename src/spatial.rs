@@ -7,6 +7,9 @@
 
 use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 
+mod inertia;
+pub use inertia::SpatialInertia;
+
 /// A rigid transform stored as a rotation matrix and a translation (cheaper to compose and apply
 /// on hot paths than a quaternion).
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -26,9 +26,9 @@ pub fn aba_from_kinematics(model: &Model, data: &mut Data, v: &[f64], tau: &[f64
         let joint_velocity = s * v[i];
         let vel = v_parent + joint_velocity;
         data.bias_acceleration[i] = cross_motion(&vel, &joint_velocity);
-        let inertia = data.body_inertia[i];
-        data.articulated_bias[i] = cross_force(&vel, &(inertia * vel));
-        data.articulated_inertia[i] = inertia;
+        let inertia = &data.body_inertia[i];
+        data.articulated_bias[i] = cross_force(&vel, &inertia.mul_motion(&vel));
+        data.articulated_inertia[i] = inertia.to_matrix();
         data.velocity[i] = vel;
     }
     for i in (0..n).rev() {

@@ -11,24 +11,47 @@ pub fn crba<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> &'d nalgebra::D
 }
 
 /// CRBA assuming `forward_kinematics` was run for the current q.
+///
+/// The composite inertias are kept in their ten numbers (world frame, so a child's is added to its
+/// parent's as it is), and each body's force set F_i = I_i^c·S_i is projected on the motion
+/// subspaces of its ancestors: M_ij = S_jᵀ·F_i, only the entries of the body and its supports.
 pub fn crba_from_kinematics(model: &Model, data: &mut Data) {
     let b = model.bodies.len();
+    let n = model.dof();
     data.composite_inertia[..b].copy_from_slice(&data.body_inertia[..b]);
-    data.mass_matrix.fill(0.0);
-    let coordinate = |i: usize| model.couplings[i].coordinate;
+    let coupled = model.has_mimic();
+    let mass = data.mass_matrix.as_mut_slice(); // column-major: (row, column) at row + column·n
+    if coupled {
+        mass.fill(0.0);
+    }
+    // Without mimic joints body i is coordinate i, and only the entries (i, j) with j supporting i
+    // (and their mirror) are non-zero: they are all written below, and the others keep the zero
+    // they got in Data::new, so the matrix is not cleared first.
+    //
     // Children have larger indices, so a body's composite inertia is complete when the reverse
     // sweep reaches it.
     for i in (0..b).rev() {
-        let force = data.composite_inertia[i] * data.motion_subspace[i];
-        let ci = coordinate(i);
-        data.mass_matrix[(ci, ci)] += data.motion_subspace[i].dot(&force);
+        let force = data.composite_inertia[i].mul_motion(&data.motion_subspace[i]);
+        let ci = model.couplings[i].coordinate;
+        let diagonal = data.motion_subspace[i].dot(&force);
         let mut ancestor = model.bodies[i].parent;
-        while let Some(j) = ancestor {
-            let m = data.motion_subspace[j].dot(&force);
-            let cj = coordinate(j);
-            data.mass_matrix[(ci, cj)] += m;
-            data.mass_matrix[(cj, ci)] += m;
-            ancestor = model.bodies[j].parent;
+        if coupled {
+            mass[ci + ci * n] += diagonal;
+            while let Some(j) = ancestor {
+                let m = data.motion_subspace[j].dot(&force);
+                let cj = model.couplings[j].coordinate;
+                mass[ci + cj * n] += m;
+                mass[cj + ci * n] += m;
+                ancestor = model.bodies[j].parent;
+            }
+        } else {
+            mass[i + i * n] = diagonal;
+            while let Some(j) = ancestor {
+                let m = data.motion_subspace[j].dot(&force);
+                mass[i + j * n] = m;
+                mass[j + i * n] = m;
+                ancestor = model.bodies[j].parent;
+            }
         }
         if let Some(p) = model.bodies[i].parent {
             let c = data.composite_inertia[i];
@@ -37,6 +60,6 @@ pub fn crba_from_kinematics(model: &Model, data: &mut Data) {
     }
     // the motors' rotors, J_r·N² on the diagonal (Drake: M.diagonal() += reflected_inertia)
     for (c, a) in model.armature.iter().enumerate() {
-        data.mass_matrix[(c, c)] += a;
+        mass[c + c * n] += a;
     }
 }

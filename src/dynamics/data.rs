@@ -1,5 +1,5 @@
 use crate::model::Model;
-use crate::spatial::Pose;
+use crate::spatial::{Pose, SpatialInertia};
 use nalgebra::{DMatrix, Matrix6, Vector6};
 
 /// The per-simulation workspace of the dynamics algorithms. Sized once for a model; the
@@ -12,7 +12,7 @@ pub struct Data {
     /// `forward_kinematics`); S_i itself for an independent joint.
     pub motion_subspace: Vec<Vector6<f64>>,
     /// Each body's spatial inertia in world coordinates (set by `forward_kinematics`).
-    pub body_inertia: Vec<Matrix6<f64>>,
+    pub body_inertia: Vec<SpatialInertia>,
     /// Body spatial velocities and accelerations (RNEA, ABA).
     pub velocity: Vec<Vector6<f64>>,
     pub acceleration: Vec<Vector6<f64>>,
@@ -20,7 +20,7 @@ pub struct Data {
     pub force: Vec<Vector6<f64>>,
     pub gravity_force: Vec<Vector6<f64>>,
     /// Composite rigid-body inertias (CRBA).
-    pub composite_inertia: Vec<Matrix6<f64>>,
+    pub composite_inertia: Vec<SpatialInertia>,
     /// ABA intermediates.
     pub bias_acceleration: Vec<Vector6<f64>>,
     pub articulated_inertia: Vec<Matrix6<f64>>,
@@ -28,7 +28,8 @@ pub struct Data {
     pub aba_u: Vec<Vector6<f64>>,
     pub aba_d: Vec<f64>,
     pub aba_torque: Vec<f64>,
-    /// Outputs.
+    /// Outputs. M(q): without `<mimic>` joints CRBA writes only the entries of joints where one
+    /// supports the other; the rest keep the zero they start with here, so nothing else may write it.
     pub mass_matrix: DMatrix<f64>,
     pub tau: Vec<f64>,
     pub qdd: Vec<f64>,
@@ -46,12 +47,12 @@ impl Data {
         Self {
             body_pose: vec![Pose::identity(); b],
             motion_subspace: vec![Vector6::zeros(); b],
-            body_inertia: vec![Matrix6::zeros(); b],
+            body_inertia: vec![SpatialInertia::zero(); b],
             velocity: vec![Vector6::zeros(); b],
             acceleration: vec![Vector6::zeros(); b],
             force: vec![Vector6::zeros(); b],
             gravity_force: vec![Vector6::zeros(); b],
-            composite_inertia: vec![Matrix6::zeros(); b],
+            composite_inertia: vec![SpatialInertia::zero(); b],
             bias_acceleration: vec![Vector6::zeros(); b],
             articulated_inertia: vec![Matrix6::zeros(); b],
             articulated_bias: vec![Vector6::zeros(); b],

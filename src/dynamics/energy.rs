@@ -18,7 +18,7 @@ pub fn kinetic_energy(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) -> f
 /// [`kinetic_energy`] from the body velocities already in `data` (any velocity pass at (q, q̇):
 /// RNEA, or the loop's gravity-and-bias pass).
 pub fn kinetic_energy_from_velocities(model: &Model, data: &Data, v: &[f64]) -> f64 {
-    let bodies: f64 = (0..model.bodies.len()).map(|i| data.velocity[i].dot(&(data.body_inertia[i] * data.velocity[i]))).sum();
+    let bodies: f64 = (0..model.bodies.len()).map(|i| data.velocity[i].dot(&data.body_inertia[i].mul_motion(&data.velocity[i]))).sum();
     let rotors: f64 = model.armature.iter().zip(v).map(|(a, v)| a * v * v).sum();
     0.5 * (bodies + rotors)
 }

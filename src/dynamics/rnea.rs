@@ -30,7 +30,7 @@ pub fn rnea_from_kinematics(model: &Model, data: &mut Data, v: &[f64], a: &[f64]
         let vel = v_parent + s * v[c];
         let acc = a_parent + s * a[c] + cross_motion(&vel, &(s * v[c]));
         let inertia = &data.body_inertia[i];
-        data.force[i] = inertia * acc + cross_force(&vel, &(inertia * vel));
+        data.force[i] = inertia.mul_motion(&acc) + cross_force(&vel, &inertia.mul_motion(&vel));
         data.velocity[i] = vel;
         data.acceleration[i] = acc;
     }
@@ -52,7 +52,7 @@ pub fn rnea_from_kinematics(model: &Model, data: &mut Data, v: &[f64], a: &[f64]
 /// `forward_kinematics` was run for the current q.
 pub fn gravity_and_bias_from_kinematics(model: &Model, data: &mut Data, v: &[f64]) {
     // With q̈ = 0 and no gravity RNEA gives C q̇; gravity alone accelerates every body by −a₀.
-    let g = -base_acceleration(model);
+    let g = model.gravity;
     for (i, (joint, coupling)) in model.bodies.iter().zip(&model.couplings).enumerate() {
         let s = data.motion_subspace[i];
         let (v_parent, a_parent) = match joint.parent {
@@ -63,8 +63,8 @@ pub fn gravity_and_bias_from_kinematics(model: &Model, data: &mut Data, v: &[f64
         let vel = v_parent + joint_velocity;
         let acc = a_parent + cross_motion(&vel, &joint_velocity);
         let inertia = &data.body_inertia[i];
-        data.force[i] = inertia * acc + cross_force(&vel, &(inertia * vel));
-        data.gravity_force[i] = inertia * g;
+        data.force[i] = inertia.mul_motion(&acc) + cross_force(&vel, &inertia.mul_motion(&vel));
+        data.gravity_force[i] = inertia.mul_linear(&g);
         data.velocity[i] = vel;
         data.acceleration[i] = acc;
     }
@@ -91,9 +91,9 @@ pub fn gravity_forces<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> &'d [
 
 /// τ_g into `data.gravity`, assuming `forward_kinematics` was run for the current q.
 pub fn gravity_from_kinematics(model: &Model, data: &mut Data) {
-    let g = -base_acceleration(model);
+    let g = model.gravity;
     for i in 0..model.bodies.len() {
-        data.gravity_force[i] = data.body_inertia[i] * g;
+        data.gravity_force[i] = data.body_inertia[i].mul_linear(&g);
     }
     data.gravity.fill(0.0);
     for (i, (joint, coupling)) in model.bodies.iter().zip(&model.couplings).enumerate().rev() {

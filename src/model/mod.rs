@@ -1,9 +1,11 @@
 //! The read-only robot model: built once from a URDF, shared by every simulation of it.
 
 mod error;
+mod joint_motion;
 mod urdf;
 
 pub use error::{ModelError, ModelErrorKind};
+pub use joint_motion::JointMotion;
 pub use urdf::{LoadOptions, load_urdf, load_urdf_str, load_urdf_str_with, load_urdf_with};
 
 use crate::spatial::{Pose, RigidInertia};
@@ -122,6 +124,9 @@ pub struct Model {
     pub bodies: Vec<Joint>,
     /// Per body, the coordinate its joint follows: q_joint = multiplier·q[coordinate] + offset.
     pub couplings: Vec<Coupling>,
+    /// Per body, its joint's motion multiplied out from the placement and axis (what forward
+    /// kinematics evaluates).
+    pub motions: Vec<JointMotion>,
     pub frames: Vec<Frame>,
     pub actuators: Vec<Actuator>,
     /// Per coordinate, the reflected inertia of its motor's rotor, J_r·N², added to M's diagonal by

@@ -1,7 +1,7 @@
 //! URDF → [`Model`]: parsing (urdf-rs, plus roxmltree for `<transmission>`, which urdf-rs drops),
 //! validation with one-line errors, fixed-joint merging and welding of a free root.
 
-use super::{Actuator, Coupling, Frame, Geometry, Joint, JointKind, Model, ModelError, ModelErrorKind as K, Visual};
+use super::{Actuator, Coupling, Frame, Geometry, Joint, JointKind, JointMotion, Model, ModelError, ModelErrorKind as K, Visual};
 use crate::spatial::{Pose, RigidInertia};
 use nalgebra::{Matrix3, SymmetricEigen, Vector3};
 use std::collections::HashMap;
@@ -218,6 +218,7 @@ fn build(text: &str, source: &Path, options: LoadOptions) -> Result<Model, K> {
         urdf_text: text.to_string(),
         gravity: Vector3::from(STANDARD_GRAVITY),
         joints,
+        motions: bodies.iter().map(JointMotion::new).collect(),
         bodies,
         couplings,
         frames,

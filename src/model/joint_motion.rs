@@ -1,0 +1,49 @@
+use super::{Joint, JointKind};
+use crate::spatial::skew;
+use nalgebra::{Matrix3, Vector3};
+
+/// A joint's motion in its parent body's frame, multiplied out once when the model is built, so that
+/// a body's world pose costs one 3×3 product: with R_pl the placement's rotation and a the
+/// unit axis, Rodrigues' formula Rot(a, q) = a·aᵀ + cos q·(1 − a·aᵀ) + sin q·[a]ₓ premultiplied by
+/// R_pl gives R_pl·Rot(a, q) = `fixed` + cos q·`cosine` + sin q·`sine`.
+#[derive(Clone, Copy, Debug)]
+pub struct JointMotion {
+    /// R_pl·a·aᵀ for a revolute joint, R_pl for a prismatic one.
+    fixed: Matrix3<f64>,
+    cosine: Matrix3<f64>,
+    sine: Matrix3<f64>,
+    /// The axis in the parent body's frame, R_pl·a.
+    pub axis: Vector3<f64>,
+    /// The joint frame's origin in the parent body's frame.
+    origin: Vector3<f64>,
+    prismatic: bool,
+}
+
+impl JointMotion {
+    pub fn new(joint: &Joint) -> Self {
+        let r = joint.placement.rotation;
+        let a = joint.axis;
+        let outer = a * a.transpose();
+        let prismatic = joint.kind == JointKind::Prismatic;
+        Self {
+            fixed: if prismatic { r } else { r * outer },
+            cosine: if prismatic { Matrix3::zeros() } else { r * (Matrix3::identity() - outer) },
+            sine: if prismatic { Matrix3::zeros() } else { r * skew(&a) },
+            axis: r * a,
+            origin: joint.placement.translation,
+            prismatic,
+        }
+    }
+
+    /// The body frame in the parent body's frame at joint position `q`.
+    #[inline]
+    pub fn local_pose(&self, q: f64) -> (Matrix3<f64>, Vector3<f64>) {
+        if self.prismatic {
+            (self.fixed, self.origin + self.axis * q)
+        } else {
+            let (s, c) = q.sin_cos();
+            (self.fixed + self.cosine * c + self.sine * s, self.origin)
+        }
+    }
+}
+
