@@ -17,7 +17,8 @@ use nalgebra::DMatrix;
 pub struct DiscretePlant {
     pub time_step: f64,
     pub substeps: usize,
-    system: DMatrix<f64>,
+    /// h·D, the implicit damping added to M's diagonal: A = M + h·D.
+    step_damping: Vec<f64>,
     factor: DMatrix<f64>,
     rhs: Vec<f64>,
     reduced_rhs: Vec<f64>,
@@ -36,7 +37,7 @@ impl DiscretePlant {
         Self {
             time_step,
             substeps,
-            system: DMatrix::zeros(n, n),
+            step_damping: model.joints.iter().map(|joint| time_step * joint.damping).collect(),
             factor: DMatrix::zeros(n, n),
             rhs: vec![0.0; n],
             reduced_rhs: vec![0.0; n],
@@ -52,20 +53,19 @@ impl DiscretePlant {
         let n = model.dof();
         let h = self.time_step;
         crba_from_kinematics(model, data);
-        let m = &data.mass_matrix;
-        for i in 0..n {
-            let mut mv = 0.0;
-            for j in 0..n {
-                mv += m[(i, j)] * v[j];
+        // b = M·v + h·(u + τ_g − C·v), M·v by columns (M is stored by columns)
+        let mass = data.mass_matrix.as_slice();
+        self.rhs.fill(0.0);
+        for (column, vj) in mass.chunks_exact(n).zip(v.iter()) {
+            for (b, mij) in self.rhs.iter_mut().zip(column) {
+                *b += mij * vj;
             }
-            self.rhs[i] = mv + h * (u[i] + data.gravity[i] - data.bias[i]);
         }
-        self.system.copy_from(m);
-        for (i, joint) in model.joints.iter().enumerate() {
-            self.system[(i, i)] += h * joint.damping;
+        for i in 0..n {
+            self.rhs[i] += h * (u[i] + data.gravity[i] - data.bias[i]);
         }
         self.constraint.fill(0);
-        self.solve_with_limits(model, q);
+        self.solve_with_limits(model, mass, q);
         for i in 0..n {
             v[i] = self.v_next[i];
             q[i] += h * v[i];
@@ -92,11 +92,11 @@ impl DiscretePlant {
 
     /// Active-set solve: start unconstrained, fix the velocity of every joint that would pass its
     /// limit to the velocity that lands on it, release a joint whose constraint would have to pull.
-    fn solve_with_limits(&mut self, model: &Model, q: &[f64]) {
+    fn solve_with_limits(&mut self, model: &Model, mass: &[f64], q: &[f64]) {
         let n = model.dof();
         let h = self.time_step;
         for _ in 0..(2 * n + 2) {
-            self.solve_reduced(model, q);
+            self.solve_reduced(model, mass, q);
             let mut changed = false;
             for i in 0..n {
                 let joint = &model.joints[i];
@@ -113,9 +113,10 @@ impl DiscretePlant {
                     }
                     side => {
                         // impulse the constraint applies: λ = (A v − b)_i; an upper stop may only push down
-                        let mut lambda = -self.rhs[i];
-                        for j in 0..n {
-                            lambda += self.system[(i, j)] * self.v_next[j];
+                        // (A v)_i = Σ_j M_ij v_j + h·D_i·v_i, row i of the symmetric M read as its column i
+                        let mut lambda = -self.rhs[i] + self.step_damping[i] * self.v_next[i];
+                        for (mij, vj) in mass[i * n..(i + 1) * n].iter().zip(&self.v_next) {
+                            lambda += mij * vj;
                         }
                         if lambda * side as f64 > 0.0 {
                             self.constraint[i] = 0;
@@ -130,10 +131,13 @@ impl DiscretePlant {
         }
     }
 
-    fn solve_reduced(&mut self, model: &Model, q: &[f64]) {
+    fn solve_reduced(&mut self, model: &Model, mass: &[f64], q: &[f64]) {
         let n = model.dof();
         let h = self.time_step;
-        self.factor.copy_from(&self.system);
+        self.factor.as_mut_slice().copy_from_slice(mass);
+        for (i, hd) in self.step_damping.iter().enumerate() {
+            self.factor[(i, i)] += hd;
+        }
         self.reduced_rhs.copy_from_slice(&self.rhs);
         for j in 0..n {
             if self.constraint[j] == 0 {
