@@ -31,6 +31,8 @@ pub struct Outputs {
     pub summary_json: Option<PathBuf>,
     /// Called with messages for the user (e.g. no viewer reachable).
     pub notice: Option<fn(&str)>,
+    /// Further recorders, run after the others (a batch's comparison series).
+    pub recorders: Vec<Box<dyn Recorder>>,
 }
 
 /// `text` with every character that is not ASCII alphanumeric or `-_.` made a `-`: usable as a
@@ -86,6 +88,7 @@ pub fn run_experiment(experiment: &Experiment, outputs: Outputs, stop: Option<&A
             recorders.push(make(path.clone()));
         }
     }
+    recorders.extend(outputs.recorders);
     let mut refs: Vec<&mut dyn Recorder> = recorders.iter_mut().map(|r| r.as_mut() as &mut dyn Recorder).collect();
     simulate(experiment, &mut refs, stop)
 }

@@ -183,3 +183,36 @@ fn batch_tables_count_lost_steps_per_joint() {
     assert!(value("real,") > 0, "the real reductions cannot hold the box model's J2");
     assert!(std::fs::read_to_string(out.join("summary.md")).unwrap().contains("| lost steps |"));
 }
+
+/// The batch writes its comparison from the series its runs keep while they go on; `armscope
+/// compare` reads the same series back from the runs' `.mcap` files. Both give the same entities,
+/// rows and values (f64 through protobuf is exact), the failed experiment in neither.
+#[test]
+fn the_batch_comparison_from_memory_equals_the_one_from_the_mcap_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let manifest = small_manifest(dir.path());
+    let out = dir.path().join("batch");
+    assert_eq!(armscope(&["batch", manifest.to_str().unwrap(), "--out", out.to_str().unwrap(), "--jobs", "2"]), 1, "'broken' fails");
+    let finished = ["wave", "step-2", "step-J4", "continuous"];
+    let mcaps: Vec<String> = finished.iter().map(|n| out.join(format!("{n}.mcap")).to_str().unwrap().to_string()).collect();
+    let from_files = dir.path().join("from_files.rrd");
+    let mut args = vec!["compare", "--out", from_files.to_str().unwrap()];
+    args.extend(mcaps.iter().map(String::as_str));
+    assert_eq!(armscope(&args), 0);
+    let (batch, files) = (common::rrd::Rrd::open(&out.join("comparison.rrd")), common::rrd::Rrd::open(&from_files));
+    let (batch_entities, file_entities) = (batch.entities(), files.entities());
+    assert_eq!(batch_entities.keys().collect::<Vec<_>>(), file_entities.keys().collect::<Vec<_>>());
+    assert!(!batch_entities.keys().any(|e| e.starts_with("/broken")));
+    let mut compared = 0;
+    for (entity, info) in &batch_entities {
+        assert_eq!(info.rows, file_entities[entity].rows, "{entity}");
+        if entity.ends_with("/error") || entity.ends_with("/torque") || entity.ends_with("/angle") {
+            let values = batch.series(entity);
+            assert!(values.len() > 500, "{entity}: {} rows", values.len());
+            assert_eq!(values, files.series(entity), "{entity}");
+            compared += 1;
+        }
+    }
+    assert_eq!(compared, finished.len() * 6 * 3, "every run, joint and series");
+    assert_eq!(batch.blueprints, 1);
+}

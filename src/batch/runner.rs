@@ -1,7 +1,7 @@
 use super::manifest::{PlannedExperiment, load_manifest, shard};
 use super::outcome::ExperimentOutcome;
 use super::table::{BatchSummary, write_tables};
-use super::compare::{ComparedRun, build_comparison};
+use super::compare::{ComparedRun, Comparison, SeriesRecorder, build_comparison};
 
 use crate::cli::RunArgs;
 use crate::error::Error;
@@ -36,11 +36,24 @@ struct RunFlags {
     args: RunArgs,
 }
 
-fn run_one(e: &PlannedExperiment, dir: &Path, stop: Option<&AtomicBool>) -> ExperimentOutcome {
+/// One experiment; with a comparison, its series are added to it when it has a summary (whatever
+/// its status, as the comparison built from the `.mcap` files after the runs included it).
+fn run_one(e: &PlannedExperiment, dir: &Path, stop: Option<&AtomicBool>, comparison: Option<&Comparison>) -> (ExperimentOutcome, Result<(), Error>) {
     let started = std::time::Instant::now();
-    let mut outcome = run_timed(e, dir, stop);
+    let series = comparison.map(|_| SeriesRecorder::new());
+    let (recorder, finished) = match series {
+        Some((recorder, finished)) => (Some(Box::new(recorder) as Box<dyn crate::recorder::Recorder>), Some(finished)),
+        None => (None, None),
+    };
+    let mut outcome = run_timed(e, dir, stop, recorder);
     outcome.wall_time = started.elapsed().as_secs_f64();
-    outcome
+    let mut added = Ok(());
+    if let (Some(comparison), Some(finished), Some(_)) = (comparison, finished, &outcome.summary) {
+        if let Some(series) = finished.lock().unwrap_or_else(|e| e.into_inner()).take() {
+            added = comparison.add(&e.name, e.index, &series);
+        }
+    }
+    (outcome, added)
 }
 
 /// A manifest experiment's `run` flags, parsed as `armscope run` parses them; the error is clap's
@@ -53,7 +66,7 @@ pub fn run_args(e: &PlannedExperiment) -> Result<RunArgs, String> {
     })
 }
 
-fn run_timed(e: &PlannedExperiment, dir: &Path, stop: Option<&AtomicBool>) -> ExperimentOutcome {
+fn run_timed(e: &PlannedExperiment, dir: &Path, stop: Option<&AtomicBool>, series: Option<Box<dyn crate::recorder::Recorder>>) -> ExperimentOutcome {
     let failed = |error: String| ExperimentOutcome { index: e.index, name: e.name.clone(), args: e.args.clone(), status: "failed".into(), summary: None, error: Some(error), wall_time: 0.0 };
     let flags = match run_args(e) {
         Ok(args) => args,
@@ -70,6 +83,7 @@ fn run_timed(e: &PlannedExperiment, dir: &Path, stop: Option<&AtomicBool>) -> Ex
             mcap: Some(dir.join(format!("{}.mcap", e.name))),
             csv: Some(dir.join(format!("{}.csv", e.name))),
             summary_json: Some(dir.join(format!("{}.json", e.name))),
+            recorders: series.into_iter().collect(),
             ..Outputs::default()
         };
         run_experiment(&experiment, outputs, stop)
@@ -106,18 +120,24 @@ pub fn run_batch(options: &BatchOptions, stop: Option<&AtomicBool>) -> Result<(B
     } else {
         bar.set_draw_target(ProgressDrawTarget::hidden());
     }
-    let outcomes: Vec<ExperimentOutcome> = pool.install(|| {
+    // the comparison recording is written while the runs go on, from the series they keep
+    let comparison = match options.compare && options.shard.is_none() {
+        true => Some(Comparison::create(&dir.join("comparison.rrd"), &manifest.name)?),
+        false => None,
+    };
+    let results: Vec<(ExperimentOutcome, Result<(), Error>)> = pool.install(|| {
         planned
             .par_iter()
             .map(|e| {
-                let outcome = run_one(e, &dir, stop);
-                bar.set_message(format!("{} {}", outcome.name, outcome.status));
+                let result = run_one(e, &dir, stop, comparison.as_ref());
+                bar.set_message(format!("{} {}", result.0.name, result.0.status));
                 bar.inc(1);
-                outcome
+                result
             })
             .collect()
     });
     bar.finish_and_clear();
+    let (outcomes, added): (Vec<ExperimentOutcome>, Vec<Result<(), Error>>) = results.into_iter().unzip();
     let summary = BatchSummary {
         batch: manifest.name.clone(),
         manifest: manifest.path.clone(),
@@ -125,8 +145,17 @@ pub fn run_batch(options: &BatchOptions, stop: Option<&AtomicBool>) -> Result<(B
         experiments: outcomes,
     };
     let mut files = write_tables(&dir, &summary)?;
-    if options.compare && options.shard.is_none() {
-        files.extend(write_comparison(&summary, std::slice::from_ref(&dir), &dir)?);
+    added.into_iter().collect::<Result<(), Error>>()?;
+    if let Some(comparison) = comparison {
+        let compared: Vec<String> = summary.experiments.iter().filter(|e| e.summary.is_some()).map(|e| e.name.clone()).collect();
+        if compared.is_empty() {
+            // nothing finished: no comparison file, as before
+            drop(comparison);
+            let _ = std::fs::remove_file(dir.join("comparison.rrd"));
+        } else {
+            comparison.finish(&compared)?;
+            files.push(dir.join("comparison.rrd"));
+        }
     }
     Ok((summary, files))
 }

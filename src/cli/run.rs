@@ -241,6 +241,7 @@ pub fn run(args: &RunArgs) -> Result<i32, Error> {
         trace: args.trace.clone(),
         summary_json: args.summary_json.clone(),
         notice: Some(|n| eprintln!("armscope: notice: {n}")),
+        recorders: Vec::new(),
     };
     install_interrupt_handler();
     INTERRUPTED.store(false, Ordering::SeqCst);

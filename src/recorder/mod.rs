@@ -10,7 +10,7 @@ mod overview;
 mod pacer;
 pub mod rrd;
 mod robot_description;
-mod rrd_file;
+pub(crate) mod rrd_file;
 mod summary_json;
 pub mod telemetry;
 mod threaded;

@@ -428,7 +428,7 @@ impl RerunRecorder {
 /// A `Scalars` column of `width` values per row, its Arrow array copied straight from the buffer:
 /// Rerun's generic serialization first turns every value into an `Option` with a validity flag
 /// (a quarter of this recorder's thread's work, in memory that is new for every block).
-fn scalar_column(values: &[f64], width: usize) -> rerun::SerializedComponentColumn {
+pub(crate) fn scalar_column(values: &[f64], width: usize) -> rerun::SerializedComponentColumn {
     use rerun::external::arrow::array::{ArrayRef, Float64Array, ListArray};
     use rerun::external::arrow::buffer::OffsetBuffer;
     use rerun::external::arrow::datatypes::{DataType, Field};
@@ -456,7 +456,7 @@ fn float32_column<C: rerun::Loggable>(values: &[f32], descriptor: rerun::Compone
 /// `send_columns` for rows already in time order. Rerun's own first reorders every chunk by time
 /// (a sort and a shuffle of each column, a fifth of this recorder's work); a block's rows are in
 /// order, so here they keep it and get consecutive row ids.
-fn send_in_order(
+pub(crate) fn send_in_order(
     rec: &RecordingStream,
     entity: &str,
     time: TimeColumn,
