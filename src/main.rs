@@ -1,5 +1,5 @@
 fn main() {
-    armscope::allocator::return_freed_memory_at_once();
+    armscope::allocator::return_freed_memory_soon();
     // before anything else, so that Ctrl-C during start-up also ends the run cleanly
     armscope::cli::install_interrupt_handler();
     std::process::exit(armscope::cli::main_with_args(std::env::args_os()));

@@ -29,7 +29,7 @@ fn run(experiment: &Experiment, dir: &Path, rrd: bool, mcap: bool) -> usize {
 }
 
 fn recording(c: &mut Criterion) {
-    armscope::allocator::return_freed_memory_at_once();
+    armscope::allocator::return_freed_memory_soon();
     let urdf = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/smallrobot_arm.urdf");
     let experiment = Experiment::prepare(RunConfig { urdf, ..RunConfig::default() }).unwrap();
     let dir = tempfile::tempdir().unwrap();

@@ -25,7 +25,7 @@ fn peak_memory_mb() -> f64 {
 
 /// One run, in this process: prints `seconds wall rrd_bytes mcap_bytes peak_mb`.
 fn one(seconds: f64) {
-    armscope::allocator::return_freed_memory_at_once();
+    armscope::allocator::return_freed_memory_soon();
     let dir = tempfile::tempdir().unwrap();
     let urdf = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/smallrobot_arm.urdf");
     let experiment = Experiment::prepare(RunConfig { urdf, duration: seconds, ..RunConfig::default() }).unwrap();
