@@ -386,7 +386,7 @@ fn an_arm_that_cannot_hold_the_start_pose_asked_for_is_told_so_per_joint() {
 fn the_default_experiment_starts_where_the_urdfs_motors_hold_the_arm_and_asks_what_they_carry() {
     use armscope::config::RunConfig;
     use armscope::control::within_effort::{MOTION_LOAD, START_LOAD};
-    use armscope::diagnose::envelope::required_torque;
+    use armscope::control::demand::required_torque;
     use armscope::experiment::Experiment;
     let urdf = common::repo().join("tests/fixtures/robots/baxter.urdf");
     let baxter = Experiment::prepare(RunConfig { urdf: urdf.clone(), ..RunConfig::default() }).unwrap();

@@ -5,7 +5,8 @@ mod common;
 
 use armscope::config::RunConfig;
 use armscope::dynamics::{Data, gravity_forces};
-use armscope::diagnose::envelope::{required_torque, sweep};
+use armscope::control::demand::required_torque;
+use armscope::diagnose::envelope::sweep;
 use armscope::model::load_urdf;
 use armscope::control::trajectory::{Trajectory, Wave};
 use common::{armscope, box_urdf};

@@ -3,6 +3,7 @@
 //! that turns a drawn shape into a joint schedule.
 
 pub mod controller;
+pub mod demand;
 pub mod gains;
 pub mod ik;
 pub mod trajectory;

@@ -5,9 +5,8 @@
 //! show the arm falling. Asked for explicitly (`--q0`, `--amp-deg`, `--freq`) the experiment is run
 //! as asked, with a notice where the motors fall short.
 
-use crate::diagnose::analysis::gravity_stiffness;
-use crate::diagnose::envelope::required_torque;
-use crate::dynamics::{Data, gravity_forces};
+use super::demand::required_torque;
+use crate::dynamics::{Data, gravity_forces, gravity_stiffness};
 use crate::model::{JointKind, Model};
 use nalgebra::{DMatrix, DVector};
 

@@ -6,7 +6,7 @@
 //! Continuous plant: ẋ = [[0, I], [M⁻¹G, −M⁻¹D]] x + [[0], [M⁻¹]] u with u = −(Kp + ff·G) δq − Kd v held
 //! over h, discretized exactly (matrix exponential).
 
-use crate::dynamics::{Data, crba, gravity_forces};
+use crate::dynamics::{Data, crba, gravity_stiffness};
 use crate::model::Model;
 use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
@@ -16,25 +16,6 @@ use serde::Serialize;
 pub enum LoopPlant {
     Discrete,
     Continuous,
-}
-
-/// G = ∂τ_g/∂q at `q`, by central differences (step 1e-6).
-pub fn gravity_stiffness(model: &Model, data: &mut Data, q: &[f64]) -> DMatrix<f64> {
-    let n = model.dof();
-    let eps = 1e-6;
-    let mut stiffness = DMatrix::zeros(n, n);
-    let mut qp = q.to_vec();
-    for j in 0..n {
-        qp[j] = q[j] + eps;
-        let plus = gravity_forces(model, data, &qp).to_vec();
-        qp[j] = q[j] - eps;
-        let minus = gravity_forces(model, data, &qp).to_vec();
-        qp[j] = q[j];
-        for i in 0..n {
-            stiffness[(i, j)] = (plus[i] - minus[i]) / (2.0 * eps);
-        }
-    }
-    stiffness
 }
 
 /// Everything the linearization needs at one pose.

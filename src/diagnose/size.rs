@@ -21,7 +21,7 @@
 
 use crate::actuator::{Catalogue, DriveTrain, MotorSet};
 use crate::config::RunConfig;
-use crate::diagnose::envelope::along_commanded_motion;
+use crate::control::demand::along_commanded_motion;
 use crate::error::Error;
 use crate::experiment::Experiment;
 use crate::model::Model;
