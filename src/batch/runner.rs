@@ -40,12 +40,8 @@ struct RunFlags {
 /// its status, as the comparison built from the `.mcap` files after the runs included it).
 fn run_one(e: &PlannedExperiment, dir: &Path, stop: Option<&AtomicBool>, comparison: Option<&Comparison>) -> (ExperimentOutcome, Result<(), Error>) {
     let started = std::time::Instant::now();
-    let series = comparison.map(|_| SeriesRecorder::new());
-    let (recorder, finished) = match series {
-        Some((recorder, finished)) => (Some(Box::new(recorder) as Box<dyn crate::recorder::Recorder>), Some(finished)),
-        None => (None, None),
-    };
-    let mut outcome = run_timed(e, dir, stop, recorder);
+    let (recorder, finished) = comparison.map(|_| SeriesRecorder::new()).unzip();
+    let mut outcome = run_timed(e, dir, stop, recorder.map(|r| Box::new(r) as Box<dyn crate::recorder::Recorder>));
     outcome.wall_time = started.elapsed().as_secs_f64();
     let mut added = Ok(());
     if let (Some(comparison), Some(finished), Some(_)) = (comparison, finished, &outcome.summary) {
@@ -121,10 +117,8 @@ pub fn run_batch(options: &BatchOptions, stop: Option<&AtomicBool>) -> Result<(B
         bar.set_draw_target(ProgressDrawTarget::hidden());
     }
     // the comparison recording is written while the runs go on, from the series they keep
-    let comparison = match options.compare && options.shard.is_none() {
-        true => Some(Comparison::create(&dir.join("comparison.rrd"), &manifest.name)?),
-        false => None,
-    };
+    let comparison_path = dir.join("comparison.rrd");
+    let comparison = if options.compare && options.shard.is_none() { Some(Comparison::create(&comparison_path, &manifest.name)?) } else { None };
     let results: Vec<(ExperimentOutcome, Result<(), Error>)> = pool.install(|| {
         planned
             .par_iter()
@@ -151,10 +145,10 @@ pub fn run_batch(options: &BatchOptions, stop: Option<&AtomicBool>) -> Result<(B
         if compared.is_empty() {
             // nothing finished: no comparison file, as before
             drop(comparison);
-            let _ = std::fs::remove_file(dir.join("comparison.rrd"));
+            let _ = std::fs::remove_file(&comparison_path);
         } else {
             comparison.finish(&compared)?;
-            files.push(dir.join("comparison.rrd"));
+            files.push(comparison_path);
         }
     }
     Ok((summary, files))
