@@ -23,6 +23,7 @@ pub mod recorder;
 pub mod runner;
 pub mod sample;
 pub mod sim;
+pub mod sizing;
 pub mod spatial;
 pub mod summary;
 

@@ -2,7 +2,7 @@
 
 use super::*;
 use crate::actuator::Catalogue;
-use crate::diagnose::size::{SizeRequest, size as size_joints};
+use crate::sizing::screening::{SizeRequest, size as size_joints};
 
 #[derive(Args, Debug)]
 pub struct SizeArgs {

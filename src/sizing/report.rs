@@ -1,8 +1,8 @@
 //! What `armscope size` shows: the console and Markdown table, the motor file of the choice, and per
 //! joint a chart of motor × ratio with the feasible region and the choice marked.
 
-use super::heatmap::{Canvas, ratio_color};
-use super::size::{Candidate, JointSizing, SizeReport};
+use super::screening::{Candidate, JointSizing, SizeReport};
+use crate::diagnose::heatmap::{Canvas, ratio_color};
 
 /// A headroom factor for people: 2.4×, 37×, ∞.
 fn times(x: f64) -> String {
