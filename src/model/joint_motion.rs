@@ -47,3 +47,43 @@ impl JointMotion {
     }
 }
 
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::spatial::{Pose, RigidInertia, rotation_about_axis};
+
+    fn joint(kind: JointKind, axis: Vector3<f64>) -> Joint {
+        Joint {
+            name: "j".into(),
+            kind,
+            parent: None,
+            placement: Pose::from_xyz_rpy([0.1, -0.2, 0.3], [0.4, -0.9, 1.3]),
+            axis: axis.normalize(),
+            inertia: RigidInertia::zero(),
+            lower: -1.0,
+            upper: 1.0,
+            effort: 1.0,
+            velocity: 1.0,
+            damping: 0.0,
+            child_link: "l".into(),
+        }
+    }
+
+    #[test]
+    fn local_pose_is_the_placement_composed_with_the_joint_motion() {
+        // against the definition: placement ∘ (rotation about a by q), or ∘ (translation a·q)
+        for axis in [Vector3::z(), Vector3::new(0.3, -0.5, 0.8)] {
+            for q in [-2.5, -0.3, 0.0, 0.7, 3.0] {
+                let j = joint(JointKind::Revolute, axis);
+                let expected = j.placement.compose(&Pose::new(rotation_about_axis(&j.axis, q), Vector3::zeros()));
+                let (rotation, translation) = JointMotion::new(&j).local_pose(q);
+                assert!((rotation - expected.rotation).abs().max() < 1e-15 && (translation - expected.translation).abs().max() < 1e-15);
+                let j = joint(JointKind::Prismatic, axis);
+                let expected = j.placement.compose(&Pose::new(Matrix3::identity(), j.axis * q));
+                let (rotation, translation) = JointMotion::new(&j).local_pose(q);
+                assert!((rotation - expected.rotation).abs().max() < 1e-15 && (translation - expected.translation).abs().max() < 1e-15);
+            }
+        }
+    }
+}

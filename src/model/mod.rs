@@ -125,7 +125,8 @@ pub struct Model {
     /// Per body, the coordinate its joint follows: q_joint = multiplier·q[coordinate] + offset.
     pub couplings: Vec<Coupling>,
     /// Per body, its joint's motion multiplied out from the placement and axis (what forward
-    /// kinematics evaluates).
+    /// kinematics evaluates), computed when the model is built: whoever changes a body's placement,
+    /// axis or kind after that rebuilds it with `JointMotion::new`.
     pub motions: Vec<JointMotion>,
     pub frames: Vec<Frame>,
     pub actuators: Vec<Actuator>,
