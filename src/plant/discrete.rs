@@ -17,8 +17,6 @@ use nalgebra::DMatrix;
 pub struct DiscretePlant {
     pub time_step: f64,
     pub substeps: usize,
-    /// h·D, the implicit damping added to M's diagonal: A = M + h·D.
-    step_damping: Vec<f64>,
     factor: DMatrix<f64>,
     rhs: Vec<f64>,
     reduced_rhs: Vec<f64>,
@@ -37,7 +35,6 @@ impl DiscretePlant {
         Self {
             time_step,
             substeps,
-            step_damping: model.joints.iter().map(|joint| time_step * joint.damping).collect(),
             factor: DMatrix::zeros(n, n),
             rhs: vec![0.0; n],
             reduced_rhs: vec![0.0; n],
@@ -114,7 +111,7 @@ impl DiscretePlant {
                     side => {
                         // impulse the constraint applies: λ = (A v − b)_i; an upper stop may only push down
                         // (A v)_i = Σ_j M_ij v_j + h·D_i·v_i, row i of the symmetric M read as its column i
-                        let mut lambda = -self.rhs[i] + self.step_damping[i] * self.v_next[i];
+                        let mut lambda = -self.rhs[i] + h * joint.damping * self.v_next[i];
                         for (mij, vj) in mass[i * n..(i + 1) * n].iter().zip(&self.v_next) {
                             lambda += mij * vj;
                         }
@@ -135,8 +132,9 @@ impl DiscretePlant {
         let n = model.dof();
         let h = self.time_step;
         self.factor.as_mut_slice().copy_from_slice(mass);
-        for (i, hd) in self.step_damping.iter().enumerate() {
-            self.factor[(i, i)] += hd;
+        // A = M + h·D
+        for (i, joint) in model.joints.iter().enumerate() {
+            self.factor[(i, i)] += h * joint.damping;
         }
         self.reduced_rhs.copy_from_slice(&self.rhs);
         for j in 0..n {
