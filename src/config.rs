@@ -69,6 +69,9 @@ pub struct RunConfig {
     pub divergence_speed: f64,
     /// Refuse physically inconsistent link inertias instead of a notice.
     pub strict_inertia: bool,
+    /// Every joint's Coulomb friction (URDF `<dynamics friction>`) times this: 1 as the URDF says,
+    /// 0 none.
+    pub friction_scale: f64,
     /// Initial joint positions: a comma list in joint order, or NAME=VALUE pairs (others: 0
     /// clamped into the joint's range).
     pub q0: Option<String>,
@@ -109,6 +112,7 @@ impl Default for RunConfig {
             settle_time: 2.0,
             divergence_speed: 1e4,
             strict_inertia: false,
+            friction_scale: 1.0,
             q0: None,
             motors: None,
             drive: DriveMode::Stepper,

@@ -9,7 +9,7 @@ use crate::plant::{ContinuousPlant, DiscretePlant, Plant, Tolerances};
 use crate::actuator::{MotorSet, OpenLoopSteppers, load_motor_file};
 use crate::model::{Actuator, LoadOptions, Model, load_urdf_with};
 use crate::diagnose::analysis::LoopPlant;
-use crate::control::trajectory::{Hold, JointSchedule, JointStep, JointWave, Trajectory, Wave};
+use crate::control::trajectory::{Hold, JointSchedule, JointStep, JointWave, RampIn, Trajectory, Wave};
 use nalgebra::Vector3;
 use std::sync::Arc;
 
@@ -74,6 +74,7 @@ impl Experiment {
         if config.no_gravity {
             model.gravity = Vector3::zeros();
         }
+        apply_friction_scale(&config, &mut model)?;
         if let Some(tool) = &config.tool {
             model.set_tool_frame(tool).map_err(|m| Error::flag("--tool", m))?;
         }
@@ -259,11 +260,18 @@ fn trajectory(config: &RunConfig, model: &mut Model, start: &mut Vec<f64>) -> Re
     } else {
         JointWave::fitted(model, start, config.amp_deg, config.freq)
     };
-    if fitted.is_uniform_about_zero(config.amp_deg.to_radians()) {
+    let wave: Box<dyn Trajectory> = if fitted.is_uniform_about_zero(config.amp_deg.to_radians()) {
         // the tutorial's wave exactly (the box model)
-        return Ok(Box::new(Wave { amplitude_rad: config.amp_deg.to_radians(), omega: config.freq }));
+        Box::new(Wave { amplitude_rad: config.amp_deg.to_radians(), omega: config.freq })
+    } else {
+        Box::new(fitted)
+    };
+    if is_tutorial_model(model) {
+        // the tutorial's start (the wave's jump at t = 0 included), checked against Drake
+        return Ok(wave);
     }
-    Ok(Box::new(fitted))
+    // any other arm: the command starts where the arm does, at rest, and blends into the wave
+    Ok(Box::new(RampIn::new(wave, start.clone())))
 }
 
 /// Move the default start pose (each joint's 0 in its range) where the URDF's motors can hold the
@@ -357,6 +365,28 @@ fn gains(config: &RunConfig, model: &Model, start: &[f64], trajectory: &dyn Traj
 
 /// A joint whose motor cannot carry the arm's weight at the start pose saturates from the first step
 /// on, whatever the controller does: say so before the run, naming the joint and both torques.
+/// `--friction SCALE` on every joint's Coulomb friction; a notice for each joint whose friction is
+/// more than its motor's effort (its motor can never move it: Allegro's URDF gives its fingers 5–12
+/// N·m against 0.7 N·m — left as the URDF says, `--friction 0` runs without).
+fn apply_friction_scale(config: &RunConfig, model: &mut Model) -> Result<(), Error> {
+    let scale = config.friction_scale;
+    if !(scale >= 0.0 && scale.is_finite()) {
+        return Err(Error::flag("--friction", format!("must be a factor ≥ 0 on the URDF's joint friction (got {scale})")));
+    }
+    for joint in &mut model.joints {
+        joint.friction *= scale;
+    }
+    let effort = model.effort_limits();
+    let stuck: Vec<String> = model.joints.iter().zip(&effort).filter(|(j, e)| j.friction > 0.0 && j.friction >= **e && **e > 0.0).map(|(j, e)| format!("{} ({} ≥ {e})", j.name, j.friction)).collect();
+    if !stuck.is_empty() {
+        model.notices.push(format!(
+            "joint friction (N·m) at least the joint's effort limit, so its motor can never move it: {} (as the URDF says; --friction 0 runs without friction)",
+            stuck.join(", ")
+        ));
+    }
+    Ok(())
+}
+
 fn weight_notices(model: &mut Model, start: &[f64]) {
     for (j, tau_g, effort) in overloaded_by_weight(model, start, 1.0) {
         let name = model.joints[j].name.clone();

@@ -35,7 +35,7 @@ pub fn describe(model: &Model) -> Value {
         "dof": model.dof(),
         "joints": model.joints.iter().map(|j| json!({
             "name": j.name, "kind": kind(j.kind), "child_link": j.child_link, "axis": [j.axis.x, j.axis.y, j.axis.z],
-            "lower": finite(j.lower), "upper": finite(j.upper), "effort": finite(j.effort), "damping": j.damping, "body_mass": j.inertia.mass,
+            "lower": finite(j.lower), "upper": finite(j.upper), "effort": finite(j.effort), "damping": j.damping, "friction": j.friction, "body_mass": j.inertia.mass,
         })).collect::<Vec<_>>(),
         "actuators": model.actuators.iter().map(|a| json!({ "name": a.name, "joint": model.joints[a.joint].name, "effort": finite(a.effort), "gear_ratio": a.gear_ratio, "rotor_inertia": a.rotor_inertia, "reflected_inertia": a.reflected_inertia() })).collect::<Vec<_>>(),
         "links": model.frames.len(),
@@ -87,14 +87,14 @@ pub fn dynamics_at(model: &Model, states: &[State]) -> Result<Value, Error> {
 pub fn table(model: &Model) -> String {
     let w = model.joints.iter().map(|j| j.name.chars().count()).max().unwrap_or(5).max(5) + 2;
     let mut out = format!("{} ({}): {} moving joints, {} links, tool link '{}'\n", model.name, model.source.display(), model.dof(), model.frames.len(), model.frames[model.tool_frame].name);
-    out += &format!("  {:<w$}{:<12}{:>22}{:>12}{:>10}{:>12}{:>8}{:>14}\n", "joint", "kind", "range", "effort", "damping", "body (kg)", "ratio", "rotor J_r·N²");
+    out += &format!("  {:<w$}{:<12}{:>22}{:>12}{:>10}{:>10}{:>12}{:>8}{:>14}\n", "joint", "kind", "range", "effort", "damping", "friction", "body (kg)", "ratio", "rotor J_r·N²");
     let efforts = model.effort_limits();
     for (i, j) in model.joints.iter().enumerate() {
         let range = if j.lower.is_finite() || j.upper.is_finite() { format!("[{:.3}, {:.3}]", j.lower, j.upper) } else { "unlimited".into() };
         let effort = if model.is_actuated(i) { format!("{}", efforts[i]) } else { "passive".into() };
         let kind = format!("{:?}", j.kind).to_lowercase();
         let ratio = model.actuators.iter().find(|a| a.joint == i).map_or(String::from("–"), |a| format!("{}", a.gear_ratio));
-        out += &format!("  {:<w$}{:<12}{:>22}{:>12}{:>10}{:>12.4}{:>8}{:>14.4e}\n", j.name, kind, range, effort, j.damping, j.inertia.mass, ratio, model.armature[i]);
+        out += &format!("  {:<w$}{:<12}{:>22}{:>12}{:>10}{:>10}{:>12.4}{:>8}{:>14.4e}\n", j.name, kind, range, effort, j.damping, j.friction, j.inertia.mass, ratio, model.armature[i]);
     }
     out
 }

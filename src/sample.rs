@@ -33,6 +33,11 @@ pub struct Sample<'a> {
     pub chatter: &'a [bool],
     /// The joint was stopped at a position limit in the step that led here.
     pub at_limit: &'a [bool],
+    /// Coulomb friction torque on each joint at the end of the step that led here, N·m (empty when
+    /// the experiment has no friction anywhere).
+    pub friction: &'a [f64],
+    /// Per joint with friction: stuck (q̇ exactly 0, held by friction); empty without friction.
+    pub stuck: &'a [bool],
     pub tool_position: Vector3<f64>,
     /// Where the command puts the tool (forward kinematics of cmd).
     pub tool_target: Vector3<f64>,

@@ -42,6 +42,9 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
     let (mut load_angle, mut lost_steps, mut lost_events) = (vec![0.0; n], vec![0i64; n], Vec::new());
     let (mut chatter, mut previous_u, mut previous_saturated) = (vec![false; n], vec![0.0; n], vec![false; n]);
     let mut at_limit = vec![false; n];
+    // friction torque and stuck flags: recorded only when some joint has friction
+    let has_friction = model.joints.iter().any(|j| j.friction > 0.0);
+    let (mut friction, mut stuck) = if has_friction { (vec![0.0; n], vec![false; n]) } else { (Vec::new(), Vec::new()) };
     let joint_names: Vec<String> = model.joints.iter().map(|j| j.name.clone()).collect();
     let mut stats = SummaryBuilder::new(joint_names, controller.effort.clone(), dt, experiment.config.settle_time).with_stepped_joints(experiment.stepped_joints());
     let started = Instant::now();
@@ -90,6 +93,8 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
             lost_steps: &lost_steps,
             chatter: &chatter,
             at_limit: &at_limit,
+            friction: &friction,
+            stuck: &stuck,
             tool_position: frame_pose(model, &data, model.tool_frame).translation,
             tool_target: frame_pose_in(model, &command_poses, model.tool_frame).translation,
             body_pose: &data.body_pose,
@@ -127,7 +132,7 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
             };
             plant.advance_driven(model, &mut data, &mut u, &mut drive, &mut q, &mut v);
             if let Some(a) = audit.as_mut() {
-                a.period_end(model, &v);
+                a.period_end(model, &v, plant.friction_work());
             }
         }
         if let Some(s) = steppers.as_mut() {
@@ -137,6 +142,10 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
             }
         }
         at_limit.copy_from_slice(plant.limit_active());
+        if has_friction {
+            friction.copy_from_slice(plant.friction_torque());
+            stuck.copy_from_slice(plant.stuck());
+        }
         if let Some(diverged) = divergence(experiment, &q, &v, t + dt) {
             status = diverged;
             break;
@@ -151,8 +160,8 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
 }
 
 /// Numerical energy audit of the discrete plant. Between control steps the arm's mechanical energy
-/// E = ½ q̇ᵀM(q)q̇ + potential may change only by the work of the torques and the damping over its
-/// plant steps (a stepper's torque changes at each). A numerically unstable plant creates energy that
+/// E = ½ q̇ᵀM(q)q̇ + potential may change only by the work of the torques, the damping and the
+/// friction over its plant steps (a stepper's torque changes at each). A numerically unstable plant creates energy that
 /// nothing supplied; more than 1 J, and more than 1 % of all the work done on the arm so far, is
 /// divergence. (On the box model's chattering default run the books balance to 5 mJ over 5 s; on the
 /// mesh model's discrete run 540 J appear.)
@@ -213,9 +222,12 @@ impl EnergyAudit {
         self.u_before.copy_from_slice(u);
     }
 
-    /// After the control period's last plant step, at q̇_{k+1}.
-    fn period_end(&mut self, model: &Model, v: &[f64]) {
+    /// After the control period's last plant step, at q̇_{k+1}; the friction's work over the period
+    /// (≤ 0) from the plant.
+    fn period_end(&mut self, model: &Model, v: &[f64], friction_work: f64) {
         self.book(model, v);
+        self.period_work += friction_work;
+        self.work += friction_work.abs();
     }
 
     /// The work of the held torque and the damping over the last plant step, at its mean speed.

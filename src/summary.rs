@@ -60,6 +60,17 @@ pub struct Summary {
     /// saturated, %. Close to the saturation share: the saturation is numerical chatter.
     pub chatter_percent: Vec<f64>,
     pub peak_abs_torque: Vec<f64>,
+    /// The peak |τ| over the control steps from `error_window_start` on (null when the run is
+    /// shorter): the motion's own demand, the start aside.
+    #[serde(default)]
+    pub peak_abs_torque_after_settle: Vec<Option<f64>>,
+    /// Per joint, the largest |friction torque| over the run, N·m (empty without friction).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub peak_friction_torque: Vec<f64>,
+    /// Per joint, the share of control steps it was stuck (held still by its friction), % (empty
+    /// without friction).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub stuck_percent: Vec<f64>,
     pub effort_limit: Vec<f64>,
     /// The lowest torque limit over the run's control steps: with `--motors`, what the motor gave at
     /// the joint's fastest; the effort limit otherwise.
@@ -101,6 +112,9 @@ pub struct SummaryBuilder {
     chatter_steps: Vec<u64>,
     control_steps: u64,
     peak_torque: Vec<f64>,
+    peak_torque_in_window: Vec<f64>,
+    peak_friction: Vec<f64>,
+    stuck_steps: Vec<u64>,
     effort: Vec<f64>,
     lowest_limit: Vec<f64>,
     peak_share: Vec<f64>,
@@ -129,6 +143,9 @@ impl SummaryBuilder {
             chatter_steps: vec![0; n],
             control_steps: 0,
             peak_torque: vec![0.0; n],
+            peak_torque_in_window: vec![0.0; n],
+            peak_friction: Vec::new(),
+            stuck_steps: Vec::new(),
             lowest_limit: effort.clone(),
             peak_share: vec![0.0; n],
             stepped: vec![false; n],
@@ -172,6 +189,9 @@ impl SummaryBuilder {
                 self.saturated_in_window[i] += (in_window && s.saturated[i]) as u64;
                 self.chatter_steps[i] += s.chatter[i] as u64;
                 self.peak_torque[i] = self.peak_torque[i].max(s.u[i].abs());
+                if in_window {
+                    self.peak_torque_in_window[i] = self.peak_torque_in_window[i].max(s.u[i].abs());
+                }
                 self.lowest_limit[i] = self.lowest_limit[i].min(s.torque_limit[i]);
                 let share = if s.k < self.first_window_step {
                     0.0
@@ -187,6 +207,16 @@ impl SummaryBuilder {
         }
         for i in 0..n {
             self.limit_hits[i] += s.at_limit[i] as u64;
+        }
+        if !s.friction.is_empty() && !s.is_final {
+            if self.stuck_steps.is_empty() {
+                self.peak_friction = vec![0.0; n];
+                self.stuck_steps = vec![0; n];
+            }
+            for i in 0..n {
+                self.peak_friction[i] = self.peak_friction[i].max(s.friction[i].abs());
+                self.stuck_steps[i] += s.stuck[i] as u64;
+            }
         }
         for a in 0..3 {
             self.tool_min[a] = self.tool_min[a].min(s.tool_position[a]);
@@ -224,6 +254,9 @@ impl SummaryBuilder {
                 .collect(),
             chatter_percent: share_of_control_steps(&self.chatter_steps),
             peak_abs_torque: self.peak_torque.clone(),
+            peak_abs_torque_after_settle: self.peak_torque_in_window.iter().map(|&p| (window_control_steps > 0).then_some(p)).collect(),
+            peak_friction_torque: self.peak_friction.clone(),
+            stuck_percent: share_of_control_steps(&self.stuck_steps),
             effort_limit: self.effort.clone(),
             lowest_torque_limit: self.lowest_limit.clone(),
             peak_torque_share: self.peak_share.clone(),

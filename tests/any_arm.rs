@@ -452,7 +452,9 @@ fn a_mode_that_needs_soft_gains_softens_only_its_own_joints() {
     // their relative motion is a light mode the sampled derivative term destabilizes. One bandwidth
     // for all joints was lowered 35× for it (head and fingers 0.09 rad off); per joint, the rest keep theirs
     let urdf = std::fs::read_to_string(common::repo().join("tests/fixtures/robots/tiago.urdf")).unwrap();
-    let (code, doc, err) = run_summary(&urdf, &["--duration", "10"]);
+    // (without the URDF's 1 N·m joint friction here: a PD loop stops within F/kp of its target,
+    // checked below)
+    let (code, doc, err) = run_summary(&urdf, &["--duration", "10", "--friction", "0"]);
     assert_eq!(code, 0, "{err}");
     let (s, gains) = (&doc["summary"], &doc["gains"]);
     assert!(gains["spectral_radius"].as_f64().unwrap() < 1.0, "{gains}");
@@ -467,4 +469,17 @@ fn a_mode_that_needs_soft_gains_softens_only_its_own_joints() {
     let damping_ratio = |name: &str| at("kd", name) / (2.0 * (at("kp", name) * inertia(name)).sqrt());
     assert!(damping_ratio("arm_5_joint") < 0.5 && damping_ratio("arm_7_joint") < 0.5, "the wrist rolls are softened");
     assert!((damping_ratio("head_1_joint") - 1.0).abs() < 1e-9 && at("kp", "head_1_joint") > 50.0, "the head keeps its gains: kp {}", at("kp", "head_1_joint"));
+
+    // with the URDF's friction (1 N·m on the torso, head and arm joints): a joint held by friction
+    // stays until the PD's kp·error exceeds F, so each may lag by up to F/kp more
+    let (code, with_friction, err) = run_summary(&urdf, &["--duration", "10"]);
+    assert_eq!(code, 0, "{err}");
+    let model = armscope::model::load_urdf_str(&urdf, std::path::Path::new("tiago.urdf")).unwrap();
+    let s = &with_friction["summary"];
+    for (j, name) in names.iter().enumerate() {
+        let friction = model.joints[j].friction;
+        let error = s["max_abs_error"][j].as_f64().unwrap();
+        assert!(error < 0.01 + friction / at("kp", name), "{name}: max error {error} with {friction} N·m friction, kp {}", at("kp", name));
+    }
+    assert!(s["stuck_percent"].as_array().unwrap().iter().any(|p| p.as_f64().unwrap() > 0.0), "some joint sticks on the way");
 }

@@ -72,6 +72,10 @@ pub struct RunArgs {
     /// Refuse physically inconsistent link inertias (as Drake does) instead of a notice.
     #[arg(long)]
     pub strict_inertia: bool,
+    /// Every joint's Coulomb friction (URDF `<dynamics friction>`, simulated with exact stiction)
+    /// times this: 0 runs without friction, 2 with twice the URDF's.
+    #[arg(long = "friction", value_name = "SCALE", default_value_t = defaults().friction_scale)]
+    pub friction_scale: f64,
     /// Initial joint positions (rad or m): a comma list in joint order, or NAME=VALUE pairs
     /// (default: each joint's 0 clamped into its range). The default wave swings around them.
     #[arg(long, value_name = "LIST", allow_hyphen_values = true)]
@@ -161,6 +165,9 @@ pub fn default_run_name(config: &RunConfig) -> String {
     if config.payload != d.payload {
         parts.push(format!("payload{}", config.payload));
     }
+    if config.friction_scale != d.friction_scale {
+        parts.push(format!("friction{}", config.friction_scale));
+    }
     if config.duration != d.duration {
         parts.push(format!("{}s", config.duration));
     }
@@ -199,6 +206,7 @@ impl RunArgs {
             settle_time: self.settle_time,
             divergence_speed: self.divergence_speed,
             strict_inertia: self.strict_inertia,
+            friction_scale: self.friction_scale,
             q0: self.q0.clone(),
             motors: self.motors.motors.clone(),
             drive: self.motors.drive,

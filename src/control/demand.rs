@@ -29,7 +29,7 @@ pub fn need(model: &Model, trajectory: &dyn Trajectory, duration: f64, dt: f64, 
 }
 
 /// Walk the commanded motion every `dt` from 0 to `duration`: `visit(t, q̇, q̈, τ)` with τ the
-/// inverse dynamics of following it exactly (RNEA plus the joints' damping) — what a perfect
+/// inverse dynamics of following it exactly (RNEA plus the joints' damping and Coulomb friction) — what a perfect
 /// controller must supply. q̈ is the central difference of the commanded velocity, one-sided at the
 /// ends: a command that starts (or stops) moving at full speed steps its velocity there, which no
 /// drive follows and no drive is sized for (the controller or step generator ramps it).
@@ -55,7 +55,11 @@ pub fn along_commanded_motion(model: &Model, trajectory: &dyn Trajectory, durati
         trajectory.sample(t, &mut q, &mut qd);
         let tau = rnea(model, &mut data, &q, &qd, &qdd);
         for j in 0..n {
-            torque[j] = tau[j] + model.joints[j].damping * qd[j];
+            // the joint's Coulomb friction against the motion (at a standstill it takes only what
+            // holds the joint, which the motion around it bounds)
+            let joint = &model.joints[j];
+            let friction = if qd[j] != 0.0 { joint.friction * qd[j].signum() } else { 0.0 };
+            torque[j] = tau[j] + joint.damping * qd[j] + friction;
         }
         visit(t, &qd, &qdd, &torque);
     }

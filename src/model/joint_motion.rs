@@ -66,6 +66,7 @@ mod tests {
             effort: 1.0,
             velocity: 1.0,
             damping: 0.0,
+            friction: 0.0,
             child_link: "l".into(),
         }
     }

@@ -44,6 +44,10 @@ pub struct Joint {
     /// Viscous damping, N·m·s/rad. In [`Model::joints`], a coordinate's: its own plus, for each
     /// joint that mimics it, multiplier² × that joint's (D_r = GᵀDG, which stays diagonal).
     pub damping: f64,
+    /// Coulomb friction, N·m or N (URDF `<dynamics friction>`): the joint sticks while the other
+    /// torques on it are within ±friction, and slides against −friction·sign(q̇). In
+    /// [`Model::joints`] a coordinate's own plus |multiplier| × each of its mimic joints'.
+    pub friction: f64,
     /// The URDF link this joint moves.
     pub child_link: String,
 }

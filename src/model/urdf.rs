@@ -280,6 +280,7 @@ fn make_joint(uj: &urdf_rs::Joint, kind: JointKind, parent: Option<usize>, place
         effort,
         velocity: uj.limit.velocity,
         damping: uj.dynamics.as_ref().map_or(0.0, |d| d.damping),
+        friction: uj.dynamics.as_ref().map_or(0.0, |d| d.friction),
         child_link: uj.child.link.clone(),
     }
 }
@@ -378,6 +379,8 @@ fn couple(bodies: &[Joint], body_urdf_joint: &[usize], robot: &urdf_rs::Robot, n
         let master = &mut joints[coupling.coordinate];
         // D_r = GᵀDG: the mimic's damping, seen through its multiplier, joins its master's
         master.damping += coupling.multiplier * coupling.multiplier * body.damping;
+        // and its Coulomb friction, a box |τ| ≤ F seen through G: |multiplier|·F at the master
+        master.friction += coupling.multiplier.abs() * body.friction;
         notices.push(format!(
             "joint '{}' mimics '{}' (q = {}·q + {}): it moves with it, its own limits and motor are not used",
             body.name, master.name, coupling.multiplier, coupling.offset
@@ -451,6 +454,9 @@ fn check_joint(joint: &urdf_rs::Joint) -> Result<(), K> {
         finite(&element, "dynamics", &[d.damping, d.friction])?;
         if d.damping < 0.0 {
             return Err(K::Negative { joint: joint.name.clone(), field: "damping", value: d.damping });
+        }
+        if d.friction < 0.0 {
+            return Err(K::Negative { joint: joint.name.clone(), field: "friction", value: d.friction });
         }
     }
     if moving {

@@ -1,5 +1,6 @@
 use super::Plant;
-use crate::dynamics::{Data, aba};
+use super::stick_slip::{JointLaw, StickSlipSolver};
+use crate::dynamics::{Data, aba, crba_from_kinematics, forward_kinematics, gravity_and_bias_from_kinematics};
 use crate::model::Model;
 
 /// Error tolerances of the adaptive integrator (per state component:
@@ -38,6 +39,14 @@ const E: [f64; 7] = [
 /// Dormand–Prince 5(4) Runge–Kutta method. Each control period is integrated exactly to its end
 /// (the torque is held over it). A joint that reaches a position limit stops there (an inelastic
 /// stop: its velocity into the limit is removed).
+///
+/// With Coulomb friction the motion is piecewise smooth, and integrated piece by piece (Modelica's
+/// stuck/forward/backward modes): each joint with friction slides (τ_f = −F·sign(q̇), constant)
+/// or is stuck (q̈ = 0 imposed, q̇ = 0, its friction whatever holds it); a step that ends with a
+/// sliding joint's velocity through zero, or a stuck joint needing more than F, is cut back to the
+/// event (bisection to 1e-13 s), the crossing velocity set to exactly 0 and the modes decided
+/// again by the acceleration-level problem M·q̈ = r + τ_f, solved exactly ([`StickSlipSolver`]).
+/// A stuck joint's position and velocity do not change at all.
 pub struct ContinuousPlant {
     pub tolerances: Tolerances,
     /// Largest step, as the reference's `max_step`.
@@ -51,6 +60,7 @@ pub struct ContinuousPlant {
     k: [Vec<f64>; 7],
     tau: Vec<f64>,
     limit_active: Vec<bool>,
+    friction: Friction,
     /// Accepted and rejected steps so far.
     pub accepted_steps: u64,
     pub rejected_steps: u64,
@@ -72,14 +82,29 @@ impl ContinuousPlant {
             k: std::array::from_fn(|_| state()),
             tau: vec![0.0; n],
             limit_active: vec![false; n],
+            friction: Friction::new(model, model.joints.iter().map(|j| j.friction).collect()),
             accepted_steps: 0,
             rejected_steps: 0,
         }
     }
 
-    /// ẏ = (q̇, q̈) with q̈ from ABA, damping included.
+    /// The plant with Coulomb friction `friction[i]` on joint i instead of the URDF's.
+    pub fn with_friction(mut self, model: &Model, friction: Vec<f64>) -> Self {
+        self.friction = Friction::new(model, friction);
+        self
+    }
+
+    /// ẏ = (q̇, q̈) with q̈ from ABA, damping included; with friction, in the current modes.
     fn derivative(&mut self, model: &Model, data: &mut Data, u: &[f64], stage: usize) {
         let n = self.n;
+        if self.friction.any {
+            let (q, v) = self.y_stage.split_at(n);
+            let qdd = self.friction.acceleration(model, data, u, q, v, stage);
+            let k = &mut self.k[stage];
+            k[..n].copy_from_slice(v);
+            k[n..].copy_from_slice(qdd);
+            return;
+        }
         let (q, v) = self.y_stage.split_at(n);
         for i in 0..n {
             self.tau[i] = u[i] - model.joints[i].damping * v[i];
@@ -88,6 +113,50 @@ impl ContinuousPlant {
         let k = &mut self.k[stage];
         k[..n].copy_from_slice(v);
         k[n..].copy_from_slice(qdd);
+    }
+
+    /// Stages 1–6 of a step of length h from y (stage 0 evaluated), and y_new.
+    fn stages(&mut self, model: &Model, data: &mut Data, u: &[f64], h: f64) {
+        let n = self.n;
+        for s in 1..7 {
+            for i in 0..2 * n {
+                let mut acc = 0.0;
+                for (j, a) in A[s][..s].iter().enumerate() {
+                    acc += a * self.k[j][i];
+                }
+                self.y_stage[i] = self.y[i] + h * acc;
+            }
+            self.derivative(model, data, u, s);
+        }
+        // stage 6 was evaluated at the fifth-order solution (FSAL)
+        for i in 0..2 * n {
+            let mut acc = 0.0;
+            for (j, b) in B5.iter().enumerate() {
+                acc += b * self.k[j][i];
+            }
+            self.y_new[i] = self.y[i] + h * acc;
+        }
+    }
+
+    /// The step from y that ends just past the first event within h (bisection on the step length:
+    /// a shorter step is at least as accurate), y_new at its end; returns its length.
+    fn step_to_event(&mut self, model: &Model, data: &mut Data, u: &[f64], h: f64) -> f64 {
+        let n = self.n;
+        let (mut before, mut after) = (0.0, h);
+        while after - before > EVENT_TIME_TOLERANCE {
+            let middle = 0.5 * (before + after);
+            if middle <= before || middle >= after {
+                break;
+            }
+            self.stages(model, data, u, middle);
+            if self.friction.event(&self.y_new[n..]) {
+                after = middle;
+            } else {
+                before = middle;
+            }
+        }
+        self.stages(model, data, u, after);
+        after
     }
 
     fn error_norm(&self, h: f64) -> f64 {
@@ -133,6 +202,10 @@ impl Plant for ContinuousPlant {
         self.y[..n].copy_from_slice(q);
         self.y[n..].copy_from_slice(v);
         self.limit_active.fill(false);
+        if self.friction.any {
+            self.friction.work = 0.0;
+            self.friction.decide_modes(model, data, u, &self.y[..n], &self.y[n..]);
+        }
         let mut remaining = self.period;
         // the torque is discontinuous at the period boundary: start each period afresh (no FSAL carry-over)
         let mut have_first_stage = false;
@@ -144,26 +217,24 @@ impl Plant for ContinuousPlant {
                 self.derivative(model, data, u, 0);
                 have_first_stage = true;
             }
-            for s in 1..7 {
-                for i in 0..2 * n {
-                    let mut acc = 0.0;
-                    for (j, a) in A[s][..s].iter().enumerate() {
-                        acc += a * self.k[j][i];
-                    }
-                    self.y_stage[i] = self.y[i] + h * acc;
-                }
-                self.derivative(model, data, u, s);
-            }
-            // stage 6 was evaluated at the fifth-order solution (FSAL)
-            for i in 0..2 * n {
-                let mut acc = 0.0;
-                for (j, b) in B5.iter().enumerate() {
-                    acc += b * self.k[j][i];
-                }
-                self.y_new[i] = self.y[i] + h * acc;
-            }
+            self.stages(model, data, u, h);
             let err = self.error_norm(h);
+            if err.is_finite() && err <= 1.0 && self.friction.any && self.friction.event(&self.y_new[n..]) {
+                // a mode ends within this step: cut it back to the event and decide the modes again
+                let taken = self.step_to_event(model, data, u, h);
+                self.friction.book(&self.y[..n], &self.y_new[..n]);
+                self.y.copy_from_slice(&self.y_new);
+                self.friction.end_modes(&mut self.y[n..]);
+                self.friction.decide_modes(model, data, u, &self.y[..n], &self.y[n..]);
+                have_first_stage = false;
+                remaining = if last && taken >= h { 0.0 } else { remaining - taken };
+                self.accepted_steps += 1;
+                continue;
+            }
             if err.is_finite() && err <= 1.0 {
+                if self.friction.any {
+                    self.friction.book(&self.y[..n], &self.y_new[..n]);
+                }
                 self.y.copy_from_slice(&self.y_new);
                 let k6 = std::mem::take(&mut self.k[6]);
                 self.k[0].copy_from_slice(&k6);
@@ -193,6 +264,18 @@ impl Plant for ContinuousPlant {
         &self.limit_active
     }
 
+    fn friction_torque(&self) -> &[f64] {
+        &self.friction.torque
+    }
+
+    fn stuck(&self) -> &[bool] {
+        &self.friction.stuck
+    }
+
+    fn friction_work(&self) -> f64 {
+        self.friction.work
+    }
+
     fn describe(&self) -> String {
         format!(
             "continuous plant: adaptive Dormand–Prince 5(4), rtol = {:e}, atol = {:e}, max step {} ms, torque held over each {} ms control period",
@@ -201,5 +284,150 @@ impl Plant for ContinuousPlant {
             self.max_step * 1e3,
             self.period * 1e3
         )
+    }
+}
+
+/// How closely a mode's end is located in time, s.
+const EVENT_TIME_TOLERANCE: f64 = 1e-13;
+
+/// The continuous plant's friction: per joint F, the mode (−1/+1 sliding that way, 0 stuck, for
+/// joints with friction; sliding ones follow their velocity's sign), and the acceleration-level
+/// solve.
+struct Friction {
+    any: bool,
+    bound: Vec<f64>,
+    /// −1, +1: sliding (τ_f = −F·mode); 0: stuck, or no friction.
+    mode: Vec<i8>,
+    laws: Vec<JointLaw>,
+    solver: StickSlipSolver,
+    rhs: Vec<f64>,
+    qdd: Vec<f64>,
+    residual: Vec<f64>,
+    zeros: Vec<f64>,
+    /// Stuck joints' friction at the last stage evaluated (stage 6: the step's end).
+    torque: Vec<f64>,
+    stuck: Vec<bool>,
+    work: f64,
+}
+
+impl Friction {
+    fn new(model: &Model, bound: Vec<f64>) -> Self {
+        let n = model.dof();
+        Self {
+            any: bound.iter().any(|&f| f > 0.0),
+            bound,
+            mode: vec![0; n],
+            laws: vec![JointLaw::FREE; n],
+            solver: StickSlipSolver::new(n, None),
+            rhs: vec![0.0; n],
+            qdd: vec![0.0; n],
+            residual: vec![0.0; n],
+            zeros: vec![0.0; n],
+            torque: vec![0.0; n],
+            stuck: vec![false; n],
+            work: 0.0,
+        }
+    }
+
+    /// M(q), and r = u − D·q̇ + τ_g − C·q̇ in `rhs`.
+    fn mass_and_forces<'d>(&mut self, model: &Model, data: &'d mut Data, u: &[f64], q: &[f64], v: &[f64]) -> &'d [f64] {
+        forward_kinematics(model, data, q);
+        gravity_and_bias_from_kinematics(model, data, v);
+        crba_from_kinematics(model, data);
+        for (i, joint) in model.joints.iter().enumerate() {
+            self.rhs[i] = u[i] - joint.damping * v[i] + data.gravity[i] - data.bias[i];
+        }
+        data.mass_matrix.as_slice()
+    }
+
+    /// At a state where the modes may change (a period's start, an event): joints moving slide
+    /// their way; each joint at rest sticks, or starts sliding, as the exact solution of
+    /// M·q̈ = r + τ_f (|τ_f| ≤ F at rest, −F·sign(q̇) moving) says.
+    fn decide_modes(&mut self, model: &Model, data: &mut Data, u: &[f64], q: &[f64], v: &[f64]) {
+        let mass = self.mass_and_forces(model, data, u, q, v);
+        for i in 0..v.len() {
+            let f = self.bound[i];
+            self.laws[i] = if f == 0.0 {
+                JointLaw::FREE
+            } else if v[i] != 0.0 {
+                // g = r − M·q̈ = −τ_f
+                let slope = f * v[i].signum();
+                JointLaw { below: slope, above: slope, ..JointLaw::FREE }
+            } else {
+                JointLaw { below: -f, above: f, ..JointLaw::FREE }
+            };
+        }
+        if self.solver.solve(mass, &self.zeros, &self.rhs, &self.laws, &mut self.qdd, &mut self.residual).is_err() {
+            // not positive definite: a state no longer finite; the divergence check reports it
+            self.mode.fill(0);
+            return;
+        }
+        for i in 0..v.len() {
+            self.mode[i] = if self.bound[i] == 0.0 {
+                0
+            } else if v[i] != 0.0 {
+                v[i].signum() as i8
+            } else if self.qdd[i] != 0.0 {
+                self.qdd[i].signum() as i8
+            } else {
+                0
+            };
+            self.stuck[i] = self.bound[i] > 0.0 && self.mode[i] == 0;
+            self.torque[i] = if self.stuck[i] { -self.residual[i] } else { -self.bound[i] * self.mode[i] as f64 };
+        }
+    }
+
+    /// q̈ in the current modes: sliding joints' friction known, stuck joints' q̈ = 0.
+    fn acceleration(&mut self, model: &Model, data: &mut Data, u: &[f64], q: &[f64], v: &[f64], _stage: usize) -> &[f64] {
+        let mass = self.mass_and_forces(model, data, u, q, v);
+        for i in 0..v.len() {
+            let f = self.bound[i];
+            self.laws[i] = if f == 0.0 {
+                JointLaw::FREE
+            } else if self.mode[i] == 0 {
+                JointLaw { lower: 0.0, upper: 0.0, below: 0.0, above: 0.0 }
+            } else {
+                let slope = f * self.mode[i] as f64;
+                JointLaw { below: slope, above: slope, ..JointLaw::FREE }
+            };
+        }
+        if self.solver.solve(mass, &self.zeros, &self.rhs, &self.laws, &mut self.qdd, &mut self.residual).is_err() {
+            self.qdd.fill(f64::NAN);
+        }
+        for i in 0..v.len() {
+            if self.bound[i] > 0.0 && self.mode[i] == 0 {
+                self.torque[i] = -self.residual[i];
+            }
+        }
+        &self.qdd
+    }
+
+    /// Whether a mode ends within the step to this velocity: a sliding joint's velocity reached or
+    /// passed zero, or a stuck joint needs more than its friction to stay (at stage 6, the end).
+    fn event(&self, v_end: &[f64]) -> bool {
+        (0..v_end.len()).any(|i| match self.mode[i] {
+            // (a relative 1e-9 over the bound: what held the joint at the mode's start is not
+            // re-decided for the solve's rounding)
+            0 => self.bound[i] > 0.0 && self.torque[i].abs() > self.bound[i] * (1.0 + 1e-9),
+            m => v_end[i] * m as f64 <= 0.0,
+        })
+    }
+
+    /// At an event: the sliding joints whose velocity reached zero are at rest (exactly).
+    fn end_modes(&mut self, v: &mut [f64]) {
+        for i in 0..v.len() {
+            if self.mode[i] != 0 && v[i] * self.mode[i] as f64 <= 0.0 {
+                v[i] = 0.0;
+            }
+        }
+    }
+
+    /// The friction's work over an accepted step: −F·|Δq| on each sliding joint.
+    fn book(&mut self, q_before: &[f64], q_after: &[f64]) {
+        for i in 0..q_before.len() {
+            if self.mode[i] != 0 {
+                self.work -= self.bound[i] * (q_after[i] - q_before[i]).abs();
+            }
+        }
     }
 }

@@ -1,7 +1,7 @@
 use super::Plant;
-use crate::dynamics::{Data, cholesky_in_place, cholesky_solve_in_place, ltdl_in_place, ltdl_solve_in_place, crba_from_kinematics, forward_kinematics, gravity_and_bias_from_kinematics};
+use super::stick_slip::{JointLaw, StickSlipSolver};
+use crate::dynamics::{Data, crba_from_kinematics, forward_kinematics, gravity_and_bias_from_kinematics};
 use crate::model::Model;
-use nalgebra::DMatrix;
 
 /// Drake's discrete MultibodyPlant without contact: semi-implicit Euler with the joint damping
 /// taken implicitly, everything evaluated at the start of the step,
@@ -11,37 +11,54 @@ use nalgebra::DMatrix;
 ///   q₁ = q₀ + h·v₁
 /// ```
 ///
-/// plus position limits as rigid one-sided constraints on v₁: a joint that would pass its limit
-/// stops exactly at it (an active-set solve of the same system). Several substeps per control
-/// period when the plant step is shorter than the control period.
+/// plus position limits as rigid one-sided constraints on v₁ (a joint that would pass its limit
+/// stops exactly at it) and Coulomb friction as a bounded impulse −h·F ≤ h·τ_f ≤ h·F opposing v₁,
+/// or holding the joint exactly still (v₁ = 0) when the rest of the step's impulse on it is within
+/// h·F — all solved exactly together ([`StickSlipSolver`]), coupled through M + hD. Several
+/// substeps per control period when the plant step is shorter than the control period.
 pub struct DiscretePlant {
     pub time_step: f64,
     pub substeps: usize,
-    factor: DMatrix<f64>,
+    /// Per joint, Coulomb friction F (N·m or N): |τ_f| ≤ F, τ_f = −F·sign(v₁) on a sliding joint.
+    friction: Vec<f64>,
+    /// h·D, added to M's diagonal.
+    damping_step: Vec<f64>,
     rhs: Vec<f64>,
-    reduced_rhs: Vec<f64>,
     v_next: Vec<f64>,
-    /// −1 lower limit, +1 upper limit, 0 free.
-    constraint: Vec<i8>,
+    residual: Vec<f64>,
+    laws: Vec<JointLaw>,
+    solver: StickSlipSolver,
     limit_active: Vec<bool>,
-    /// A branched tree (and no `<mimic>`): M + hD factorized along the tree's sparsity (LᵀDL), each
-    /// joint's parent joint here; a chain keeps the dense Cholesky (the same cost, and its rounding).
-    tree_parents: Option<Vec<Option<usize>>>,
+    friction_torque: Vec<f64>,
+    stuck: Vec<bool>,
+    /// Work of the friction over the last `advance` (≤ 0), J.
+    friction_work: f64,
 }
 
 impl DiscretePlant {
+    /// The plant with the URDF's joint friction (see [`Self::with_friction`]).
     pub fn new(model: &Model, time_step: f64, substeps: usize) -> Self {
+        let friction = model.joints.iter().map(|j| j.friction).collect();
+        Self::with_friction(model, time_step, substeps, friction)
+    }
+
+    /// The plant with Coulomb friction `friction[i]` on joint i (0: none, Drake's update exactly).
+    pub fn with_friction(model: &Model, time_step: f64, substeps: usize, friction: Vec<f64>) -> Self {
         let n = model.dof();
         Self {
             time_step,
             substeps,
-            factor: DMatrix::zeros(n, n),
+            friction,
+            damping_step: model.joints.iter().map(|j| time_step * j.damping).collect(),
             rhs: vec![0.0; n],
-            reduced_rhs: vec![0.0; n],
             v_next: vec![0.0; n],
-            constraint: vec![0; n],
+            residual: vec![0.0; n],
+            laws: vec![JointLaw::FREE; n],
+            solver: StickSlipSolver::new(n, branched_tree(model)),
             limit_active: vec![false; n],
-            tree_parents: branched_tree(model),
+            friction_torque: vec![0.0; n],
+            stuck: vec![false; n],
+            friction_work: 0.0,
         }
     }
 
@@ -61,110 +78,59 @@ impl DiscretePlant {
         for i in 0..n {
             self.rhs[i] += h * (u[i] + data.gravity[i] - data.bias[i]);
         }
-        self.constraint.fill(0);
-        self.solve_with_limits(model, mass, q);
+        // each joint's velocity bounds (the limits reached at the step's end) and friction impulses
+        for (i, joint) in model.joints.iter().enumerate() {
+            let friction = h * self.friction[i];
+            self.laws[i] = JointLaw { lower: (joint.lower - q[i]) / h, upper: (joint.upper - q[i]) / h, below: -friction, above: friction };
+        }
+        // M + hD is symmetric positive definite for any valid model; a failure means the state is
+        // no longer finite, which the simulation loop reports as divergence
+        if self.solver.solve(mass, &self.damping_step, &self.rhs, &self.laws, &mut self.v_next, &mut self.residual).is_err() {
+            self.v_next.fill(f64::NAN);
+        }
         for i in 0..n {
+            let v_before = v[i];
             v[i] = self.v_next[i];
             q[i] += h * v[i];
-            if self.constraint[i] != 0 {
+            let side = self.solver.limit_side(&self.laws, i);
+            if side != 0 {
                 // land exactly on the limit, not a rounding error past it
-                q[i] = if self.constraint[i] > 0 { model.joints[i].upper } else { model.joints[i].lower };
+                q[i] = if side > 0 { model.joints[i].upper } else { model.joints[i].lower };
                 self.limit_active[i] = true;
             }
+            // the friction's work, booked at the step's mean speed as the energy audit books the
+            // torques and damping (a limit's inelastic stop is not booked: it only takes energy)
+            let mean = 0.5 * (v_before + v[i]);
+            if self.friction[i] > 0.0 {
+                let torque = self.friction_on(i, side, v[i]);
+                self.friction_torque[i] = torque;
+                self.stuck[i] = v[i] == 0.0;
+                self.friction_work += h * torque * mean;
+            }
+
         }
+    }
+
+    /// The friction torque on joint i after a step: −g/h within the bounds; at rest on a limit the
+    /// limit takes what pushes into it, the friction only what pulls away.
+    fn friction_on(&self, i: usize, side: i8, v: f64) -> f64 {
+        let bound = self.friction[i];
+        let g = self.residual[i] / self.time_step;
+        let g = if side != 0 && v == 0.0 { if side > 0 { g.min(0.0) } else { g.max(0.0) } } else { g };
+        (-g).clamp(-bound, bound)
     }
 
     /// The control period's plant steps, each by `step`; the kinematics, τ_g and C·v it needs are
     /// computed for every step after the first (the loop computed them for the first).
     fn over_substeps(&mut self, model: &Model, data: &mut Data, q: &mut [f64], v: &mut [f64], mut step: impl FnMut(&mut Self, &mut Data, &mut [f64], &mut [f64])) {
         self.limit_active.fill(false);
+        self.friction_work = 0.0;
         for s in 0..self.substeps {
             if s > 0 {
                 forward_kinematics(model, data, q);
                 gravity_and_bias_from_kinematics(model, data, v);
             }
             step(self, data, q, v);
-        }
-    }
-
-    /// Active-set solve: start unconstrained, fix the velocity of every joint that would pass its
-    /// limit to the velocity that lands on it, release a joint whose constraint would have to pull.
-    fn solve_with_limits(&mut self, model: &Model, mass: &[f64], q: &[f64]) {
-        let n = model.dof();
-        let h = self.time_step;
-        for _ in 0..(2 * n + 2) {
-            self.solve_reduced(model, mass, q);
-            let mut changed = false;
-            for i in 0..n {
-                let joint = &model.joints[i];
-                match self.constraint[i] {
-                    0 => {
-                        let q_next = q[i] + h * self.v_next[i];
-                        if q_next > joint.upper {
-                            self.constraint[i] = 1;
-                            changed = true;
-                        } else if q_next < joint.lower {
-                            self.constraint[i] = -1;
-                            changed = true;
-                        }
-                    }
-                    side => {
-                        // impulse the constraint applies: λ = (A v − b)_i; an upper stop may only push down
-                        // (A v)_i = Σ_j M_ij v_j + h·D_i·v_i, row i of the symmetric M read as its column i
-                        let mut lambda = -self.rhs[i] + h * joint.damping * self.v_next[i];
-                        for (mij, vj) in mass[i * n..(i + 1) * n].iter().zip(&self.v_next) {
-                            lambda += mij * vj;
-                        }
-                        if lambda * side as f64 > 0.0 {
-                            self.constraint[i] = 0;
-                            changed = true;
-                        }
-                    }
-                }
-            }
-            if !changed {
-                return;
-            }
-        }
-    }
-
-    fn solve_reduced(&mut self, model: &Model, mass: &[f64], q: &[f64]) {
-        let n = model.dof();
-        let h = self.time_step;
-        self.factor.as_mut_slice().copy_from_slice(mass);
-        // A = M + h·D
-        for (i, joint) in model.joints.iter().enumerate() {
-            self.factor[(i, i)] += h * joint.damping;
-        }
-        self.reduced_rhs.copy_from_slice(&self.rhs);
-        for j in 0..n {
-            if self.constraint[j] == 0 {
-                continue;
-            }
-            let limit = if self.constraint[j] > 0 { model.joints[j].upper } else { model.joints[j].lower };
-            let v_fixed = (limit - q[j]) / h;
-            for i in 0..n {
-                self.reduced_rhs[i] -= self.factor[(i, j)] * v_fixed;
-                self.factor[(i, j)] = 0.0;
-                self.factor[(j, i)] = 0.0;
-            }
-            self.factor[(j, j)] = 1.0;
-            self.reduced_rhs[j] = v_fixed;
-        }
-        // M + hD is symmetric positive definite for any valid model; a failure means the state is
-        // no longer finite, which the simulation loop reports as divergence.
-        let factored = match &self.tree_parents {
-            Some(parents) => ltdl_in_place(&mut self.factor, parents),
-            None => cholesky_in_place(&mut self.factor),
-        };
-        if !factored {
-            self.v_next.fill(f64::NAN);
-            return;
-        }
-        self.v_next.copy_from_slice(&self.reduced_rhs);
-        match &self.tree_parents {
-            Some(parents) => ltdl_solve_in_place(&self.factor, parents, &mut self.v_next),
-            None => cholesky_solve_in_place(&self.factor, &mut self.v_next),
         }
     }
 }
@@ -185,9 +151,22 @@ impl Plant for DiscretePlant {
         &self.limit_active
     }
 
+    fn friction_torque(&self) -> &[f64] {
+        &self.friction_torque
+    }
+
+    fn stuck(&self) -> &[bool] {
+        &self.stuck
+    }
+
+    fn friction_work(&self) -> f64 {
+        self.friction_work
+    }
+
     fn describe(&self) -> String {
         format!(
-            "discrete plant: semi-implicit Euler, implicit joint damping (Drake's update), h = {} ms{}",
+            "discrete plant: semi-implicit Euler, implicit joint damping (Drake's update){}, h = {} ms{}",
+            if self.friction.iter().any(|&f| f > 0.0) { ", exact Coulomb stick–slip" } else { "" },
             self.time_step * 1e3,
             if self.substeps > 1 { format!(", {} steps per control period", self.substeps) } else { String::new() }
         )

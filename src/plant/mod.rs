@@ -2,9 +2,11 @@
 
 mod continuous;
 mod discrete;
+mod stick_slip;
 
 pub use continuous::{ContinuousPlant, Tolerances};
 pub use discrete::DiscretePlant;
+pub use stick_slip::{JointLaw, NotPositiveDefinite, StickSlipSolver};
 
 use crate::dynamics::Data;
 use crate::model::Model;
@@ -22,6 +24,17 @@ pub trait Plant: Send {
 
     /// Per joint: whether it was stopped at a position limit during the last `advance`.
     fn limit_active(&self) -> &[bool];
+
+    /// Per joint: the Coulomb friction torque at the end of the last `advance` (0 without friction).
+    fn friction_torque(&self) -> &[f64];
+
+    /// Per joint with friction: whether it is stuck (q̇ exactly 0, held by friction) at the end of
+    /// the last `advance`.
+    fn stuck(&self) -> &[bool];
+
+    /// The work the friction did over the last `advance`, J (≤ 0: it dissipates), for the energy
+    /// audit.
+    fn friction_work(&self) -> f64;
 
     /// One line for the console and the recordings.
     fn describe(&self) -> String;

@@ -159,6 +159,13 @@ pub fn write_summary(out: &mut dyn Write, s: &Summary) -> std::io::Result<()> {
     writeln!(out, "{}", row("saturation (%)", s.saturation_percent.iter().map(|p| format!("{p:.1}")).collect()))?;
     writeln!(out, "{}", row("chatter (%)", s.chatter_percent.iter().map(|p| format!("{p:.1}")).collect()))?;
     writeln!(out, "{}", row("peak |u| (N·m)", s.peak_abs_torque.iter().map(|p| format!("{p:.3}")).collect()))?;
+    if s.peak_abs_torque_after_settle.iter().any(|p| p.is_some()) {
+        writeln!(out, "{}   (t >= {} s: the motion's own)", row("  after settling", s.peak_abs_torque_after_settle.iter().map(|p| p.map_or("n/a".into(), |p| format!("{p:.3}"))).collect()), s.error_window_start)?;
+    }
+    if !s.stuck_percent.is_empty() {
+        writeln!(out, "{}", row("peak friction (N·m)", s.peak_friction_torque.iter().map(|p| format!("{p:.3}")).collect()))?;
+        writeln!(out, "{}", row("stuck (%)", s.stuck_percent.iter().map(|p| format!("{p:.1}")).collect()))?;
+    }
     writeln!(out, "{}", row("effort limit (N·m)", s.effort_limit.iter().map(|p| format!("{}", (p * 1e3).round() / 1e3)).collect()))?;
     if s.first_lost_step_time.iter().any(|t| t.is_some()) || s.lost_steps.iter().any(|&l| l > 0) {
         writeln!(out, "{}", row("lost steps (full)", s.lost_steps.iter().map(|p| format!("{p}")).collect()))?;

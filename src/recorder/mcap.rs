@@ -587,6 +587,7 @@ impl Recorder for McapRecorder {
             joints: names.iter().map(|n| JointState { name: n.clone(), ..Default::default() }).collect(),
         };
         let n = model.dof();
+        let has_friction = model.joints.iter().any(|j| j.friction > 0.0);
         self.telemetry = ControllerTelemetry {
             time: 0.0,
             target: vec![0.0; n],
@@ -601,6 +602,8 @@ impl Recorder for McapRecorder {
             load_angle: vec![0.0; n],
             lost_steps: vec![0; n],
             motor_speed: vec![0.0; n],
+            friction: if has_friction { vec![0.0; n] } else { Vec::new() },
+            stuck: if has_friction { vec![0; n] } else { Vec::new() },
         };
         self.motors = e.motors.clone();
         self.scene = scene_from_model(model).map_err(|(path, err)| Error::output(&path, err))?;
@@ -665,6 +668,12 @@ impl Recorder for McapRecorder {
             tel.load_angle[j] = s.load_angle[j];
             tel.lost_steps[j] = s.lost_steps[j];
             tel.motor_speed[j] = self.motors.as_ref().and_then(|m| m.motor_speed(j, s.v[j])).unwrap_or(0.0);
+        }
+        if !s.friction.is_empty() {
+            tel.friction.copy_from_slice(s.friction);
+            for (flag, &stuck) in tel.stuck.iter_mut().zip(s.stuck) {
+                *flag = stuck as u32;
+            }
         }
         let path = &self.path;
         let fail = |e: String| Error::output(path, e);

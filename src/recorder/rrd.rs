@@ -62,6 +62,8 @@ struct JointColumns {
     lost_steps: Vec<f64>,
     /// With `--motors`: `joints/<joint>/motor_speed`, the motor shaft's speed N·q̇ in rev/s, per step.
     motor_speed: Vec<f64>,
+    /// With joint friction: `joints/<joint>/friction`, [friction torque, stuck 0/1] per step.
+    friction: Vec<f64>,
 }
 
 impl JointColumns {
@@ -76,11 +78,12 @@ impl JointColumns {
             load_angle: Vec::new(),
             lost_steps: Vec::new(),
             motor_speed: Vec::new(),
+            friction: Vec::new(),
         }
     }
 
     fn clear(&mut self) {
-        for c in [&mut self.position, &mut self.torque, &mut self.status, &mut self.saturated_times, &mut self.saturated_torque, &mut self.limit, &mut self.load_angle, &mut self.lost_steps, &mut self.motor_speed] {
+        for c in [&mut self.position, &mut self.torque, &mut self.status, &mut self.saturated_times, &mut self.saturated_torque, &mut self.limit, &mut self.load_angle, &mut self.lost_steps, &mut self.motor_speed, &mut self.friction] {
             c.clear();
         }
     }
@@ -321,6 +324,7 @@ impl RerunRecorder {
                 ("load_angle", lines(&[format!("{name} load angle (electrical °; ±90 peak torque, ±180 slip)")], &[c], &[1.5])),
                 ("lost_steps", lines(&[format!("{name} lost steps (full)")], &[red], &[2.0])),
                 ("motor_speed", lines(&[format!("{name} motor speed (rev/s)")], &[c], &[1.5])),
+                ("friction", lines(&[format!("{name} friction (N·m)"), format!("{name} stuck (0/1)")], &[rerun::Color::from_rgb(150, 100, 200), rerun::Color::from_rgb(100, 100, 100)], &[1.0, 1.0])),
             ];
             for (leaf, style) in styles {
                 rec.log_static(format!("{base}/{leaf}"), &style).map_err(e)?;
@@ -366,6 +370,9 @@ impl RerunRecorder {
             }
             if self.motors.as_ref().is_some_and(|m| m.joints[j].is_some()) {
                 send(&format!("{base}/motor_speed"), time.clone(), scalars(&c.motor_speed, 1))?;
+            }
+            if !c.friction.is_empty() {
+                send(&format!("{base}/friction"), time.clone(), scalars(&c.friction, 2))?;
             }
             if self.stepped[j] {
                 send(&format!("{base}/load_angle"), time.clone(), scalars(&c.load_angle, 1))?;
@@ -546,7 +553,7 @@ pub fn blueprint(joint_names: &[String], stepped: &[bool], prefix: &str) -> Blue
     let torque_views = joint_names.iter().map(|j| {
         TimeSeriesView::new(format!("{j} torque vs ±limit"))
             .with_origin(format!("{prefix}joints/{j}"))
-            .with_contents(["$origin/torque", "$origin/torque_limit", "$origin/saturated_torque"])
+            .with_contents(["$origin/torque", "$origin/torque_limit", "$origin/saturated_torque", "$origin/friction"])
             .into()
     });
     let columns = joint_names.len().div_ceil(2).clamp(1, 4) as u32;
@@ -677,6 +684,9 @@ impl Recorder for RerunRecorder {
                 c.lost_steps.push(s.lost_steps[j] as f64);
             }
             c.status.extend_from_slice(&[s.tracking_error(j), flag(s.saturated[j]), flag(s.chatter[j])]);
+            if !s.friction.is_empty() {
+                c.friction.extend_from_slice(&[s.friction[j], flag(s.stuck[j])]);
+            }
             if s.saturated[j] {
                 c.saturated_times.push(s.t);
                 c.saturated_torque.push(s.u[j]);

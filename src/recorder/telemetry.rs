@@ -54,6 +54,12 @@ pub struct ControllerTelemetry {
     /// With `--motors`: each motor's shaft speed N·q̇, rev/s (0 where no motor file entry).
     #[prost(double, repeated, tag = "13")]
     pub motor_speed: Vec<f64>,
+    /// Coulomb friction torque on each joint, N·m (empty when no joint has friction).
+    #[prost(double, repeated, tag = "14")]
+    pub friction: Vec<f64>,
+    /// 1 where the joint is stuck, held still by its friction (empty when no joint has friction).
+    #[prost(uint32, repeated, tag = "15")]
+    pub stuck: Vec<u32>,
 }
 
 /// The schema as MCAP's protobuf profile wants it: a serialized FileDescriptorSet. Kept next to
@@ -83,6 +89,8 @@ pub fn file_descriptor_set() -> Vec<u8> {
             field("load_angle", 11, true, Type::Double),
             field("lost_steps", 12, true, Type::Int64),
             field("motor_speed", 13, true, Type::Double),
+            field("friction", 14, true, Type::Double),
+            field("stuck", 15, true, Type::Uint32),
         ],
         ..Default::default()
     };

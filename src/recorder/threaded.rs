@@ -38,6 +38,8 @@ struct SampleBlock {
     saturated: Vec<bool>,
     chatter: Vec<bool>,
     at_limit: Vec<bool>,
+    friction: Vec<f64>,
+    stuck: Vec<bool>,
     tool: Vec<Vector3<f64>>,
     tool_target: Vec<Vector3<f64>>,
     body_pose: Vec<Pose>,
@@ -64,6 +66,8 @@ impl SampleBlock {
             saturated: Vec::with_capacity(capacity * n),
             chatter: Vec::with_capacity(capacity * n),
             at_limit: Vec::with_capacity(capacity * n),
+            friction: Vec::new(),
+            stuck: Vec::new(),
             tool: Vec::with_capacity(capacity),
             tool_target: Vec::with_capacity(capacity),
             body_pose: Vec::with_capacity(capacity * bodies),
@@ -90,6 +94,8 @@ impl SampleBlock {
         self.saturated.extend_from_slice(s.saturated);
         self.chatter.extend_from_slice(s.chatter);
         self.at_limit.extend_from_slice(s.at_limit);
+        self.friction.extend_from_slice(s.friction);
+        self.stuck.extend_from_slice(s.stuck);
         self.tool.push(s.tool_position);
         self.tool_target.push(s.tool_target);
         self.body_pose.extend_from_slice(s.body_pose);
@@ -113,6 +119,9 @@ impl SampleBlock {
             saturated: &self.saturated[a..b],
             chatter: &self.chatter[a..b],
             at_limit: &self.at_limit[a..b],
+            // (all samples of a run have friction, or none has)
+            friction: if self.friction.is_empty() { &[] } else { &self.friction[a..b] },
+            stuck: if self.stuck.is_empty() { &[] } else { &self.stuck[a..b] },
             tool_position: self.tool[i],
             tool_target: self.tool_target[i],
             body_pose: &self.body_pose[i * self.bodies..(i + 1) * self.bodies],
@@ -132,6 +141,8 @@ impl Reusable for SampleBlock {
         self.saturated.clear();
         self.chatter.clear();
         self.at_limit.clear();
+        self.friction.clear();
+        self.stuck.clear();
         self.tool.clear();
         self.tool_target.clear();
         self.body_pose.clear();

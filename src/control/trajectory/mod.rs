@@ -2,12 +2,14 @@
 
 mod hold;
 mod joint_wave;
+mod ramp_in;
 mod schedule;
 mod step;
 mod wave;
 
 pub use hold::Hold;
 pub use joint_wave::JointWave;
+pub use ramp_in::RampIn;
 pub use schedule::JointSchedule;
 pub use step::JointStep;
 pub use wave::Wave;
