@@ -188,6 +188,21 @@ fn every_pattern(a: &DMatrix<f64>, b: &DVector<f64>, hf: &[f64]) -> DVector<f64>
     v
 }
 
+/// The discrete step's A = M + hD and b = M·v + h·(u + τ_g − C·v) at (q, v), written out from the
+/// model's M, τ_g and C·v; `data` is left with the kinematics the plant's step needs.
+fn discrete_problem(model: &Model, data: &mut Data, h: f64, q: &[f64], v: &[f64], u: &[f64]) -> (DMatrix<f64>, DVector<f64>) {
+    let n = model.dof();
+    forward_kinematics(model, data, q);
+    gravity_and_bias_from_kinematics(model, data, v);
+    crba_from_kinematics(model, data);
+    let mut a = data.mass_matrix.clone();
+    for i in 0..n {
+        a[(i, i)] += h * model.joints[i].damping;
+    }
+    let b = &data.mass_matrix * DVector::from_column_slice(v) + h * DVector::from_fn(n, |i, _| u[i] + data.gravity[i] - data.bias[i]);
+    (a, b)
+}
+
 #[test]
 fn every_discrete_step_of_an_arm_with_friction_is_the_exact_box_constrained_solution() {
     // friction on all six joints, sized so that along the fall some joints stick while others slide
@@ -204,15 +219,7 @@ fn every_discrete_step_of_an_arm_with_friction_is_the_exact_box_constrained_solu
     let (mut stuck_steps, mut sliding_steps, mut changes) = (0, 0, 0);
     let mut previous_stuck = vec![false; n];
     for k in 0..600 {
-        forward_kinematics(&model, &mut data, &q);
-        gravity_and_bias_from_kinematics(&model, &mut data, &v);
-        crba_from_kinematics(&model, &mut data);
-        // the problem, written out from the model's M, τ_g and C·v
-        let mut a = data.mass_matrix.clone();
-        for i in 0..n {
-            a[(i, i)] += h * model.joints[i].damping;
-        }
-        let b = &data.mass_matrix * DVector::from_column_slice(&v) + h * DVector::from_fn(n, |i, _| u[i] + data.gravity[i] - data.bias[i]);
+        let (a, b) = discrete_problem(&model, &mut data, h, &q, &v, &u);
         let hf: Vec<f64> = friction.iter().map(|f| h * f).collect();
         let exact = every_pattern(&a, &b, &hf);
         let scale = exact.amax().max(1e-3);
@@ -246,14 +253,7 @@ fn without_friction_the_discrete_step_is_the_frictionless_update() {
     let mut data = Data::new(&model);
     let (mut q, mut v, u) = (vec![0.2, 0.5, -0.6, 0.3, 0.4, 0.0], vec![0.1; 6], vec![0.0; 6]);
     for _ in 0..100 {
-        forward_kinematics(&model, &mut data, &q);
-        gravity_and_bias_from_kinematics(&model, &mut data, &v);
-        crba_from_kinematics(&model, &mut data);
-        let mut a = data.mass_matrix.clone();
-        for i in 0..n {
-            a[(i, i)] += h * model.joints[i].damping;
-        }
-        let b = &data.mass_matrix * DVector::from_column_slice(&v) + h * DVector::from_fn(n, |i, _| u[i] + data.gravity[i] - data.bias[i]);
+        let (a, b) = discrete_problem(&model, &mut data, h, &q, &v, &u);
         let want = a.cholesky().unwrap().solve(&b);
         plant.advance(&model, &mut data, &u, &mut q, &mut v);
         for i in 0..n {
