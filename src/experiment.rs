@@ -363,8 +363,6 @@ fn gains(config: &RunConfig, model: &Model, start: &[f64], trajectory: &dyn Traj
     Ok(Gains { kp, kd, source, ..base })
 }
 
-/// A joint whose motor cannot carry the arm's weight at the start pose saturates from the first step
-/// on, whatever the controller does: say so before the run, naming the joint and both torques.
 /// `--friction SCALE` on every joint's Coulomb friction; a notice for each joint whose friction is
 /// more than its motor's effort (its motor can never move it: Allegro's URDF gives its fingers 5–12
 /// N·m against 0.7 N·m — left as the URDF says, `--friction 0` runs without).
@@ -387,6 +385,8 @@ fn apply_friction_scale(config: &RunConfig, model: &mut Model) -> Result<(), Err
     Ok(())
 }
 
+/// A joint whose motor cannot carry the arm's weight at the start pose saturates from the first step
+/// on, whatever the controller does: say so before the run, naming the joint and both torques.
 fn weight_notices(model: &mut Model, start: &[f64]) {
     for (j, tau_g, effort) in overloaded_by_weight(model, start, 1.0) {
         let name = model.joints[j].name.clone();

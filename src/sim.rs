@@ -46,7 +46,7 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
     let has_friction = model.joints.iter().any(|j| j.friction > 0.0);
     let (mut friction, mut stuck) = if has_friction { (vec![0.0; n], vec![false; n]) } else { (Vec::new(), Vec::new()) };
     let joint_names: Vec<String> = model.joints.iter().map(|j| j.name.clone()).collect();
-    let mut stats = SummaryBuilder::new(joint_names, controller.effort.clone(), dt, experiment.config.settle_time).with_stepped_joints(experiment.stepped_joints());
+    let mut stats = SummaryBuilder::new(joint_names, controller.effort.clone(), dt, experiment.config.settle_time).with_stepped_joints(experiment.stepped_joints()).with_friction(has_friction);
     let started = Instant::now();
     let mut status = RunStatus::Completed;
     let mut audit = EnergyAudit::new(experiment);

@@ -165,6 +165,14 @@ impl SummaryBuilder {
         self
     }
 
+    /// Some joint has friction: its peak friction torque and stuck steps are counted.
+    pub fn with_friction(mut self, has_friction: bool) -> Self {
+        let n = if has_friction { self.joints.len() } else { 0 };
+        self.peak_friction = vec![0.0; n];
+        self.stuck_steps = vec![0; n];
+        self
+    }
+
     /// A stepper lost steps (stepper mode).
     pub fn lost_steps(&mut self, e: crate::actuator::LostSteps) {
         self.lost_steps[e.joint] += e.steps.unsigned_abs();
@@ -208,11 +216,7 @@ impl SummaryBuilder {
         for i in 0..n {
             self.limit_hits[i] += s.at_limit[i] as u64;
         }
-        if !s.friction.is_empty() && !s.is_final {
-            if self.stuck_steps.is_empty() {
-                self.peak_friction = vec![0.0; n];
-                self.stuck_steps = vec![0; n];
-            }
+        if !self.stuck_steps.is_empty() && !s.is_final {
             for i in 0..n {
                 self.peak_friction[i] = self.peak_friction[i].max(s.friction[i].abs());
                 self.stuck_steps[i] += s.stuck[i] as u64;

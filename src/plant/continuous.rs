@@ -82,16 +82,10 @@ impl ContinuousPlant {
             k: std::array::from_fn(|_| state()),
             tau: vec![0.0; n],
             limit_active: vec![false; n],
-            friction: Friction::new(model, model.joints.iter().map(|j| j.friction).collect()),
+            friction: Friction::new(model),
             accepted_steps: 0,
             rejected_steps: 0,
         }
-    }
-
-    /// The plant with Coulomb friction `friction[i]` on joint i instead of the URDF's.
-    pub fn with_friction(mut self, model: &Model, friction: Vec<f64>) -> Self {
-        self.friction = Friction::new(model, friction);
-        self
     }
 
     /// ẏ = (q̇, q̈) with q̈ from ABA, damping included; with friction, in the current modes.
@@ -99,7 +93,7 @@ impl ContinuousPlant {
         let n = self.n;
         if self.friction.any {
             let (q, v) = self.y_stage.split_at(n);
-            let qdd = self.friction.acceleration(model, data, u, q, v, stage);
+            let qdd = self.friction.acceleration(model, data, u, q, v);
             let k = &mut self.k[stage];
             k[..n].copy_from_slice(v);
             k[n..].copy_from_slice(qdd);
@@ -311,8 +305,9 @@ struct Friction {
 }
 
 impl Friction {
-    fn new(model: &Model, bound: Vec<f64>) -> Self {
+    fn new(model: &Model) -> Self {
         let n = model.dof();
+        let bound: Vec<f64> = model.joints.iter().map(|j| j.friction).collect();
         Self {
             any: bound.iter().any(|&f| f > 0.0),
             bound,
@@ -378,7 +373,7 @@ impl Friction {
     }
 
     /// q̈ in the current modes: sliding joints' friction known, stuck joints' q̈ = 0.
-    fn acceleration(&mut self, model: &Model, data: &mut Data, u: &[f64], q: &[f64], v: &[f64], _stage: usize) -> &[f64] {
+    fn acceleration(&mut self, model: &Model, data: &mut Data, u: &[f64], q: &[f64], v: &[f64]) -> &[f64] {
         let mass = self.mass_and_forces(model, data, u, q, v);
         for i in 0..v.len() {
             let f = self.bound[i];

@@ -19,9 +19,10 @@ use crate::model::Model;
 pub struct DiscretePlant {
     pub time_step: f64,
     pub substeps: usize,
-    /// Per joint, Coulomb friction F (N·m or N): |τ_f| ≤ F, τ_f = −F·sign(v₁) on a sliding joint.
-    friction: Vec<f64>,
-    /// h·D, added to M's diagonal.
+    /// Whether some joint has Coulomb friction (each joint's F is the model's).
+    has_friction: bool,
+    /// h·D, added to M's diagonal: computed each step from the model's damping and the plant's
+    /// time step (a cached copy would go stale when `time_step` changes).
     damping_step: Vec<f64>,
     rhs: Vec<f64>,
     v_next: Vec<f64>,
@@ -36,20 +37,14 @@ pub struct DiscretePlant {
 }
 
 impl DiscretePlant {
-    /// The plant with the URDF's joint friction (see [`Self::with_friction`]).
+    /// The plant with the model's joint friction (0: none, Drake's update exactly).
     pub fn new(model: &Model, time_step: f64, substeps: usize) -> Self {
-        let friction = model.joints.iter().map(|j| j.friction).collect();
-        Self::with_friction(model, time_step, substeps, friction)
-    }
-
-    /// The plant with Coulomb friction `friction[i]` on joint i (0: none, Drake's update exactly).
-    pub fn with_friction(model: &Model, time_step: f64, substeps: usize, friction: Vec<f64>) -> Self {
         let n = model.dof();
         Self {
             time_step,
             substeps,
-            friction,
-            damping_step: model.joints.iter().map(|j| time_step * j.damping).collect(),
+            has_friction: model.joints.iter().any(|j| j.friction > 0.0),
+            damping_step: vec![0.0; n],
             rhs: vec![0.0; n],
             v_next: vec![0.0; n],
             residual: vec![0.0; n],
@@ -78,9 +73,10 @@ impl DiscretePlant {
         for i in 0..n {
             self.rhs[i] += h * (u[i] + data.gravity[i] - data.bias[i]);
         }
-        // each joint's velocity bounds (the limits reached at the step's end) and friction impulses
+        // each joint's h·D, velocity bounds (the limits reached at the step's end) and friction impulses
         for (i, joint) in model.joints.iter().enumerate() {
-            let friction = h * self.friction[i];
+            self.damping_step[i] = h * joint.damping;
+            let friction = h * joint.friction;
             self.laws[i] = JointLaw { lower: (joint.lower - q[i]) / h, upper: (joint.upper - q[i]) / h, below: -friction, above: friction };
         }
         // M + hD is symmetric positive definite for any valid model; a failure means the state is
@@ -101,20 +97,19 @@ impl DiscretePlant {
             // the friction's work, booked at the step's mean speed as the energy audit books the
             // torques and damping (a limit's inelastic stop is not booked: it only takes energy)
             let mean = 0.5 * (v_before + v[i]);
-            if self.friction[i] > 0.0 {
-                let torque = self.friction_on(i, side, v[i]);
+            let bound = model.joints[i].friction;
+            if bound > 0.0 {
+                let torque = self.friction_on(i, bound, side, v[i]);
                 self.friction_torque[i] = torque;
                 self.stuck[i] = v[i] == 0.0;
                 self.friction_work += h * torque * mean;
             }
-
         }
     }
 
     /// The friction torque on joint i after a step: −g/h within the bounds; at rest on a limit the
     /// limit takes what pushes into it, the friction only what pulls away.
-    fn friction_on(&self, i: usize, side: i8, v: f64) -> f64 {
-        let bound = self.friction[i];
+    fn friction_on(&self, i: usize, bound: f64, side: i8, v: f64) -> f64 {
         let g = self.residual[i] / self.time_step;
         let g = if side != 0 && v == 0.0 { if side > 0 { g.min(0.0) } else { g.max(0.0) } } else { g };
         (-g).clamp(-bound, bound)
@@ -166,7 +161,7 @@ impl Plant for DiscretePlant {
     fn describe(&self) -> String {
         format!(
             "discrete plant: semi-implicit Euler, implicit joint damping (Drake's update){}, h = {} ms{}",
-            if self.friction.iter().any(|&f| f > 0.0) { ", exact Coulomb stick–slip" } else { "" },
+            if self.has_friction { ", exact Coulomb stick–slip" } else { "" },
             self.time_step * 1e3,
             if self.substeps > 1 { format!(", {} steps per control period", self.substeps) } else { String::new() }
         )

@@ -107,6 +107,8 @@ pub struct StickSlipSolver {
     rhs: Vec<f64>,
     /// Per joint, the piece of φ_i it is on (see [`JointLaw`]); kept between solves as the start.
     piece: Vec<usize>,
+    /// Per joint, the breakpoints of the current solve's law and how many (worked out once per solve).
+    points: Vec<([f64; 3], usize)>,
     /// Each joint's parent joint when A has a branched tree's sparsity (LᵀDL), else dense Cholesky.
     tree_parents: Option<Vec<Option<usize>>>,
     violated: Vec<usize>,
@@ -120,36 +122,22 @@ pub struct NotPositiveDefinite;
 
 impl StickSlipSolver {
     pub fn new(n: usize, tree_parents: Option<Vec<Option<usize>>>) -> Self {
-        Self { n, factor: DMatrix::zeros(n, n), rhs: vec![0.0; n], piece: vec![0; n], tree_parents, violated: Vec::with_capacity(n), fallbacks: 0 }
+        Self { n, factor: DMatrix::zeros(n, n), rhs: vec![0.0; n], piece: vec![0; n], points: vec![([0.0; 3], 0); n], tree_parents, violated: Vec::with_capacity(n), fallbacks: 0 }
     }
 
-    /// Forget the pieces of the last solve: the next starts with every joint on the piece x_i = 0
-    /// lies on (sticking where there is friction).
-    pub fn reset(&mut self, laws: &[JointLaw]) {
-        for (p, law) in self.piece.iter_mut().zip(laws) {
-            *p = law.piece_of(0.0);
-        }
-    }
-
-    /// Whether joint i ended on a breakpoint at 0 where it has friction: stuck.
-    pub fn is_stuck(&self, laws: &[JointLaw], i: usize) -> bool {
-        let (points, _) = laws[i].breakpoints();
-        let piece = self.piece[i];
-        laws[i].has_kink() && piece % 2 == 1 && points[piece / 2] == 0.0
-    }
-
-    /// Whether joint i ended on a limit (lower: −1, upper: +1, else 0).
+    /// Whether joint i ended the last solve of `laws` on a limit (lower: −1, upper: +1, else 0). A
+    /// limit is the first or last breakpoint (a kink at 0 lies strictly between the limits).
     pub fn limit_side(&self, laws: &[JointLaw], i: usize) -> i8 {
         let law = &laws[i];
-        let (points, m) = law.breakpoints();
+        let (points, m) = self.points[i];
         let piece = self.piece[i];
         if piece % 2 == 0 {
             return 0;
         }
         let k = piece / 2;
-        if law.lower.is_finite() && k == 0 && !(law.has_kink() && points[0] == 0.0) {
+        if law.lower.is_finite() && k == 0 {
             -1
-        } else if law.upper.is_finite() && k == m - 1 && points[k] == law.upper && !(law.has_kink() && points[k] == 0.0) {
+        } else if law.upper.is_finite() && k == m - 1 && points[k] == law.upper {
             1
         } else {
             0
@@ -160,9 +148,9 @@ impl StickSlipSolver {
     /// `g` holds b − A·x for every joint. Starts from the pieces of the last solve.
     pub fn solve(&mut self, a: &[f64], diagonal: &[f64], b: &[f64], laws: &[JointLaw], x: &mut [f64], g: &mut [f64]) -> Result<(), NotPositiveDefinite> {
         let n = self.n;
-        for (p, law) in self.piece.iter_mut().zip(laws) {
-            let (_, m) = law.breakpoints();
-            let (first, last) = law.piece_range(m);
+        for ((p, points), law) in self.piece.iter_mut().zip(&mut self.points).zip(laws) {
+            *points = law.breakpoints();
+            let (first, last) = law.piece_range(points.1);
             *p = (*p).clamp(first, last);
         }
         let mut fewest = usize::MAX;
@@ -176,7 +164,7 @@ impl StickSlipSolver {
             self.find_violations(laws, x, g);
             let count = self.violated.len();
             if count == 0 {
-                snap_to_pieces(laws, &self.piece, x);
+                self.snap_to_pieces(laws, x);
                 return Ok(());
             }
             let block = if count < fewest {
@@ -208,7 +196,7 @@ impl StickSlipSolver {
         self.rhs.copy_from_slice(b);
         for (j, law) in laws.iter().enumerate() {
             let piece = self.piece[j];
-            let (points, m) = law.breakpoints();
+            let (points, m) = self.points[j];
             if piece % 2 == 0 {
                 let slope = law.segment_slope(&points, m, piece / 2);
                 if slope != 0.0 {
@@ -216,13 +204,12 @@ impl StickSlipSolver {
                 }
             }
         }
-        for (j, law) in laws.iter().enumerate() {
+        for j in 0..n {
             let piece = self.piece[j];
             if piece % 2 == 0 {
                 continue;
             }
-            let (points, _) = law.breakpoints();
-            let fixed = points[piece / 2];
+            let fixed = self.points[j].0[piece / 2];
             for i in 0..n {
                 self.rhs[i] -= self.factor[(i, j)] * fixed;
                 self.factor[(i, j)] = 0.0;
@@ -252,7 +239,7 @@ impl StickSlipSolver {
         self.violated.clear();
         let scale = x.iter().fold(1.0_f64, |s, v| s.max(v.abs()));
         for (i, law) in laws.iter().enumerate() {
-            let (points, m) = law.breakpoints();
+            let (points, m) = self.points[i];
             let piece = self.piece[i];
             let k = piece / 2;
             if piece % 2 == 0 {
@@ -273,6 +260,19 @@ impl StickSlipSolver {
                     self.violated.push(encode(i, true));
                 } else if g[i] < left {
                     self.violated.push(encode(i, false));
+                }
+            }
+        }
+    }
+
+    /// A joint on a segment that ends at a kink may sit a rounding error past it: put it on the kink.
+    fn snap_to_pieces(&self, laws: &[JointLaw], x: &mut [f64]) {
+        for (i, law) in laws.iter().enumerate() {
+            let (piece, (points, m)) = (self.piece[i], self.points[i]);
+            if piece % 2 == 0 && law.has_kink() {
+                let k = piece / 2;
+                if (k < m && points[k] == 0.0 && x[i] > 0.0) || (k >= 1 && points[k - 1] == 0.0 && x[i] < 0.0) {
+                    x[i] = 0.0;
                 }
             }
         }
@@ -325,7 +325,7 @@ impl StickSlipSolver {
         // the solution's)
         self.solve_on_pieces(a, diagonal, b, laws, x)?;
         residual(a, diagonal, b, x, g);
-        snap_to_pieces(laws, &self.piece, x);
+        self.snap_to_pieces(laws, x);
         Ok(())
     }
 }
@@ -350,18 +350,6 @@ fn residual(a: &[f64], diagonal: &[f64], b: &[f64], x: &[f64], g: &mut [f64]) {
     }
 }
 
-/// A joint on a segment that ends at a kink may sit a rounding error past it: put it on the kink.
-fn snap_to_pieces(laws: &[JointLaw], piece: &[usize], x: &mut [f64]) {
-    for (i, law) in laws.iter().enumerate() {
-        if piece[i] % 2 == 0 && law.has_kink() {
-            let (points, m) = law.breakpoints();
-            let k = piece[i] / 2;
-            if (k < m && points[k] == 0.0 && x[i] > 0.0) || (k >= 1 && points[k - 1] == 0.0 && x[i] < 0.0) {
-                x[i] = 0.0;
-            }
-        }
-    }
-}
 
 #[cfg(test)]
 mod tests {
