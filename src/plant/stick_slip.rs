@@ -145,7 +145,8 @@ impl StickSlipSolver {
     }
 
     /// Solve for x (A by columns, n×n; `diagonal` added to A's diagonal, e.g. h·D). On return
-    /// `g` holds b − A·x for every joint. Starts from the pieces of the last solve.
+    /// `g` holds b − A·x for every joint (on a segment, exactly its slope, which the solve imposed).
+    /// Starts from the pieces of the last solve.
     pub fn solve(&mut self, a: &[f64], diagonal: &[f64], b: &[f64], laws: &[JointLaw], x: &mut [f64], g: &mut [f64]) -> Result<(), NotPositiveDefinite> {
         let n = self.n;
         for ((p, points), law) in self.piece.iter_mut().zip(&mut self.points).zip(laws) {
@@ -160,7 +161,7 @@ impl StickSlipSolver {
         let max_iterations = 20 * n + 50;
         for _ in 0..max_iterations {
             self.solve_on_pieces(a, diagonal, b, laws, x)?;
-            residual(a, diagonal, b, x, g);
+            self.residual(a, diagonal, b, laws, x, g);
             self.find_violations(laws, x, g);
             let count = self.violated.len();
             if count == 0 {
@@ -265,6 +266,25 @@ impl StickSlipSolver {
         }
     }
 
+    /// g = b − (A + diag)·x: on a segment the slope the solve imposed there, on a breakpoint the
+    /// row worked out (A by columns, symmetric: row i read as column i) — only the rows the checks
+    /// need, as a frictionless step away from its limits needs none.
+    fn residual(&self, a: &[f64], diagonal: &[f64], b: &[f64], laws: &[JointLaw], x: &[f64], g: &mut [f64]) {
+        let n = x.len();
+        for i in 0..n {
+            let (piece, (points, m)) = (self.piece[i], self.points[i]);
+            if piece % 2 == 0 {
+                g[i] = laws[i].segment_slope(&points, m, piece / 2);
+                continue;
+            }
+            let mut ax = diagonal[i] * x[i];
+            for (aij, xj) in a[i * n..(i + 1) * n].iter().zip(x) {
+                ax += aij * xj;
+            }
+            g[i] = b[i] - ax;
+        }
+    }
+
     /// A joint on a segment that ends at a kink may sit a rounding error past it: put it on the kink.
     fn snap_to_pieces(&self, laws: &[JointLaw], x: &mut [f64]) {
         for (i, law) in laws.iter().enumerate() {
@@ -324,7 +344,7 @@ impl StickSlipSolver {
         // polish: the exact solution on the pieces found (within rounding of the descent, they are
         // the solution's)
         self.solve_on_pieces(a, diagonal, b, laws, x)?;
-        residual(a, diagonal, b, x, g);
+        self.residual(a, diagonal, b, laws, x, g);
         self.snap_to_pieces(laws, x);
         Ok(())
     }
@@ -338,17 +358,6 @@ fn decode(code: usize) -> (usize, bool) {
     (code / 2, code % 2 == 1)
 }
 
-/// g = b − (A + diag)·x, A by columns (symmetric: row i read as column i).
-fn residual(a: &[f64], diagonal: &[f64], b: &[f64], x: &[f64], g: &mut [f64]) {
-    let n = x.len();
-    for i in 0..n {
-        let mut ax = diagonal[i] * x[i];
-        for (aij, xj) in a[i * n..(i + 1) * n].iter().zip(x) {
-            ax += aij * xj;
-        }
-        g[i] = b[i] - ax;
-    }
-}
 
 
 #[cfg(test)]
@@ -431,8 +440,10 @@ mod tests {
                 let (mut x, mut g) = (vec![0.0; n], vec![0.0; n]);
                 solver.solve(&a, &vec![0.0; n], &b, &laws, &mut x, &mut g).unwrap();
                 for i in 0..n {
-                    let v = optimality_violation(&laws[i], x[i], g[i]);
-                    assert!(v < 1e-12, "trial {trial} round {round} joint {i}: x = {}, g = {}, law {:?}", x[i], g[i], laws[i]);
+                    // the residual worked out here, every row (the solver's g gives segments their slope)
+                    let g: f64 = b[i] - (0..n).map(|j| a[j * n + i] * x[j]).sum::<f64>();
+                    let v = optimality_violation(&laws[i], x[i], g);
+                    assert!(v < 1e-12, "trial {trial} round {round} joint {i}: x = {}, g = {g}, law {:?}", x[i], laws[i]);
                 }
             }
         }
