@@ -161,5 +161,40 @@ fn motors(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, algorithms, discrete_step, whole_run, large_trees, motors);
+/// A 7-joint serial arm (1 kg, 0.2 m links, axes alternating z, y) with Coulomb friction `friction`
+/// on every joint.
+fn seven_joint_arm(friction: f64) -> armscope::model::Model {
+    let mut urdf = String::from("<robot name=\"seven\"><link name=\"base\"/>");
+    for i in 1..=7 {
+        let axis = if i % 2 == 1 { "0 0 1" } else { "0 1 0" };
+        let parent = if i == 1 { "base".to_string() } else { format!("l{}", i - 1) };
+        urdf += &format!(
+            "<link name=\"l{i}\"><inertial><origin xyz=\"0 0 0.1\"/><mass value=\"1\"/><inertia ixx=\"0.004\" iyy=\"0.004\" izz=\"0.001\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/></inertial></link>\
+             <joint name=\"j{i}\" type=\"revolute\"><parent link=\"{parent}\"/><child link=\"l{i}\"/><origin xyz=\"0 0 {}\"/><axis xyz=\"{axis}\"/>\
+             <limit lower=\"-3\" upper=\"3\" effort=\"50\" velocity=\"3\"/><dynamics damping=\"0.1\" friction=\"{friction}\"/></joint>",
+            if i == 1 { 0.0 } else { 0.2 }
+        );
+    }
+    urdf += "</robot>";
+    armscope::model::load_urdf_str(&urdf, Path::new("seven.urdf")).unwrap()
+}
+
+/// The discrete step on a 7-joint arm without friction, and with friction on every joint: every
+/// joint sliding (small F, moving), every joint stuck (F above what acts on it, at rest), and a mix.
+/// Issue 22's bar: friction costs at most 30 % more per step.
+fn friction(c: &mut Criterion) {
+    let q = vec![0.3, -0.5, 0.8, -1.1, 0.6, 0.2, -0.4];
+    let moving = vec![0.4, 0.9, -1.2, 0.5, -2.0, 1.0, 0.7];
+    let u = vec![0.0; 7];
+    let mut group = c.benchmark_group("friction_7_joints");
+    for (name, friction, v) in [("none", 0.0, &moving), ("all_sliding", 0.05, &moving), ("all_stuck", 50.0, &vec![0.0; 7]), ("mixed", 2.0, &moving)] {
+        let model = seven_joint_arm(friction);
+        let mut data = Data::new(&model);
+        let mut plant = armscope::plant::DiscretePlant::new(&model, 1e-3, 1);
+        group.bench_function(name, |b| plant_step(b, &model, &mut data, &mut plant, &q, v, &u));
+    }
+    group.finish();
+}
+
+criterion_group!(benches, algorithms, discrete_step, whole_run, large_trees, motors, friction);
 criterion_main!(benches);
