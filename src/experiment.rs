@@ -5,7 +5,7 @@ use crate::control::controller::PdGravityController;
 use crate::error::Error;
 use crate::control::gains::{Gains, TUTORIAL_KD, TUTORIAL_KP, auto_tune, is_tutorial_model};
 use crate::control::within_effort::{MOTION_LOAD, START_LOAD, carried_wave, holdable_pose, overloaded_by_weight};
-use crate::plant::{ContinuousPlant, DiscretePlant, Plant, Tolerances};
+use crate::plant::{JointFriction, ContinuousPlant, DiscretePlant, Plant, Tolerances};
 use crate::actuator::{MotorSet, OpenLoopSteppers, load_motor_file};
 use crate::model::{Actuator, LoadOptions, Model, load_urdf_with};
 use crate::diagnose::analysis::LoopPlant;
@@ -107,16 +107,29 @@ impl Experiment {
             actuated: (0..n).map(|i| self.model.is_actuated(i)).collect(),
             feed_forward: !self.config.no_ff,
             motors: self.motors.clone(),
+            detent_origin: self.start.clone(),
         }
     }
 
     pub fn make_plant(&self) -> Box<dyn Plant> {
+        let gears = self.gears();
         match self.plant {
-            PlantSpec::Discrete { time_step, substeps } => Box::new(DiscretePlant::new(&self.model, time_step, substeps)),
+            PlantSpec::Discrete { time_step, substeps } => Box::new(DiscretePlant::with_gears(&self.model, time_step, substeps, &gears)),
             PlantSpec::Continuous { rtol, atol } => {
-                Box::new(ContinuousPlant::new(&self.model, self.config.dt, Tolerances { rtol, atol }))
+                Box::new(ContinuousPlant::with_gears(&self.model, self.config.dt, Tolerances { rtol, atol }, &gears))
             }
         }
+    }
+
+    /// Per coordinate, the gearbox losses of the joint's drive train (`--motors`; None without).
+    pub fn gears(&self) -> Vec<Option<crate::actuator::LossyGear>> {
+        self.motors.as_ref().map_or_else(|| vec![None; self.model.dof()], |m| m.gears())
+    }
+
+    /// Per coordinate: whether the joint has friction — the URDF's, or its gearbox's losses.
+    pub fn joint_has_friction(&self) -> Vec<bool> {
+        let friction = JointFriction::new(&self.model, &self.gears());
+        (0..self.model.dof()).map(|i| friction.has(i)).collect()
     }
 
     /// Whether stepper joints run open loop.

@@ -42,11 +42,12 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
     let (mut load_angle, mut lost_steps, mut lost_events) = (vec![0.0; n], vec![0i64; n], Vec::new());
     let (mut chatter, mut previous_u, mut previous_saturated) = (vec![false; n], vec![0.0; n], vec![false; n]);
     let mut at_limit = vec![false; n];
-    // friction torque and stuck flags: recorded only when some joint has friction
-    let has_friction = model.joints.iter().any(|j| j.friction > 0.0);
+    // friction torque and stuck flags: recorded only when some joint has friction (its URDF's or
+    // its gearbox's)
+    let has_friction = experiment.joint_has_friction().contains(&true);
     let (mut friction, mut stuck) = if has_friction { (vec![0.0; n], vec![false; n]) } else { (Vec::new(), Vec::new()) };
     let joint_names: Vec<String> = model.joints.iter().map(|j| j.name.clone()).collect();
-    let mut stats = SummaryBuilder::new(joint_names, controller.effort.clone(), dt, experiment.config.settle_time).with_stepped_joints(experiment.stepped_joints()).with_friction(has_friction);
+    let mut stats = SummaryBuilder::new(joint_names, controller.limits_at_rest(), dt, experiment.config.settle_time).with_stepped_joints(experiment.stepped_joints()).with_friction(has_friction);
     let started = Instant::now();
     let mut status = RunStatus::Completed;
     let mut audit = EnergyAudit::new(experiment);

@@ -71,6 +71,9 @@ pub struct Summary {
     /// without friction).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub stuck_percent: Vec<f64>,
+    /// Per joint, the largest torque the controller can command at rest: the effort limit, or with
+    /// `--motors` the motor's torque at the joint before the gearbox's losses (N·T; the joint gets
+    /// η of it driving).
     pub effort_limit: Vec<f64>,
     /// The lowest torque limit over the run's control steps: with `--motors`, what the motor gave at
     /// the joint's fastest; the effort limit otherwise.

@@ -4,7 +4,7 @@
 
 mod common;
 
-use armscope::actuator::{Catalogue, DcServo, DriveTrain, Motor, PullOut, Stepper, load_motor_file};
+use armscope::actuator::{Catalogue, DcServo, DriveTrain, LossyGear, Motor, PullOut, Stepper, load_motor_file};
 use armscope::config::RunConfig;
 use armscope::dynamics::{Data, crba};
 use armscope::experiment::Experiment;
@@ -26,9 +26,9 @@ fn every_catalogue_entry_loads_with_its_numbers() {
         assert!(drive.motor.torque_at(0.0) > 0.0, "{name}");
     }
     let nema17 = catalogue.drive_train("17HS4401").unwrap().unwrap();
-    assert_eq!((nema17.motor.torque_at(0.0), nema17.motor.rotor_inertia(), nema17.gear_ratio, nema17.efficiency, nema17.rated_torque), (0.40, 5.4e-6, 1.0, 1.0, f64::INFINITY));
+    assert_eq!((nema17.motor.torque_at(0.0), nema17.motor.rotor_inertia(), nema17.gear_ratio, nema17.efficiency(), nema17.rated_torque), (0.40, 5.4e-6, 1.0, 1.0, f64::INFINITY));
     let geared = catalogue.drive_train("17HS15-1584S-MG5").unwrap().unwrap();
-    assert_eq!((geared.gear_ratio, geared.efficiency, geared.rated_torque), (5.0, 0.9, 9.0), "the gearmotor's own 5:1 planetary");
+    assert_eq!((geared.gear_ratio, geared.efficiency(), geared.rated_torque), (5.0, 0.9, 9.0), "the gearmotor's own 5:1 planetary");
 }
 
 /// The stepper's derived pull-out curve: holding torque up to the corner speed V/(2·L·I·200) rev/s
@@ -36,7 +36,7 @@ fn every_catalogue_entry_loads_with_its_numbers() {
 /// line falls from stall to zero at its no-load speed.
 #[test]
 fn torque_speed_curves_follow_their_stated_formulas() {
-    let stepper = Stepper { name: "s".into(), holding_torque: 0.4, rotor_inertia: 5.4e-6, step_angle_deg: 1.8, pull_out: PullOut::Derived { inductance: 2.8e-3, current: 1.7, supply_voltage: 24.0 }, damping: 0.0 };
+    let stepper = Stepper { name: "s".into(), holding_torque: 0.4, rotor_inertia: 5.4e-6, step_angle_deg: 1.8, pull_out: PullOut::Derived { inductance: 2.8e-3, current: 1.7, supply_voltage: 24.0 }, damping: 0.0, detent_torque: 0.0 };
     let corner = 24.0 / (2.0 * 2.8e-3 * 1.7 * 200.0);
     assert!((stepper.corner_speed_rev_s().unwrap() - corner).abs() < 1e-12 && (corner - 12.605).abs() < 1e-3);
     let omega = |rev_s: f64| rev_s * 2.0 * std::f64::consts::PI;
@@ -53,7 +53,7 @@ fn torque_speed_curves_follow_their_stated_formulas() {
 #[test]
 fn a_drive_train_multiplies_torque_divides_speed_and_is_capped_by_its_rating() {
     let servo = DcServo { name: "v".into(), stall_torque: 1.0, no_load_speed: 100.0, rotor_inertia: 2e-6 };
-    let drive = DriveTrain { motor: Box::new(servo), gear_ratio: 10.0, efficiency: 0.8, rated_torque: 7.0 };
+    let drive = DriveTrain::new(Box::new(servo), 10.0, 0.8, 7.0);
     assert_eq!(drive.torque_limit(0.0), 7.0, "0.8·10·1 = 8 N·m, rated 7");
     assert!((drive.torque_limit(5.0) - 4.0).abs() < 1e-12, "motor at 50 rad/s gives 0.5 N·m: 0.8·10·0.5");
     assert_eq!(drive.torque_limit(10.0), 0.0, "the motor's no-load speed reached at the joint's 10 rad/s");
@@ -71,6 +71,9 @@ fn bad_motor_files_get_one_line_naming_the_file_the_joint_and_the_field() {
         ("[joints.J1]\nmotor = \"17HS4401\"\ngear_ratio = -3\n", vec!["joint 'J1'", "field 'gear_ratio'", "positive"]),
         ("[joints.J1]\nmotor = \"17HS4401\"\nefficiency = 1.5\n", vec!["joint 'J1'", "field 'efficiency'", "(0, 1]"]),
         ("[joints.J1]\nmotor = \"17HS4401\"\ngear_ration = 3\n", vec!["joint 'J1'", "unknown field 'gear_ration'"]),
+        ("[joints.J1]\nmotor = \"17HS4401\"\nbackdrive_efficiency = 1.2\n", vec!["joint 'J1'", "field 'backdrive_efficiency'", "at most 1", "self-locking"]),
+        ("[joints.J1]\nmotor = \"17HS4401\"\nbreakaway_torque = -0.1\n", vec!["joint 'J1'", "field 'breakaway_torque'", "negative"]),
+        ("[motors.M]\nkind = \"servo\"\nstall_torque = 1\nno_load_speed = 9\ngearbox_viscous = \"a lot\"\n[joints.J1]\nmotor = \"M\"\n", vec!["motor 'M'", "field 'gearbox_viscous'", "number"]),
         ("[joints.J1]\ngear_ratio = 3\n", vec!["joint 'J1'", "field 'motor'", "missing"]),
         ("[motors.M]\nkind = \"stepper\"\nholding_torque = 0.4\nstep_angle = 1.8\n[joints.J1]\nmotor = \"M\"\n", vec!["motor 'M'", "field 'inductance'", "missing"]),
         ("[motors.M]\nkind = \"brushless\"\n[joints.J1]\nmotor = \"M\"\n", vec!["motor 'M'", "field 'kind'", "'brushless'"]),
@@ -111,9 +114,11 @@ impl Recorder for Capture {
 
 /// Servo mode (`--drive pd`: the PD loop on the steppers' pull-out curve) on the tutorial's motor
 /// file with a fast wave: at every step the limit is what the
-/// drive train gives at the joint's speed, the applied torque never exceeds it, and a step is
+/// motor gives at the joint's speed in the direction of the torque (N·T before the gearbox's losses,
+/// which the plant applies as friction), the applied torque never exceeds it, and a step is
 /// flagged saturated exactly when the torque sits at the limit; the limit does fall (J2, J3 at least
-/// 5 % below their 0.9 × 15 × 0.59 = 7.965 N·m at rest), and the summary reports the lowest.
+/// 5 % below their 15 × 0.59 = 8.85 N·m at rest), and the summary reports the lowest. The summary's
+/// limit at rest is the motor's too: N·T, or the rating over η (J6: 1.5/0.9).
 #[test]
 fn servo_mode_clips_to_the_speed_dependent_limit_at_every_step() {
     let config = RunConfig { urdf: common::box_urdf(), motors: Some(motors_file("tutorial.toml")), drive: armscope::config::DriveMode::Pd, duration: 6.0, freq: 3.0, ..RunConfig::default() };
@@ -124,7 +129,8 @@ fn servo_mode_clips_to_the_speed_dependent_limit_at_every_step() {
     let mut lowest = [f64::INFINITY; 6];
     for (u, limit, v, saturated) in &capture.rows {
         for j in 0..6 {
-            let want = motors.joints[j].as_ref().unwrap().torque_limit(v[j]);
+            let (low, high) = motors.joints[j].as_ref().unwrap().torque_range(v[j]);
+            let want = if u[j] >= 0.0 { high } else { -low };
             assert_eq!(limit[j], want, "J{} limit at q̇ = {}", j + 1, v[j]);
             assert!(u[j].abs() <= limit[j], "J{}: |u| {} > limit {}", j + 1, u[j], limit[j]);
             if saturated[j] {
@@ -133,9 +139,9 @@ fn servo_mode_clips_to_the_speed_dependent_limit_at_every_step() {
             lowest[j] = lowest[j].min(limit[j]);
         }
     }
-    assert!(lowest[1] < 0.95 * 7.965 && lowest[2] < 0.95 * 7.965, "the limit falls with speed: {lowest:?}");
+    assert!(lowest[1] < 0.95 * 8.85 && lowest[2] < 0.95 * 8.85, "the limit falls with speed: {lowest:?}");
     assert_eq!(summary.lowest_torque_limit, lowest.to_vec());
-    for (got, want) in summary.effort_limit.iter().zip([7.965, 7.965, 7.965, 1.8, 1.8, 1.5]) {
+    for (got, want) in summary.effort_limit.iter().zip([8.85, 8.85, 8.85, 2.0, 2.0, 1.5 / 0.9]) {
         assert!((got - want).abs() < 1e-12, "limit at rest {got} vs {want}");
     }
 }
@@ -171,8 +177,9 @@ fn recordings_and_console_show_the_speed_dependent_limit() {
     assert!(stdout.contains("motors (") && stdout.contains("17HS19-2004S1") && stdout.contains("17HS4401") && stdout.contains("lowest limit (N·m)"), "{stdout}");
     let limits = common::rrd::Rrd::open(&rrd).series("/joints/J2/torque_limit");
     assert_eq!(limits.len(), 1001, "one row per step");
-    assert!(limits.iter().all(|(_, v)| v.len() == 2 && v[0] == -v[1] && v[0] > 0.0 && v[0] <= 7.965 + 1e-12));
-    assert!(limits.iter().any(|(_, v)| v[0] < 0.98 * 7.965), "the limit falls somewhere in the run");
+    // (the motor's torque at the joint before the gearbox's losses: at most 15 × 0.59 = 8.85 N·m)
+    assert!(limits.iter().all(|(_, v)| v.len() == 2 && v[0] == -v[1] && v[0] > 0.0 && v[0] <= 8.85 + 1e-12));
+    assert!(limits.iter().any(|(_, v)| v[0] < 0.98 * 8.85), "the limit falls somewhere in the run");
     // the motor's shaft speed, N·q̇ in rev/s, at every step
     let speed = common::rrd::Rrd::open(&rrd).series("/joints/J2/motor_speed");
     assert_eq!(speed.len(), 1001);
@@ -233,10 +240,11 @@ fn a_servo_brakes_with_its_stall_torque_and_a_stepper_is_symmetric() {
     assert_eq!((lowest, highest), (0.0, 2.94), "past the no-load speed backwards: nothing with the motion, all of it against");
     assert_eq!(servo.available(1.0, 10.0), 0.0, "with the motion past the no-load speed: nothing");
     assert_eq!(servo.available(-1.0, 10.0), 2.94, "against it: the stall torque");
-    let stepper = catalogue.drive_train("17HS4401").unwrap().unwrap().followed_by(10.0, 0.9, f64::INFINITY);
+    let stepper = catalogue.drive_train("17HS4401").unwrap().unwrap().followed_by(10.0, LossyGear::with_efficiency(0.9), f64::INFINITY);
     for speed in [0.0, 3.0, -3.0, 40.0] {
+        // the range is the motor's, before the gearbox's losses (the plant takes those as friction)
         let (lowest, highest) = stepper.torque_range(speed);
         assert_eq!(-lowest, highest);
-        assert_eq!(highest, stepper.torque_limit(speed));
+        assert!((0.9 * highest - stepper.torque_limit(speed)).abs() < 1e-12);
     }
 }

@@ -22,6 +22,9 @@ fn config(motors: &str, extra: impl FnOnce(&mut RunConfig)) -> RunConfig {
 #[derive(Default)]
 struct Positions {
     rows: Vec<(f64, Vec<f64>, Vec<i64>)>,
+    /// The last sample's torques and stuck flags.
+    last_u: Vec<f64>,
+    last_stuck: Vec<bool>,
 }
 
 impl Recorder for Positions {
@@ -30,6 +33,8 @@ impl Recorder for Positions {
     }
     fn record(&mut self, s: &Sample) -> Result<(), armscope::error::Error> {
         self.rows.push((s.t, s.q.to_vec(), s.lost_steps.to_vec()));
+        self.last_u = s.u.to_vec();
+        self.last_stuck = s.stuck.to_vec();
         Ok(())
     }
     fn finish(&mut self, _: &RunInfo, _: &Summary) -> Result<(), armscope::error::Error> {
@@ -37,10 +42,13 @@ impl Recorder for Positions {
     }
 }
 
-/// Holding the arm out horizontally (every joint commanded to 0): each stepper sags by the load angle
-/// that carries its share of the weight, η·N·T_H·sin(N_r·N·Δq) = τ_g, and loses no step while the
-/// weight is within its holding torque (J2 needs 4.43 of its 8.0 N·m). The rotor rings about that
-/// angle (almost no damping): its mean over the last 2 s of 6 s is compared, within 3 %.
+/// Holding the arm out horizontally (every joint commanded to 0): each stepper sags by a load angle
+/// that carries its share of the weight and loses no step while the weight is within its holding
+/// torque (J2 needs 4.43 of its 8.0 N·m). The rotor rings about that angle until the gearbox's
+/// friction holds it: at rest each loaded joint is stuck with the motor's torque u (field and detent)
+/// within the gear's holding band, η_b·G ≤ u ≤ G/η (G the weight's torque, η = η_b = 0.9: the
+/// friction takes up to 10 % of u against a load it back-drives and helps hold one that pushes) —
+/// to the solve's rounding, 1e-9 relative.
 #[test]
 fn a_stepper_holding_the_arm_sags_by_the_load_angle_that_carries_the_weight_and_loses_nothing() {
     let experiment = Experiment::prepare(config("tutorial.toml", |c| {
@@ -52,18 +60,16 @@ fn a_stepper_holding_the_arm_sags_by_the_load_angle_that_carries_the_weight_and_
     let mut rec = Positions::default();
     let summary = simulate(&experiment, &mut [&mut rec], None).unwrap();
     assert_eq!(summary.lost_steps, [0, 0, 0, 0, 0, 0]);
-    let tail: Vec<&Vec<f64>> = rec.rows.iter().filter(|r| r.0 >= 4.0).map(|r| &r.1).collect();
-    let mean: Vec<f64> = (0..6).map(|j| tail.iter().map(|q| q[j]).sum::<f64>() / tail.len() as f64).collect();
-    let tau_g = gravity_forces(&experiment.model, &mut Data::new(&experiment.model), &mean).to_vec();
-    let ratios = [15.0, 15.0, 15.0, 5.0, 5.0, 5.0];
-    let holding = [0.59, 0.59, 0.59, 0.40, 0.40, 0.40];
+    let last = &rec.rows.last().unwrap().1;
+    let tau_g = gravity_forces(&experiment.model, &mut Data::new(&experiment.model), last).to_vec();
     for j in 1..5 {
-        // equilibrium: the stepper's torque η·N·T_H·sin(50·N·(0 − q)) balances τ_g
-        let available = 0.9 * ratios[j] * holding[j];
-        let want = (tau_g[j] / available).asin() / (50.0 * ratios[j]);
-        assert!((mean[j] - want).abs() <= 0.03 * want.abs(), "J{}: mean sag {:.4e} rad, load angle predicts {want:.4e}", j + 1, mean[j]);
+        let weight = -tau_g[j];
+        assert!(rec.last_stuck[j], "J{} rests, held by its gear's friction", j + 1);
+        let share = rec.last_u[j] / weight;
+        assert!((0.9 * (1.0 - 1e-9)..=(1.0 + 1e-9) / 0.9).contains(&share), "J{}: u = {} against the weight's {weight}: {share} of it", j + 1, rec.last_u[j]);
+        assert!(last[j] * weight < 0.0, "J{} sags with the weight", j + 1);
     }
-    assert!(mean[1] > 5e-4, "J2 sags visibly (asin(4.43/8.0)/750 = 0.78 mrad): {}", mean[1]);
+    assert!(last[1].abs() > 5e-4, "J2 sags visibly (asin(0.9·4.43/8.85)/750 = 0.62 mrad at least): {}", last[1]);
 }
 
 /// The same pose with the real SmallRobotArm's reductions: J2's stepper (4:1, 1.52 N·m) cannot
@@ -120,7 +126,7 @@ fn energy_balances(summary: &Summary) {
 /// early, as its step generator starts the wave from rest: the rotor rings about its mean load angle
 /// whenever the motion's acceleration changes, which is why steppers are sized with ~30 % headroom
 /// (J2 slips there from 3 rad/s, 57 % of its curve) — and the joints that need less than half their
-/// torque lose none of their own accord (once J2 slips and the arm swings off its command, others can
+/// torque lose none of their own accord after the start's catch-up (once J2 slips and the arm swings off its command, others can
 /// be dragged out of step too).
 #[test]
 fn a_slow_wave_within_the_pull_out_curve_loses_nothing_a_fast_one_loses_steps_where_demand_exceeds_it() {
@@ -145,7 +151,13 @@ fn a_slow_wave_within_the_pull_out_curve_loses_nothing_a_fast_one_loses_steps_wh
         }
         if ratio[j] < 0.5 {
             // a joint within its curve loses nothing of its own accord: only once J2 slips and the
-            // arm swings off its command can it be dragged out of step
+            // arm swings off its command can it be dragged out of step — or in the start's catch-up
+            // (the wave starts at 2.9 rad/s, the arm at rest: not in the ratio), where J4, at 0.46 of
+            // its curve, slips once (4 full steps) at 27 ms with its gearbox's friction and not
+            // without it
+            if summary.first_lost_step_time[j].is_some_and(|t| t < 0.1) && summary.lost_steps[j] <= 4 {
+                continue;
+            }
             if let Some(t) = summary.first_lost_step_time[j] {
                 let j2 = summary.first_lost_step_time[1].expect("J2 slips");
                 assert!(t > j2 + 1.0, "J{} needs only {:.2}× its curve yet lost steps at {t} s, J2 first at {j2} s", j + 1, ratio[j]);

@@ -12,7 +12,9 @@
 //! current = 1.7
 //! supply_voltage = 24
 //! # pull_out = [[0, 0.40], [5, 0.30], [10, 0.15]]   # or measured points, rev/s and N·m
-//! # gearbox_ratio / gearbox_efficiency / gearbox_rated_torque: a gearmotor's own gearbox
+//! # gearbox_ratio / gearbox_efficiency / gearbox_rated_torque: a gearmotor's own gearbox, and its
+//! # losses where published: gearbox_backdrive_efficiency (η_b, ≤ 1; ≤ 0 self-locking; η when not
+//! # given), gearbox_breakaway_torque (N·m at its output), gearbox_viscous (N·m·s/rad at its output)
 //! ```
 //!
 //! A motor file (`--motors FILE.toml`) gives joints a motor and a drive train:
@@ -22,11 +24,17 @@
 //! [joints.J1]
 //! motor = "17HS4401"
 //! gear_ratio = 15                # the reduction after the motor (and after its own gearbox)
-//! efficiency = 0.9               # of that reduction
+//! efficiency = 0.9               # of that reduction, driving (the joint gets η·N·T)
+//! backdrive_efficiency = 0.85    # optional, when the load drives the motor (η when not given; ≤ 0: self-locking)
+//! breakaway_torque = 0.1         # optional, N·m at the joint: the reduction's friction at no load
+//! viscous = 0.01                 # optional, N·m·s/rad at the joint
 //! rated_torque = 9               # N·m at the joint
 //! ```
+//!
+//! The reduction's losses act as friction at the joint by the direction power flows
+//! ([`super::LossyGear`]).
 
-use super::{DcServo, DriveTrain, Motor, MotorSet, PullOut, Stepper};
+use super::{DcServo, DriveTrain, LossyGear, Motor, MotorSet, PullOut, Stepper};
 use crate::error::Error;
 use crate::model::Model;
 use std::collections::BTreeMap;
@@ -85,9 +93,9 @@ fn drive_train_from(source: &Path, name: &str, t: &toml::Table) -> Result<DriveT
     let what = format!("motor '{name}'");
     let fields = Fields { file: source, what: &what, table: t };
     let kind = fields.string("kind")?;
-    let (gear_ratio, efficiency, rated) =
-        (fields.optional_positive("gearbox_ratio")?.unwrap_or(1.0), fields.optional_fraction("gearbox_efficiency")?.unwrap_or(1.0), fields.optional_positive("gearbox_rated_torque")?.unwrap_or(f64::INFINITY));
-    let common = ["kind", "gearbox_ratio", "gearbox_efficiency", "gearbox_rated_torque", "rotor_inertia", "source"];
+    let (gear_ratio, rated) = (fields.optional_positive("gearbox_ratio")?.unwrap_or(1.0), fields.optional_positive("gearbox_rated_torque")?.unwrap_or(f64::INFINITY));
+    let gear = fields.gear("gearbox_")?;
+    let common = ["kind", "gearbox_ratio", "gearbox_efficiency", "gearbox_backdrive_efficiency", "gearbox_breakaway_torque", "gearbox_viscous", "gearbox_rated_torque", "rotor_inertia", "source"];
     let motor: Box<dyn Motor> = match kind.as_str() {
         "stepper" => {
             fields.known(&[&common[..], &["holding_torque", "step_angle", "inductance", "current", "supply_voltage", "pull_out", "resistance", "mass", "detent_torque"]].concat())?;
@@ -106,6 +114,7 @@ fn drive_train_from(source: &Path, name: &str, t: &toml::Table) -> Result<DriveT
                 damping,
                 rotor_inertia: fields.non_negative("rotor_inertia")?,
                 step_angle_deg: fields.positive("step_angle")?,
+                detent_torque: fields.non_negative("detent_torque")?,
                 pull_out,
             })
         }
@@ -115,7 +124,7 @@ fn drive_train_from(source: &Path, name: &str, t: &toml::Table) -> Result<DriveT
         }
         other => return Err(fail(source, format!("{what}: field 'kind' is '{other}', expected 'stepper' or 'servo'"))),
     };
-    Ok(DriveTrain { motor, gear_ratio, efficiency, rated_torque: rated })
+    Ok(DriveTrain { motor, gear_ratio, gear, rated_torque: rated })
 }
 
 /// A TOML table's fields, each checked with an error naming the file, the entry and the field.
@@ -155,6 +164,19 @@ impl Fields<'_> {
             Some(x) if !(x > 0.0 && x <= 1.0) => Err(self.err(field, &format!("must be in (0, 1] (got {x})"))),
             other => Ok(other),
         }
+    }
+
+    /// A gear's losses from the fields `{prefix}efficiency`, `{prefix}backdrive_efficiency`,
+    /// `{prefix}breakaway_torque` and `{prefix}viscous` (a lossless gear where none is given).
+    fn gear(&self, prefix: &str) -> Result<LossyGear, Error> {
+        let efficiency = self.optional_fraction(&format!("{prefix}efficiency"))?.unwrap_or(1.0);
+        let field = format!("{prefix}backdrive_efficiency");
+        let backdrive_efficiency = match self.number(&field)? {
+            Some(x) if x > 1.0 => return Err(self.err(&field, &format!("must be at most 1 (got {x}; 0 or less: a self-locking drive)"))),
+            Some(x) => x,
+            None => efficiency,
+        };
+        Ok(LossyGear { efficiency, backdrive_efficiency, breakaway_torque: self.non_negative(&format!("{prefix}breakaway_torque"))?, viscous: self.non_negative(&format!("{prefix}viscous"))? })
     }
 
     fn non_negative(&self, field: &str) -> Result<f64, Error> {
@@ -227,12 +249,12 @@ pub fn load_motor_file(path: &Path, model: &Model) -> Result<MotorSet, Error> {
         };
         let Value::Table(t) = value else { return Err(fail(path, format!("{what}: expected a table"))) };
         let fields = Fields { file: path, what: &what, table: t };
-        fields.known(&["motor", "gear_ratio", "efficiency", "rated_torque", "microsteps", "acceleration"])?;
+        fields.known(&["motor", "gear_ratio", "efficiency", "backdrive_efficiency", "breakaway_torque", "viscous", "rated_torque", "microsteps", "acceleration"])?;
         set.acceleration[index] = fields.optional_positive("acceleration")?;
         let motor_name = fields.string("motor")?;
         let own = catalogue.drive_train(&motor_name).ok_or_else(|| fail(path, format!("{what}: no motor '{motor_name}' (known: {})", catalogue.names())))??;
         let ratio = fields.optional_positive("gear_ratio")?.unwrap_or(1.0);
-        let efficiency = fields.optional_fraction("efficiency")?.unwrap_or(1.0);
+        let gear = fields.gear("")?;
         let rated = fields.optional_positive("rated_torque")?.unwrap_or(f64::INFINITY);
         if let Some(m) = fields.optional_positive("microsteps")? {
             if m.fract() != 0.0 || m > 1024.0 {
@@ -240,7 +262,7 @@ pub fn load_motor_file(path: &Path, model: &Model) -> Result<MotorSet, Error> {
             }
             set.microsteps[index] = Some(m as u32);
         }
-        set.joints[index] = Some(own.followed_by(ratio, efficiency, rated));
+        set.joints[index] = Some(own.followed_by(ratio, gear, rated));
     }
     Ok(set)
 }

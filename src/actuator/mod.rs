@@ -5,11 +5,13 @@
 //! a model's joints, from a motor file (`--motors FILE.toml`, see [`catalogue`]).
 
 pub mod catalogue;
+mod lossy_gear;
 mod open_loop;
 mod servo;
 mod stepper;
 
 pub use catalogue::{Catalogue, load_motor_file};
+pub use lossy_gear::LossyGear;
 pub use open_loop::{LostSteps, OpenLoopSteppers};
 pub use servo::DcServo;
 pub use stepper::{PullOut, Stepper};
@@ -38,55 +40,99 @@ pub trait Motor: Debug + Send + Sync {
     }
 }
 
-/// A motor behind a gearbox: the joint turns `gear_ratio` times slower than the motor.
+/// A motor behind a gearbox: the joint turns `gear_ratio` times slower than the motor, and the
+/// gearbox's losses act as friction at the joint by the direction power flows ([`LossyGear`]).
 #[derive(Debug)]
 pub struct DriveTrain {
     pub motor: Box<dyn Motor>,
     pub gear_ratio: f64,
-    /// Gearbox efficiency η (0, 1]: the joint gets η·N·T_motor.
-    pub efficiency: f64,
+    /// The gearbox's losses: efficiency η driving (the joint gets η·N·T_motor), η_b back-driven,
+    /// breakaway and viscous friction at the output.
+    pub gear: LossyGear,
     /// The gearbox's rated output torque, N·m (infinite when not limited).
     pub rated_torque: f64,
 }
 
 impl DriveTrain {
+    /// A drive train whose gearbox loses the same fraction both ways (η_b = η) and has no friction
+    /// at no load.
+    pub fn new(motor: Box<dyn Motor>, gear_ratio: f64, efficiency: f64, rated_torque: f64) -> Self {
+        Self { motor, gear_ratio, gear: LossyGear::with_efficiency(efficiency), rated_torque }
+    }
+
+    /// The gearbox's efficiency when the motor drives, η.
+    pub fn efficiency(&self) -> f64 {
+        self.gear.efficiency
+    }
+
     /// Torque available at the joint at joint speed `speed`, driving with the motion (the smaller of
     /// the two directions): min(η·N·T_motor(N·speed), rated).
     pub fn torque_limit(&self, speed: f64) -> f64 {
-        (self.efficiency * self.gear_ratio * self.motor.torque_at(self.gear_ratio * speed)).min(self.rated_torque)
+        (self.gear.efficiency * self.gear_ratio * self.motor.torque_at(self.gear_ratio * speed)).min(self.rated_torque)
     }
 
-    /// What the motor gives at the joint in the direction of `torque` at joint speed `speed`, before
-    /// the gearbox's rating caps it: η·N·T with the motion (its torque–speed curve), η·N·T_braking
-    /// against it. At rest a positive torque counts as with the motion.
+    /// Whether a torque of this sign at joint speed `speed` brakes the motion (at rest a positive
+    /// torque counts as with the motion).
+    fn braking(torque: f64, speed: f64) -> bool {
+        if speed >= 0.0 { torque < 0.0 } else { torque >= 0.0 }
+    }
+
+    /// What the motor gives at the joint before the gearbox's losses, N·T, in the direction of
+    /// `torque` at joint speed `speed`: its torque–speed curve with the motion, its braking torque
+    /// against it.
     pub fn motor_torque(&self, torque: f64, speed: f64) -> f64 {
         let shaft = self.gear_ratio * speed;
-        let braking = if speed >= 0.0 { torque < 0.0 } else { torque >= 0.0 };
-        self.efficiency * self.gear_ratio * if braking { self.motor.braking_torque_at(shaft) } else { self.motor.torque_at(shaft) }
+        self.gear_ratio * if Self::braking(torque, speed) { self.motor.braking_torque_at(shaft) } else { self.motor.torque_at(shaft) }
     }
 
-    /// The torque available in the direction of `torque` at joint speed `speed` (≥ 0): what the
-    /// motor gives there, capped by the gearbox's rating.
+    /// The torque the joint gets in the direction of `torque` at joint speed `speed` (≥ 0), the
+    /// motor at its most: driving, η·N·T less the gear's breakaway and viscous friction, capped by
+    /// the gearbox's rating; braking (back-driven), N·T_b/η_b plus the friction, which helps (a
+    /// self-locking gear holds whatever the rating allows).
     pub fn available(&self, torque: f64, speed: f64) -> f64 {
-        self.motor_torque(torque, speed).min(self.rated_torque)
+        let motor = self.motor_torque(torque, speed);
+        let friction = self.gear.breakaway_torque + self.gear.viscous * speed.abs();
+        let at_joint = if Self::braking(torque, speed) {
+            if self.gear.self_locking() { f64::INFINITY } else { motor / self.gear.backdrive_efficiency + friction }
+        } else {
+            (self.gear.efficiency * motor - friction).max(0.0)
+        };
+        at_joint.min(self.rated_torque)
     }
 
-    /// The range of torque the joint can get at joint speed `speed`: (lowest ≤ 0, highest ≥ 0). With
-    /// the motion the motor's torque–speed curve holds; against it (braking) the motor's braking torque.
+    /// The range of the motor's torque at the joint before the gearbox's losses, N·T, at joint
+    /// speed `speed` — what a controller can command: (lowest ≤ 0, highest ≥ 0). The gearbox's
+    /// rating caps what reaches the joint: rated/η driving, rated·η_b braking.
     pub fn torque_range(&self, speed: f64) -> (f64, f64) {
-        (-self.available(-1.0, speed), self.available(1.0, speed))
+        let cap = |torque: f64| {
+            let rated = if !Self::braking(torque, speed) {
+                self.rated_torque / self.gear.efficiency
+            } else if self.gear.self_locking() {
+                self.rated_torque
+            } else {
+                self.rated_torque * self.gear.backdrive_efficiency
+            };
+            self.motor_torque(torque, speed).min(rated)
+        };
+        (-cap(-1.0), cap(1.0))
     }
 
     /// This drive train followed by a further reduction (a belt or gearbox after a gearmotor): the
-    /// ratios and efficiencies multiply; the first gearbox's rating, at its output, is carried through
-    /// the second, whose own rating caps it.
-    pub fn followed_by(self, gear_ratio: f64, efficiency: f64, rated_torque: f64) -> Self {
+    /// ratios multiply and the losses compose ([`LossyGear::followed_by`]); the first gearbox's
+    /// rating, at its output, is carried through the second, whose own rating caps it.
+    pub fn followed_by(self, gear_ratio: f64, next: LossyGear, rated_torque: f64) -> Self {
         Self {
-            rated_torque: (self.rated_torque * gear_ratio * efficiency).min(rated_torque),
+            rated_torque: (self.rated_torque * gear_ratio * next.efficiency).min(rated_torque),
+            gear: self.gear.followed_by(gear_ratio, &next),
             gear_ratio: self.gear_ratio * gear_ratio,
-            efficiency: self.efficiency * efficiency,
             motor: self.motor,
         }
+    }
+
+    /// A stepper's detent torque at the joint, N·T_d(N·offset), with the joint `offset` (rad) from
+    /// where the rotor sat in a detent position; 0 for other motors.
+    pub fn detent_torque(&self, offset: f64) -> f64 {
+        self.motor.as_stepper().map_or(0.0, |s| self.gear_ratio * s.detent_torque_at(self.gear_ratio * offset))
     }
 
     /// The rotor's inertia seen at the joint, J_r·N².
@@ -130,13 +176,17 @@ impl MotorSet {
     /// the rotor's inertia at the joint and the joint speed at which the torque runs out.
     pub fn table(&self, joint_names: &[String]) -> String {
         let w = joint_names.iter().map(|n| n.chars().count()).max().unwrap_or(5).max(5) + 2;
-        let mut out = format!("    {:<w$}{:<20}{:>7}{:>6}{:>10}{:>15}{:>16}{:>26}\n", "joint", "motor", "ratio", "η", "rated", "at rest (N·m)", "J_r·N² (kg·m²)", "half of it above (rad/s)");
+        let mut out = format!("    {:<w$}{:<20}{:>7}{:>6}{:>7}{:>10}{:>15}{:>16}{:>26}\n", "joint", "motor", "ratio", "η", "η_b", "rated", "at rest (N·m)", "J_r·N² (kg·m²)", "half of it above (rad/s)");
         for (name, drive) in joint_names.iter().zip(&self.joints) {
             let Some(d) = drive else { continue };
             let rated = if d.rated_torque.is_finite() { format!("{:.2}", d.rated_torque) } else { "–".into() };
             let top = d.speed_at_fraction(0.5);
             let top = if top.is_finite() { format!("{top:.2}") } else { "–".into() };
-            out += &format!("    {:<w$}{:<20}{:>7}{:>6}{:>10}{:>15.3}{:>16.3e}{:>26}\n", name, d.motor.name(), d.gear_ratio, d.efficiency, rated, d.torque_limit(0.0), d.reflected_inertia(), top);
+            let backdrive = if d.gear.self_locking() { "locks".to_string() } else { format!("{}", d.gear.backdrive_efficiency) };
+            out += &format!("    {:<w$}{:<20}{:>7}{:>6}{:>7}{:>10}{:>15.3}{:>16.3e}{:>26}\n", name, d.motor.name(), d.gear_ratio, d.gear.efficiency, backdrive, rated, d.torque_limit(0.0), d.reflected_inertia(), top);
+            if d.gear.breakaway_torque > 0.0 || d.gear.viscous > 0.0 {
+                out += &format!("    {:<w$}  gear friction at the joint: breakaway {} N·m, viscous {} N·m·s/rad\n", "", d.gear.breakaway_torque, d.gear.viscous);
+            }
         }
         out
     }
@@ -145,6 +195,11 @@ impl MotorSet {
     /// for a joint the motor file leaves out.
     pub fn motor_speed(&self, joint: usize, joint_speed: f64) -> Option<f64> {
         self.joints[joint].as_ref().map(|d| d.gear_ratio * joint_speed / std::f64::consts::TAU)
+    }
+
+    /// Per coordinate, the gearbox losses of the joint's drive train (None without one).
+    pub fn gears(&self) -> Vec<Option<LossyGear>> {
+        self.joints.iter().map(|d| d.as_ref().map(|d| d.gear)).collect()
     }
 
     /// Whether any joint has a stepper.

@@ -54,15 +54,16 @@ impl SteppedJoint {
 
     fn torque(&self, q: f64, v: f64) -> f64 {
         let available = super::Motor::torque_at(&self.stepper, self.gear_ratio * v);
-        let pull = self.efficiency * self.gear_ratio * available * (self.teeth * self.lag(q)).sin();
+        let pull = self.gear_ratio * available * (self.teeth * self.lag(q)).sin();
         // the rotor's oscillation about the field damped (at the joint through the gears, N²): on the
         // slip speed, the field turning at the step generator's speed (the drive holds the current,
         // so there is no drag on the speed itself: that is the pull-out curve's part)
         let damping = self.stepper.damping * self.gear_ratio * self.gear_ratio * (self.generator_velocity - v);
         // the drive limits the phase current: field and damping together give at most what the
-        // motor gives at this speed (through the gearbox, capped by its rating)
-        let most = (self.efficiency * self.gear_ratio * available).min(self.rated_torque);
-        (pull + damping).clamp(-most, most)
+        // motor gives at this speed (capped so that the gearbox's output stays within its rating)
+        let most = (self.gear_ratio * available).min(self.rated_torque / self.efficiency);
+        // the magnets' detent torque does not go through the current limit
+        (pull + damping).clamp(-most, most) + self.gear_ratio * self.stepper.detent_torque_at(self.gear_ratio * (q - self.start))
     }
 }
 
@@ -89,13 +90,13 @@ impl OpenLoopSteppers {
     pub fn new(motors: &MotorSet, start: &[f64], inertia: &[f64], load: &[f64]) -> Option<Self> {
         let mut joints = Vec::new();
         for (j, drive) in motors.joints.iter().enumerate() {
-            let Some(DriveTrain { motor, gear_ratio, efficiency, rated_torque }) = drive else { continue };
+            let Some(DriveTrain { motor, gear_ratio, gear, rated_torque }) = drive else { continue };
             let Some(stepper) = motor.as_stepper() else { continue };
             let micro = motors.microsteps.get(j).copied().flatten().unwrap_or(1) as f64;
             let mut joint = SteppedJoint {
                 joint: j,
                 gear_ratio: *gear_ratio,
-                efficiency: *efficiency,
+                efficiency: gear.efficiency,
                 rated_torque: *rated_torque,
                 teeth: 90.0 / stepper.step_angle_deg,
                 microstep: stepper.step_angle_deg.to_radians() / micro,

@@ -30,11 +30,23 @@ pub struct Stepper {
     /// (0.037 for the 17HS4401). An estimate, upper bound: a chopper drive that holds the current
     /// removes part of it. 0 when the catalogue gives no resistance.
     pub damping: f64,
+    /// The detent (residual, unpowered) torque's amplitude, N·m at the shaft (0 when not given).
+    pub detent_torque: f64,
 }
 
 impl Stepper {
     pub fn steps_per_rev(&self) -> f64 {
         360.0 / self.step_angle_deg
+    }
+
+    /// The detent torque at rotor angle `angle` (rad) from a detent position: the magnets pull the
+    /// rotor to the nearest one, −T_d·sin(2π·angle/step): one period per full step, the first
+    /// harmonic of a hybrid stepper's cogging (its unpowered rest positions are the full steps).
+    pub fn detent_torque_at(&self, angle: f64) -> f64 {
+        if self.detent_torque == 0.0 {
+            return 0.0;
+        }
+        -self.detent_torque * (std::f64::consts::TAU * angle / self.step_angle_deg.to_radians()).sin()
     }
 
     /// The corner speed of a derived pull-out curve, rev/s.
@@ -88,5 +100,24 @@ impl Motor for Stepper {
 
     fn as_stepper(&self) -> Option<&Stepper> {
         Some(self)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The detent torque repeats every full step, is zero on the full steps (the rest positions)
+    /// and pulls towards the nearest one with at most T_d (a quarter step away).
+    #[test]
+    fn detent_has_one_period_per_full_step_and_pulls_to_the_nearest_full_step() {
+        let stepper = Stepper { name: "s".into(), holding_torque: 0.4, rotor_inertia: 5.4e-6, step_angle_deg: 1.8, pull_out: PullOut::Table(vec![(0.0, 0.4)]), damping: 0.0, detent_torque: 0.022 };
+        let step = 1.8f64.to_radians();
+        for k in [-3.0, 0.0, 1.0, 7.0] {
+            assert!(stepper.detent_torque_at(k * step).abs() < 1e-15, "zero on full step {k}");
+            assert!((stepper.detent_torque_at(k * step + 0.25 * step) + 0.022).abs() < 1e-15, "a quarter step past: pulled back with T_d");
+            assert!((stepper.detent_torque_at(k * step - 0.25 * step) - 0.022).abs() < 1e-15);
+        }
+        assert!((stepper.detent_torque_at(0.1 * step) - stepper.detent_torque_at(1.1 * step)).abs() < 1e-15);
     }
 }

@@ -1,9 +1,10 @@
 //! The tutorial's joint controller: PD on the command plus gravity feed-forward, clipped to the
 //! motors' limits.
 
-/// u = kp∘(cmd − q) + kd∘(cmd_dot − q̇) − τ_g(q), clipped to ±effort (with `--motors`, to what the
-/// motor gives at the joint's speed through its gearbox, with the motion or braking); zero on
-/// unactuated joints.
+/// u = kp∘(cmd − q) + kd∘(cmd_dot − q̇) − τ_g(q), clipped to ±effort (with `--motors`, the motor's
+/// torque at the joint, N·τ_m: a stepper's detent torque added, clipped to what the motor gives at
+/// the joint's speed, with the motion or braking; the gearbox's losses are the plant's friction);
+/// zero on unactuated joints.
 #[derive(Clone, Debug)]
 pub struct PdGravityController {
     pub kp: Vec<f64>,
@@ -15,6 +16,10 @@ pub struct PdGravityController {
     pub feed_forward: bool,
     /// Motors whose torque falls with speed (`--motors`); `effort` elsewhere.
     pub motors: Option<std::sync::Arc<crate::actuator::MotorSet>>,
+    /// The start pose, where each stepper's rotor sits in a detent position: its detent torque
+    /// joins the motor's torque (within the motor's limit: the pull-out curve is measured at the
+    /// shaft, detent included).
+    pub detent_origin: Vec<f64>,
 }
 
 /// One controller output.
@@ -35,6 +40,17 @@ impl PdGravityController {
         (keep(&self.kp), keep(&self.kd))
     }
 
+    /// Per joint, the largest torque the controller can command at rest: with `--motors`, the
+    /// motor's N·T at the joint (before the gearbox's losses); the effort limit elsewhere.
+    pub fn limits_at_rest(&self) -> Vec<f64> {
+        (0..self.effort.len())
+            .map(|i| match self.motors.as_ref().and_then(|m| m.joints[i].as_ref()) {
+                Some(drive) => drive.torque_range(0.0).1,
+                None => self.effort[i],
+            })
+            .collect()
+    }
+
     #[allow(clippy::too_many_arguments)]
     pub fn compute(&self, q: &[f64], v: &[f64], cmd: &[f64], cmd_dot: &[f64], tau_g: &[f64], out: ControlOutput) {
         for i in 0..q.len() {
@@ -49,7 +65,10 @@ impl PdGravityController {
                 u -= tau_g[i];
             }
             let (lowest, highest) = match self.motors.as_ref().and_then(|m| m.joints[i].as_ref()) {
-                Some(drive) => drive.torque_range(v[i]),
+                Some(drive) => {
+                    u += drive.detent_torque(q[i] - self.detent_origin[i]);
+                    drive.torque_range(v[i])
+                }
                 None => (-self.effort[i], self.effort[i]),
             };
             out.saturated[i] = u > highest || u < lowest;

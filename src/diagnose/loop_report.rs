@@ -28,6 +28,9 @@ pub struct LoopReport {
     pub stable_kd_radius: f64,
     /// The command that runs the loop with the suggested kd.
     pub run_hint: String,
+    /// The joints with friction (the URDF's, or a gearbox's losses) and what it is: the
+    /// linearization leaves it out.
+    pub friction_left_out: Vec<(String, String)>,
 }
 
 impl LoopReport {
@@ -66,6 +69,7 @@ impl LoopReport {
             stable_kd,
             stable_kd_radius,
             run_hint,
+            friction_left_out: friction_left_out(experiment),
         }
     }
 
@@ -85,6 +89,7 @@ impl LoopReport {
             "stable_kd": if fixes { Some(&self.stable_kd) } else { None },
             "stable_kd_spectral_radius": self.stable_kd_radius,
             "run_with_stable_kd": fixes.then_some(&self.run_hint),
+            "friction_left_out": self.friction_left_out.iter().cloned().collect::<std::collections::BTreeMap<_, _>>(),
         })
     }
 
@@ -120,6 +125,34 @@ impl LoopReport {
         } else {
             out += &format!("  no kd scaling makes this loop stable at dt = {} ms (best spectral radius {:.3}): lower kp or dt\n", h * 1e3, self.stable_kd_radius);
         }
+        if !self.friction_left_out.is_empty() {
+            out += &format!(
+                "  left out: friction on {} — Coulomb friction is not linear: the run can stick where this loop moves, and a small oscillation it predicts can be held still\n",
+                self.friction_left_out.iter().map(|(j, what)| format!("{j} ({what})")).collect::<Vec<_>>().join(", ")
+            );
+        }
         out
     }
+}
+
+/// Per joint with friction: its name and what the friction is (the URDF's F, the gearbox's losses).
+fn friction_left_out(experiment: &Experiment) -> Vec<(String, String)> {
+    let gears = experiment.gears();
+    experiment
+        .model
+        .joints
+        .iter()
+        .zip(&gears)
+        .filter_map(|(joint, gear)| {
+            let mut parts = Vec::new();
+            if joint.friction > 0.0 {
+                parts.push(format!("{} N·m", joint.friction));
+            }
+            if let Some(g) = gear.filter(|g| !g.is_lossless()) {
+                let backdrive = if g.self_locking() { "self-locking".to_string() } else { format!("η_b {}", g.backdrive_efficiency) };
+                parts.push(format!("gear η {}, {backdrive}, breakaway {} N·m", g.efficiency, g.breakaway_torque));
+            }
+            (!parts.is_empty()).then(|| (joint.name.clone(), parts.join("; ")))
+        })
+        .collect()
 }

@@ -1,5 +1,7 @@
 use super::Plant;
+use super::joint_friction::JointFriction;
 use super::stick_slip::{JointLaw, StickSlipSolver};
+use crate::actuator::LossyGear;
 use crate::dynamics::{Data, aba, crba_from_kinematics, forward_kinematics, gravity_and_bias_from_kinematics};
 use crate::model::Model;
 
@@ -41,7 +43,8 @@ const E: [f64; 7] = [
 /// stop: its velocity into the limit is removed).
 ///
 /// With Coulomb friction the motion is piecewise smooth, and integrated piece by piece (Modelica's
-/// stuck/forward/backward modes): each joint with friction slides (τ_f = −F·sign(q̇), constant)
+/// stuck/forward/backward modes): each joint with friction slides (τ_f = −F⁺ or +F⁻, constant over
+/// the period: the URDF's friction and the gear's losses for the held torque, [`JointFriction`])
 /// or is stuck (q̈ = 0 imposed, q̇ = 0, its friction whatever holds it); a step that ends with a
 /// sliding joint's velocity through zero, or a stuck joint needing more than F, is cut back to the
 /// event (bisection to 1e-13 s), the crossing velocity set to exactly 0 and the modes decided
@@ -68,6 +71,11 @@ pub struct ContinuousPlant {
 
 impl ContinuousPlant {
     pub fn new(model: &Model, period: f64, tolerances: Tolerances) -> Self {
+        Self::with_gears(model, period, tolerances, &[])
+    }
+
+    /// The plant with the drive trains' gear losses (by coordinate) as friction at the joints.
+    pub fn with_gears(model: &Model, period: f64, tolerances: Tolerances, gears: &[Option<LossyGear>]) -> Self {
         let n = model.dof();
         let state = || vec![0.0; 2 * n];
         Self {
@@ -82,7 +90,7 @@ impl ContinuousPlant {
             k: std::array::from_fn(|_| state()),
             tau: vec![0.0; n],
             limit_active: vec![false; n],
-            friction: Friction::new(model),
+            friction: Friction::new(model, gears),
             accepted_steps: 0,
             rejected_steps: 0,
         }
@@ -198,6 +206,7 @@ impl Plant for ContinuousPlant {
         self.limit_active.fill(false);
         if self.friction.any {
             self.friction.work = 0.0;
+            self.friction.start_period(u, &mut self.y[n..]);
             self.friction.decide_modes(model, data, u, &self.y[..n], &self.y[n..]);
         }
         let mut remaining = self.period;
@@ -284,13 +293,16 @@ impl Plant for ContinuousPlant {
 /// How closely a mode's end is located in time, s.
 const EVENT_TIME_TOLERANCE: f64 = 1e-13;
 
-/// The continuous plant's friction: per joint F, the mode (−1/+1 sliding that way, 0 stuck, for
-/// joints with friction; sliding ones follow their velocity's sign), and the acceleration-level
-/// solve.
+/// The continuous plant's friction: per joint the Coulomb band (F⁺, F⁻) for the period's motor
+/// torque, the mode (−1/+1 sliding that way, 0 stuck, for joints with friction; sliding ones follow
+/// their velocity's sign), and the acceleration-level solve.
 struct Friction {
+    joints: JointFriction,
     any: bool,
-    bound: Vec<f64>,
-    /// −1, +1: sliding (τ_f = −F·mode); 0: stuck, or no friction.
+    /// (F⁺, F⁻) for this control period's torque (infinite on a self-locking gear's locked side).
+    up: Vec<f64>,
+    down: Vec<f64>,
+    /// −1, +1: sliding (τ_f = −F⁺ or +F⁻); 0: stuck, or no friction.
     mode: Vec<i8>,
     laws: Vec<JointLaw>,
     solver: StickSlipSolver,
@@ -305,12 +317,14 @@ struct Friction {
 }
 
 impl Friction {
-    fn new(model: &Model) -> Self {
+    fn new(model: &Model, gears: &[Option<LossyGear>]) -> Self {
         let n = model.dof();
-        let bound: Vec<f64> = model.joints.iter().map(|j| j.friction).collect();
+        let joints = JointFriction::new(model, gears);
         Self {
-            any: bound.iter().any(|&f| f > 0.0),
-            bound,
+            any: joints.any,
+            joints,
+            up: vec![0.0; n],
+            down: vec![0.0; n],
             mode: vec![0; n],
             laws: vec![JointLaw::FREE; n],
             solver: StickSlipSolver::new(n, None),
@@ -324,32 +338,47 @@ impl Friction {
         }
     }
 
-    /// M(q), and r = u − D·q̇ + τ_g − C·q̇ in `rhs`.
+    /// The bands for a control period with the motor torque `u` held; a joint moving towards a side
+    /// its gear now locks stops there (an inelastic stop, as at a position limit).
+    fn start_period(&mut self, u: &[f64], v: &mut [f64]) {
+        for i in 0..u.len() {
+            (self.up[i], self.down[i]) = self.joints.bounds(i, u[i]);
+            if (v[i] > 0.0 && self.up[i].is_infinite()) || (v[i] < 0.0 && self.down[i].is_infinite()) {
+                v[i] = 0.0;
+            }
+        }
+    }
+
+    /// The friction on joint i sliding in direction `mode` (±1): −F⁺ or +F⁻.
+    fn sliding(&self, i: usize, mode: i8) -> f64 {
+        if mode > 0 { -self.up[i] } else { self.down[i] }
+    }
+
+    /// M(q), and r = u − D·q̇ + τ_g − C·q̇ in `rhs` (D with the gears' viscous friction).
     fn mass_and_forces<'d>(&mut self, model: &Model, data: &'d mut Data, u: &[f64], q: &[f64], v: &[f64]) -> &'d [f64] {
         forward_kinematics(model, data, q);
         gravity_and_bias_from_kinematics(model, data, v);
         crba_from_kinematics(model, data);
         for (i, joint) in model.joints.iter().enumerate() {
-            self.rhs[i] = u[i] - joint.damping * v[i] + data.gravity[i] - data.bias[i];
+            self.rhs[i] = u[i] - (joint.damping + self.joints.viscous(i)) * v[i] + data.gravity[i] - data.bias[i];
         }
         data.mass_matrix.as_slice()
     }
 
     /// At a state where the modes may change (a period's start, an event): joints moving slide
     /// their way; each joint at rest sticks, or starts sliding, as the exact solution of
-    /// M·q̈ = r + τ_f (|τ_f| ≤ F at rest, −F·sign(q̇) moving) says.
+    /// M·q̈ = r + τ_f (−F⁺ ≤ τ_f ≤ F⁻ at rest, the sliding friction moving) says.
     fn decide_modes(&mut self, model: &Model, data: &mut Data, u: &[f64], q: &[f64], v: &[f64]) {
         let mass = self.mass_and_forces(model, data, u, q, v);
         for i in 0..v.len() {
-            let f = self.bound[i];
-            self.laws[i] = if f == 0.0 {
+            self.laws[i] = if !self.joints.has(i) {
                 JointLaw::FREE
             } else if v[i] != 0.0 {
                 // g = r − M·q̈ = −τ_f
-                let slope = f * v[i].signum();
+                let slope = -self.sliding(i, v[i].signum() as i8);
                 JointLaw { below: slope, above: slope, ..JointLaw::FREE }
             } else {
-                JointLaw { below: -f, above: f, ..JointLaw::FREE }
+                self.joints.law(i, u[i], 1.0, f64::NEG_INFINITY, f64::INFINITY).0
             };
         }
         if self.solver.solve(mass, &self.zeros, &self.rhs, &self.laws, &mut self.qdd, &mut self.residual).is_err() {
@@ -358,7 +387,7 @@ impl Friction {
             return;
         }
         for i in 0..v.len() {
-            self.mode[i] = if self.bound[i] == 0.0 {
+            self.mode[i] = if !self.joints.has(i) {
                 0
             } else if v[i] != 0.0 {
                 v[i].signum() as i8
@@ -367,8 +396,8 @@ impl Friction {
             } else {
                 0
             };
-            self.stuck[i] = self.bound[i] > 0.0 && self.mode[i] == 0;
-            self.torque[i] = if self.stuck[i] { -self.residual[i] } else { -self.bound[i] * self.mode[i] as f64 };
+            self.stuck[i] = self.joints.has(i) && self.mode[i] == 0;
+            self.torque[i] = if self.stuck[i] { -self.residual[i] } else if self.mode[i] != 0 { self.sliding(i, self.mode[i]) } else { 0.0 };
         }
     }
 
@@ -376,13 +405,12 @@ impl Friction {
     fn acceleration(&mut self, model: &Model, data: &mut Data, u: &[f64], q: &[f64], v: &[f64]) -> &[f64] {
         let mass = self.mass_and_forces(model, data, u, q, v);
         for i in 0..v.len() {
-            let f = self.bound[i];
-            self.laws[i] = if f == 0.0 {
+            self.laws[i] = if !self.joints.has(i) {
                 JointLaw::FREE
             } else if self.mode[i] == 0 {
                 JointLaw { lower: 0.0, upper: 0.0, below: 0.0, above: 0.0 }
             } else {
-                let slope = f * self.mode[i] as f64;
+                let slope = -self.sliding(i, self.mode[i]);
                 JointLaw { below: slope, above: slope, ..JointLaw::FREE }
             };
         }
@@ -390,7 +418,7 @@ impl Friction {
             self.qdd.fill(f64::NAN);
         }
         for i in 0..v.len() {
-            if self.bound[i] > 0.0 && self.mode[i] == 0 {
+            if self.joints.has(i) && self.mode[i] == 0 {
                 self.torque[i] = -self.residual[i];
             }
         }
@@ -398,12 +426,12 @@ impl Friction {
     }
 
     /// Whether a mode ends within the step to this velocity: a sliding joint's velocity reached or
-    /// passed zero, or a stuck joint needs more than its friction to stay (at stage 6, the end).
+    /// passed zero, or a stuck joint needs more than its band to stay (at stage 6, the end).
     fn event(&self, v_end: &[f64]) -> bool {
         (0..v_end.len()).any(|i| match self.mode[i] {
-            // (a relative 1e-9 over the bound: what held the joint at the mode's start is not
+            // (a relative 1e-9 over the band: what held the joint at the mode's start is not
             // re-decided for the solve's rounding)
-            0 => self.bound[i] > 0.0 && self.torque[i].abs() > self.bound[i] * (1.0 + 1e-9),
+            0 => self.joints.has(i) && (self.torque[i] < -self.up[i] * (1.0 + 1e-9) || self.torque[i] > self.down[i] * (1.0 + 1e-9)),
             m => v_end[i] * m as f64 <= 0.0,
         })
     }
@@ -417,11 +445,11 @@ impl Friction {
         }
     }
 
-    /// The friction's work over an accepted step: −F·|Δq| on each sliding joint.
+    /// The Coulomb friction's work over an accepted step: −F·|Δq| on each sliding joint.
     fn book(&mut self, q_before: &[f64], q_after: &[f64]) {
         for i in 0..q_before.len() {
             if self.mode[i] != 0 {
-                self.work -= self.bound[i] * (q_after[i] - q_before[i]).abs();
+                self.work += self.sliding(i, self.mode[i]) * (q_after[i] - q_before[i]);
             }
         }
     }

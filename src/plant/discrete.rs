@@ -1,5 +1,7 @@
 use super::Plant;
+use super::joint_friction::JointFriction;
 use super::stick_slip::{JointLaw, StickSlipSolver};
+use crate::actuator::LossyGear;
 use crate::dynamics::{Data, crba_from_kinematics, forward_kinematics, gravity_and_bias_from_kinematics};
 use crate::model::Model;
 
@@ -12,15 +14,21 @@ use crate::model::Model;
 /// ```
 ///
 /// plus position limits as rigid one-sided constraints on v₁ (a joint that would pass its limit
-/// stops exactly at it) and Coulomb friction as a bounded impulse −h·F ≤ h·τ_f ≤ h·F opposing v₁,
+/// stops exactly at it) and Coulomb friction as a bounded impulse −h·F⁺ ≤ h·τ_f ≤ h·F⁻ opposing v₁,
 /// or holding the joint exactly still (v₁ = 0) when the rest of the step's impulse on it is within
-/// h·F — all solved exactly together ([`StickSlipSolver`]), coupled through M + hD. Several
-/// substeps per control period when the plant step is shorter than the control period.
+/// that band — all solved exactly together ([`StickSlipSolver`]), coupled through M + hD. The band
+/// is the URDF's friction plus the gearbox's losses for the step's motor torque ([`JointFriction`]:
+/// wider against a back-driving load, locked on a self-locking gear's back-driven side); the
+/// gear's viscous friction joins D. Several substeps per control period when the plant step is
+/// shorter than the control period.
 pub struct DiscretePlant {
     pub time_step: f64,
     pub substeps: usize,
-    /// Whether some joint has Coulomb friction (each joint's F is the model's).
-    has_friction: bool,
+    /// Each joint's Coulomb band and the gears' viscous friction.
+    friction: JointFriction,
+    /// Per joint: whether the last step's upper / lower velocity bound was a self-locking gear's
+    /// lock rather than the position limit.
+    locked: Vec<(bool, bool)>,
     /// h·D, added to M's diagonal: computed each step from the model's damping and the plant's
     /// time step (a cached copy would go stale when `time_step` changes).
     damping_step: Vec<f64>,
@@ -39,11 +47,17 @@ pub struct DiscretePlant {
 impl DiscretePlant {
     /// The plant with the model's joint friction (0: none, Drake's update exactly).
     pub fn new(model: &Model, time_step: f64, substeps: usize) -> Self {
+        Self::with_gears(model, time_step, substeps, &[])
+    }
+
+    /// The plant with the model's joint friction and the drive trains' gear losses (by coordinate).
+    pub fn with_gears(model: &Model, time_step: f64, substeps: usize, gears: &[Option<LossyGear>]) -> Self {
         let n = model.dof();
         Self {
             time_step,
             substeps,
-            has_friction: model.joints.iter().any(|j| j.friction > 0.0),
+            friction: JointFriction::new(model, gears),
+            locked: vec![(false, false); n],
             damping_step: vec![0.0; n],
             rhs: vec![0.0; n],
             v_next: vec![0.0; n],
@@ -75,9 +89,10 @@ impl DiscretePlant {
         }
         // each joint's h·D, velocity bounds (the limits reached at the step's end) and friction impulses
         for (i, joint) in model.joints.iter().enumerate() {
-            self.damping_step[i] = h * joint.damping;
-            let friction = h * joint.friction;
-            self.laws[i] = JointLaw { lower: (joint.lower - q[i]) / h, upper: (joint.upper - q[i]) / h, below: -friction, above: friction };
+            self.damping_step[i] = h * (joint.damping + self.friction.viscous(i));
+            let (law, locked_up, locked_down) = self.friction.law(i, u[i], h, (joint.lower - q[i]) / h, (joint.upper - q[i]) / h);
+            self.laws[i] = law;
+            self.locked[i] = (locked_up, locked_down);
         }
         // M + hD is symmetric positive definite for any valid model; a failure means the state is
         // no longer finite, which the simulation loop reports as divergence
@@ -88,7 +103,12 @@ impl DiscretePlant {
             let v_before = v[i];
             v[i] = self.v_next[i];
             q[i] += h * v[i];
-            let side = self.solver.limit_side(&self.laws, i);
+            let side = match self.solver.limit_side(&self.laws, i) {
+                // held by a self-locking gear, not by the limit
+                1 if self.locked[i].0 => 0,
+                -1 if self.locked[i].1 => 0,
+                side => side,
+            };
             if side != 0 {
                 // land exactly on the limit, not a rounding error past it
                 q[i] = if side > 0 { model.joints[i].upper } else { model.joints[i].lower };
@@ -97,22 +117,23 @@ impl DiscretePlant {
             // the friction's work, booked at the step's mean speed as the energy audit books the
             // torques and damping (a limit's inelastic stop is not booked: it only takes energy)
             let mean = 0.5 * (v_before + v[i]);
-            let bound = model.joints[i].friction;
-            if bound > 0.0 {
-                let torque = self.friction_on(i, bound, side, v[i]);
+            if self.friction.has(i) {
+                let torque = self.friction_on(i, u[i], side, v[i]);
                 self.friction_torque[i] = torque;
                 self.stuck[i] = v[i] == 0.0;
-                self.friction_work += h * torque * mean;
+                // the gear's viscous friction is booked here too (the audit books the URDF's damping)
+                self.friction_work += h * (torque * mean - self.friction.viscous(i) * mean * mean);
             }
         }
     }
 
-    /// The friction torque on joint i after a step: −g/h within the bounds; at rest on a limit the
-    /// limit takes what pushes into it, the friction only what pulls away.
-    fn friction_on(&self, i: usize, bound: f64, side: i8, v: f64) -> f64 {
+    /// The Coulomb friction torque on joint i after a step: −g/h within its band; at rest on a
+    /// limit the limit takes what pushes into it, the friction only what pulls away.
+    fn friction_on(&self, i: usize, u: f64, side: i8, v: f64) -> f64 {
         let g = self.residual[i] / self.time_step;
         let g = if side != 0 && v == 0.0 { if side > 0 { g.min(0.0) } else { g.max(0.0) } } else { g };
-        (-g).clamp(-bound, bound)
+        let (up, down) = self.friction.bounds(i, u);
+        (-g).clamp(-up, down)
     }
 
     /// The control period's plant steps, each by `step`; the kinematics, τ_g and C·v it needs are
@@ -161,7 +182,7 @@ impl Plant for DiscretePlant {
     fn describe(&self) -> String {
         format!(
             "discrete plant: semi-implicit Euler, implicit joint damping (Drake's update){}, h = {} ms{}",
-            if self.has_friction { ", exact Coulomb stick–slip" } else { "" },
+            if self.friction.has_gears() { ", exact Coulomb stick–slip with the gearboxes' losses" } else if self.friction.any { ", exact Coulomb stick–slip" } else { "" },
             self.time_step * 1e3,
             if self.substeps > 1 { format!(", {} steps per control period", self.substeps) } else { String::new() }
         )

@@ -2,10 +2,12 @@
 
 mod continuous;
 mod discrete;
+mod joint_friction;
 mod stick_slip;
 
 pub use continuous::{ContinuousPlant, Tolerances};
 pub use discrete::DiscretePlant;
+pub use joint_friction::JointFriction;
 pub use stick_slip::{JointLaw, NotPositiveDefinite, StickSlipSolver};
 
 use crate::dynamics::Data;

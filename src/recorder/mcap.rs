@@ -587,7 +587,7 @@ impl Recorder for McapRecorder {
             joints: names.iter().map(|n| JointState { name: n.clone(), ..Default::default() }).collect(),
         };
         let n = model.dof();
-        let has_friction = model.joints.iter().any(|j| j.friction > 0.0);
+        let has_friction = run.experiment.joint_has_friction().contains(&true);
         self.telemetry = ControllerTelemetry {
             time: 0.0,
             target: vec![0.0; n],

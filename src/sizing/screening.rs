@@ -19,7 +19,7 @@
 //! a joint whose choice loses steps or uses more than 1/(1 + m) of its torque in the full simulation
 //! moves on to its next candidate with more torque to spare, until the whole set passes.
 
-use crate::actuator::{Catalogue, DriveTrain, MotorSet};
+use crate::actuator::{Catalogue, DriveTrain, LossyGear, MotorSet};
 use crate::config::RunConfig;
 use crate::control::demand::along_commanded_motion;
 use crate::error::Error;
@@ -225,7 +225,7 @@ fn commanded_motion(request: &SizeRequest) -> Result<Motion, Error> {
 /// The drive train of `motor` behind `ratio` at efficiency `efficiency` (1 for ratio 1).
 pub fn drive_train(catalogue: &Catalogue, motor: &str, ratio: f64, efficiency: f64) -> Result<DriveTrain, Error> {
     let own = catalogue.drive_train(motor).ok_or_else(|| Error::flag("--candidates", format!("no motor '{motor}' in {} (known: {})", catalogue.source.display(), catalogue.names())))??;
-    Ok(own.followed_by(ratio, if ratio == 1.0 { 1.0 } else { efficiency }, f64::INFINITY))
+    Ok(own.followed_by(ratio, LossyGear::with_efficiency(if ratio == 1.0 { 1.0 } else { efficiency }), f64::INFINITY))
 }
 
 /// Rate one candidate on joint `j`'s commanded motion: its share with the margin, torque and speed
@@ -260,7 +260,7 @@ fn rate(drive: &DriveTrain, motion: &Motion, j: usize, margin: f64) -> (f64, f64
         let torque = motion.torque[j][i];
         k * torque.abs() <= drive.available(torque, k * motion.speed[j][i])
     });
-    let shortfall = if drive.rated_torque < motor_torque {
+    let shortfall = if drive.rated_torque < drive.gear.efficiency * motor_torque {
         Shortfall::Gearbox { at: instant, need, rated: drive.rated_torque }
     } else if without_rotor && reflected > 0.0 {
         Shortfall::ReflectedInertia { at: instant, reflected, need, available }

@@ -1,0 +1,79 @@
+//! What resists each joint's motion besides its damping: the URDF's Coulomb friction and the drive
+//! train's gearbox losses ([`LossyGear`]: breakaway, viscous, and the load-dependent loss by the
+//! direction power flows), as one Coulomb band and one viscous coefficient per joint for a plant
+//! step with the motor's torque held.
+
+use super::stick_slip::JointLaw;
+use crate::actuator::LossyGear;
+use crate::model::Model;
+
+/// Per joint: the URDF's friction F and the gear's losses (None: no drive train, or a lossless one).
+#[derive(Clone, Debug)]
+pub struct JointFriction {
+    coulomb: Vec<f64>,
+    gears: Vec<Option<LossyGear>>,
+    /// Whether any joint has friction or gear losses (without, the plants keep their plain update).
+    pub any: bool,
+}
+
+impl JointFriction {
+    /// The model's joint friction and the drive trains' gears (by coordinate; empty: none).
+    pub fn new(model: &Model, gears: &[Option<LossyGear>]) -> Self {
+        let coulomb: Vec<f64> = model.joints.iter().map(|j| j.friction).collect();
+        let gears: Vec<Option<LossyGear>> = (0..model.dof()).map(|i| gears.get(i).copied().flatten().filter(|g| !g.is_lossless())).collect();
+        let any = coulomb.iter().any(|&f| f > 0.0) || gears.iter().any(Option::is_some);
+        Self { coulomb, gears, any }
+    }
+
+    /// Whether some joint has a lossy gearbox.
+    pub fn has_gears(&self) -> bool {
+        self.gears.iter().any(Option::is_some)
+    }
+
+    /// Whether joint i has any friction (its friction torque and stuck flag mean something).
+    pub fn has(&self, i: usize) -> bool {
+        self.coulomb[i] > 0.0 || self.gears[i].is_some()
+    }
+
+    /// (F⁺, F⁻) of joint i when the motor gives `u` at the joint: the friction against positive and
+    /// against negative motion, infinite on a side a self-locking gear locks.
+    pub fn bounds(&self, i: usize, u: f64) -> (f64, f64) {
+        let f = self.coulomb[i];
+        match &self.gears[i] {
+            Some(gear) => {
+                let (up, down) = gear.friction_bounds(u);
+                (f + up, f + down)
+            }
+            None => (f, f),
+        }
+    }
+
+    /// The gear's viscous coefficient at joint i, N·m·s/rad (added to the joint's damping).
+    pub fn viscous(&self, i: usize) -> f64 {
+        self.gears[i].map_or(0.0, |g| g.viscous)
+    }
+
+    /// The law for joint i with the bounds `scale`·(F⁺, F⁻) and the position bounds (lower, upper):
+    /// a side with infinite friction becomes a bound at 0 (the joint cannot move that way). Returns
+    /// the law and whether its upper / lower bound is such a lock rather than the given one.
+    pub fn law(&self, i: usize, u: f64, scale: f64, lower: f64, upper: f64) -> (JointLaw, bool, bool) {
+        let (up, down) = self.bounds(i, u);
+        let mut law = JointLaw { lower, upper, below: -scale * down, above: scale * up };
+        let (mut locked_up, mut locked_down) = (false, false);
+        if up.is_infinite() {
+            law.above = 0.0;
+            locked_up = law.upper > 0.0;
+            law.upper = law.upper.min(0.0);
+        }
+        if down.is_infinite() {
+            law.below = 0.0;
+            locked_down = law.lower < 0.0;
+            law.lower = law.lower.max(0.0);
+        }
+        if law.lower > law.upper {
+            // a locked joint found past its limit: it stays where it is
+            (law.lower, law.upper, locked_up, locked_down) = (0.0, 0.0, true, true);
+        }
+        (law, locked_up, locked_down)
+    }
+}
