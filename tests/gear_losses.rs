@@ -93,29 +93,39 @@ impl Recorder for Ends {
     }
 }
 
-/// The box model on a motor file of the user's own: a small DC motor on every joint through a
-/// 30:1 gear with `gear` (η, η_b), run with the motor off (zero gains, no feed-forward) from a pose.
-fn motor_off_run(dir: &Path, efficiency: f64, backdrive: f64, time_step: Option<f64>) -> (Ends, Summary) {
-    let joints: String = (1..=6).map(|j| format!("[joints.J{j}]\nmotor = \"M\"\ngear_ratio = 30\nefficiency = {efficiency}\nbackdrive_efficiency = {backdrive}\n")).collect();
-    let file = dir.join(format!("gear_{efficiency}_{backdrive}.toml"));
+/// A motor file of the user's own: a small DC motor on every joint of the box model through a 30:1
+/// gear described by `reduction` (motor-file fields).
+fn motor_file(dir: &Path, name: &str, reduction: &str) -> std::path::PathBuf {
+    let joints: String = (1..=6).map(|j| format!("[joints.J{j}]\nmotor = \"M\"\ngear_ratio = 30\n{reduction}\n")).collect();
+    let file = dir.join(name);
     std::fs::write(&file, format!("[motors.M]\nkind = \"servo\"\nstall_torque = 0.5\nno_load_speed = 300\nrotor_inertia = 1e-7\n{joints}")).unwrap();
-    let config = RunConfig {
+    file
+}
+
+/// The box model on `motors` with the motor off (zero gains, no feed-forward), from a pose.
+fn motor_off(motors: std::path::PathBuf, duration: f64, time_step: Option<f64>) -> RunConfig {
+    RunConfig {
         urdf: common::box_urdf(),
-        motors: Some(file),
+        motors: Some(motors),
         drive: DriveMode::Pd,
         hold: true,
         no_ff: true,
         kp: Some(vec![0.0; 6]),
         kd: Some(vec![0.0; 6]),
         q0: Some("0.2,0.5,-0.6,0.3,0.4,0".into()),
-        duration: 2.0,
+        duration,
         time_step,
         ..RunConfig::default()
-    };
-    let experiment = Experiment::prepare(config).unwrap();
+    }
+}
+
+/// The motor-off run through gears of efficiency η and η_b: its first and last samples.
+fn motor_off_run(dir: &Path, efficiency: f64, backdrive: f64, time_step: Option<f64>) -> Ends {
+    let file = motor_file(dir, &format!("gear_{efficiency}_{backdrive}.toml"), &format!("efficiency = {efficiency}\nbackdrive_efficiency = {backdrive}"));
+    let experiment = Experiment::prepare(motor_off(file, 2.0, time_step)).unwrap();
     let mut ends = Ends::default();
-    let summary = simulate(&experiment, &mut [&mut ends], None).unwrap();
-    (ends, summary)
+    simulate(&experiment, &mut [&mut ends], None).unwrap();
+    ends
 }
 
 /// A self-locking drive (a worm, η_b < 0) cannot be back-driven: with its motor off it holds the
@@ -125,10 +135,10 @@ fn motor_off_run(dir: &Path, efficiency: f64, backdrive: f64, time_step: Option<
 fn a_self_locking_drive_holds_the_arm_with_its_motor_off_and_an_efficient_one_lets_it_fall() {
     let dir = tempfile::tempdir().unwrap();
     for time_step in [None, Some(0.0)] {
-        let (worm, _) = motor_off_run(dir.path(), 0.4, -0.3, time_step);
+        let worm = motor_off_run(dir.path(), 0.4, -0.3, time_step);
         assert_eq!(worm.last, worm.first, "time step {time_step:?}: the worm holds");
         assert!(worm.stuck.iter().all(|&s| s), "every joint stuck: {:?}", worm.stuck);
-        let (efficient, _) = motor_off_run(dir.path(), 0.9, 0.9, time_step);
+        let efficient = motor_off_run(dir.path(), 0.9, 0.9, time_step);
         assert!((efficient.last[1] - efficient.first[1]).abs() > 0.1, "time step {time_step:?}: the efficient drive lets J2 fall: {:?} → {:?}", efficient.first, efficient.last);
     }
 }
@@ -139,21 +149,8 @@ fn a_self_locking_drive_holds_the_arm_with_its_motor_off_and_an_efficient_one_le
 #[test]
 fn the_energy_audit_books_the_gear_losses_and_balances() {
     let dir = tempfile::tempdir().unwrap();
-    let joints: String = (1..=6).map(|j| format!("[joints.J{j}]\nmotor = \"M\"\ngear_ratio = 30\nefficiency = 0.9\nbreakaway_torque = 0.2\nviscous = 0.05\n")).collect();
-    let file = dir.path().join("lossy.toml");
-    std::fs::write(&file, format!("[motors.M]\nkind = \"servo\"\nstall_torque = 0.5\nno_load_speed = 300\nrotor_inertia = 1e-7\n{joints}")).unwrap();
-    let config = RunConfig {
-        urdf: common::box_urdf(),
-        motors: Some(file),
-        drive: DriveMode::Pd,
-        hold: true,
-        no_ff: true,
-        kp: Some(vec![0.0; 6]),
-        kd: Some(vec![0.0; 6]),
-        q0: Some("0.2,0.5,-0.6,0.3,0.4,0".into()),
-        duration: 3.0,
-        ..RunConfig::default()
-    };
+    let file = motor_file(dir.path(), "lossy.toml", "efficiency = 0.9\nbreakaway_torque = 0.2\nviscous = 0.05");
+    let config = motor_off(file, 3.0, None);
     let experiment = Experiment::prepare(config).unwrap();
     let summary = simulate(&experiment, &mut [], None).unwrap();
     let books = summary.energy_balance.unwrap();
