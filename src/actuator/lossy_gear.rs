@@ -72,11 +72,12 @@ impl LossyGear {
         (self.breakaway_torque + self.loss(motor_torque), self.breakaway_torque + self.loss(-motor_torque))
     }
 
-    /// The torque the joint gets while it moves at `speed` ≠ 0 with the motor at `motor_torque`
-    /// (u + τ_f, the viscous part included): what the motor's torque becomes through the gear.
-    pub fn output_torque(&self, motor_torque: f64, speed: f64) -> f64 {
+    /// The torque the joint gets while it moves in `direction` (> 0 or < 0) at `speed` with the
+    /// motor at `motor_torque` (u + τ_f, the viscous part included): what the motor's torque becomes
+    /// through the gear; ±∞ where a self-locking gear takes whatever the load asks.
+    pub fn output_torque(&self, motor_torque: f64, direction: f64, speed: f64) -> f64 {
         let (up, down) = self.friction_bounds(motor_torque);
-        let coulomb = if speed > 0.0 { -up } else if speed < 0.0 { down } else { 0.0 };
+        let coulomb = if direction > 0.0 { -up } else { down };
         motor_torque + coulomb - self.viscous * speed
     }
 
@@ -129,9 +130,9 @@ mod tests {
     #[test]
     fn output_torque_by_power_flow() {
         let gear = LossyGear { efficiency: 0.9, backdrive_efficiency: 0.7, breakaway_torque: 0.0, viscous: 0.0 };
-        assert!((gear.output_torque(1.0, 1.0) - 0.9).abs() < 1e-15, "driving: η·u");
-        assert!((gear.output_torque(1.0, -1.0) - 1.0 / 0.7).abs() < 1e-12, "back-driven: u/η_b");
-        assert!((gear.output_torque(-1.0, -1.0) + 0.9).abs() < 1e-15);
+        assert!((gear.output_torque(1.0, 1.0, 1.0) - 0.9).abs() < 1e-15, "driving: η·u");
+        assert!((gear.output_torque(1.0, -1.0, -1.0) - 1.0 / 0.7).abs() < 1e-12, "back-driven: u/η_b");
+        assert!((gear.output_torque(-1.0, -1.0, -1.0) + 0.9).abs() < 1e-15);
     }
 
     #[test]

@@ -90,14 +90,11 @@ impl DriveTrain {
     /// the gearbox's rating; braking (back-driven), N·T_b/η_b plus the friction, which helps (a
     /// self-locking gear holds whatever the rating allows).
     pub fn available(&self, torque: f64, speed: f64) -> f64 {
-        let motor = self.motor_torque(torque, speed);
-        let friction = self.gear.breakaway_torque + self.gear.viscous * speed.abs();
-        let at_joint = if Self::braking(torque, speed) {
-            if self.gear.self_locking() { f64::INFINITY } else { motor / self.gear.backdrive_efficiency + friction }
-        } else {
-            (self.gear.efficiency * motor - friction).max(0.0)
-        };
-        at_joint.min(self.rated_torque)
+        let sign = if torque >= 0.0 { 1.0 } else { -1.0 };
+        // the direction of motion: the torque's when it drives (at rest too), the other braking
+        let direction = if Self::braking(torque, speed) { -sign } else { sign };
+        let at_joint = sign * self.gear.output_torque(sign * self.motor_torque(torque, speed), direction, speed);
+        at_joint.max(0.0).min(self.rated_torque)
     }
 
     /// The range of the motor's torque at the joint before the gearbox's losses, N·T, at joint

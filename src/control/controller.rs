@@ -43,12 +43,20 @@ impl PdGravityController {
     /// Per joint, the largest torque the controller can command at rest: with `--motors`, the
     /// motor's N·T at the joint (before the gearbox's losses); the effort limit elsewhere.
     pub fn limits_at_rest(&self) -> Vec<f64> {
-        (0..self.effort.len())
-            .map(|i| match self.motors.as_ref().and_then(|m| m.joints[i].as_ref()) {
-                Some(drive) => drive.torque_range(0.0).1,
-                None => self.effort[i],
-            })
-            .collect()
+        (0..self.effort.len()).map(|i| self.range(i, 0.0).1).collect()
+    }
+
+    /// Joint i's drive train, with `--motors`.
+    fn drive(&self, i: usize) -> Option<&crate::actuator::DriveTrain> {
+        self.motors.as_ref().and_then(|m| m.joints[i].as_ref())
+    }
+
+    /// The torque joint i can be commanded at joint speed `speed`: (lowest ≤ 0, highest ≥ 0).
+    fn range(&self, i: usize, speed: f64) -> (f64, f64) {
+        match self.drive(i) {
+            Some(drive) => drive.torque_range(speed),
+            None => (-self.effort[i], self.effort[i]),
+        }
     }
 
     #[allow(clippy::too_many_arguments)]
@@ -64,13 +72,10 @@ impl PdGravityController {
             if self.feed_forward {
                 u -= tau_g[i];
             }
-            let (lowest, highest) = match self.motors.as_ref().and_then(|m| m.joints[i].as_ref()) {
-                Some(drive) => {
-                    u += drive.detent_torque(q[i] - self.detent_origin[i]);
-                    drive.torque_range(v[i])
-                }
-                None => (-self.effort[i], self.effort[i]),
-            };
+            if let Some(drive) = self.drive(i) {
+                u += drive.detent_torque(q[i] - self.detent_origin[i]);
+            }
+            let (lowest, highest) = self.range(i, v[i]);
             out.saturated[i] = u > highest || u < lowest;
             out.u[i] = u.clamp(lowest, highest);
             out.limit[i] = if u >= 0.0 { highest } else { -lowest };
