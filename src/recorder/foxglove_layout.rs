@@ -1,10 +1,12 @@
 //! A Foxglove Studio layout for a run of a given model (Layouts → Import): the arm in 3D with the
-//! tool's path, and plots of every joint's angle against its target and of every joint's torque,
+//! tool's path, a plot of every joint's angle against its target and one plot per joint of its
+//! torque (scaled to the motion's own torque, the limit beside it where near: `TorqueAxis`),
 //! labelled with the model's own joint names. Written beside each `.mcap`.
 
 use crate::dynamics::{body_poses, frame_pose_in};
 use crate::model::Model;
 use crate::spatial::Pose;
+use super::torque_axis::TorqueAxis;
 use serde_json::{Value, json};
 
 /// The plot settings every plot panel shares.
@@ -42,14 +44,26 @@ fn camera(model: &Model, q: &[f64]) -> ([f64; 3], f64) {
     ([centre.x, centre.y, centre.z], (4.0 * spread).max(0.6))
 }
 
-/// The layout for `model`, whose run starts at joint positions `q0`.
+/// The layout for `model`, whose run starts at joint positions `q0` (torque plots scaled by the
+/// viewer: the committed layout, for live runs of any command).
 pub fn layout(model: &Model, q0: &[f64]) -> Value {
-    layout_with_motors(model, q0, false, &[])
+    layout_with_motors(model, q0, false, &[], &[])
+}
+
+/// `panels` side by side (`direction` "row") or stacked ("column"), each given an equal share.
+fn split_evenly(mut panels: Vec<Value>, direction: &str) -> Value {
+    if panels.len() <= 1 {
+        return panels.pop().unwrap_or(Value::Null);
+    }
+    let second = panels.split_off(panels.len() / 2);
+    let share = 100.0 * panels.len() as f64 / (panels.len() + second.len()) as f64;
+    json!({ "first": split_evenly(panels, direction), "second": split_evenly(second, direction), "direction": direction, "splitPercentage": share })
 }
 
 /// With `--motors` (`motors`): each joint's speed-dependent torque limit beside its torque; with
-/// steppers driven open loop (`stepped`): a third plot of their load angles and lost steps.
-pub fn layout_with_motors(model: &Model, q0: &[f64], motors: bool, stepped: &[bool]) -> Value {
+/// steppers driven open loop (`stepped`): a third plot of their load angles and lost steps. Each
+/// joint's torque plot spans ±`torque_axes[i].half_range` when given.
+pub fn layout_with_motors(model: &Model, q0: &[f64], motors: bool, stepped: &[bool], torque_axes: &[TorqueAxis]) -> Value {
     let (target, distance) = camera(model, q0);
     let names: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();
     let angles = names
@@ -57,14 +71,26 @@ pub fn layout_with_motors(model: &Model, q0: &[f64], motors: bool, stepped: &[bo
         .enumerate()
         .flat_map(|(i, n)| [series(format!("/joint_states.joints[{i}].position"), format!("{n} angle")), series(format!("/controller.target[{i}]"), format!("{n} target"))])
         .collect();
-    let torques = names
+    // one plot per joint: joints' torques differ by orders of magnitude, and each is read against
+    // its own limit
+    let torque_plots: Vec<(String, Value)> = names
         .iter()
         .enumerate()
-        .flat_map(|(i, n)| {
+        .map(|(i, n)| {
             let limit = motors.then(|| series(format!("/controller.torque_limit[{i}]"), format!("{n} limit")));
-            std::iter::once(series(format!("/controller.torque[{i}]"), format!("{n} torque"))).chain(limit)
+            let paths = std::iter::once(series(format!("/controller.torque[{i}]"), format!("{n} torque"))).chain(limit).collect();
+            let mut panel = plot(paths);
+            if let Some(axis) = torque_axes.get(i) {
+                panel["minYValue"] = json!(-axis.half_range);
+                panel["maxYValue"] = json!(axis.half_range);
+                panel["foxglovePanelTitle"] = json!(axis.title(n));
+            }
+            (format!("Plot!torque{i}"), panel)
         })
         .collect();
+    let columns = names.len().div_ceil(2).clamp(1, 4);
+    let torque_rows = torque_plots.chunks(columns).map(|row| split_evenly(row.iter().map(|(id, _)| json!(id)).collect(), "row")).collect();
+    let torques = split_evenly(torque_rows, "column");
     let steppers: Vec<Value> = names
         .iter()
         .enumerate()
@@ -72,9 +98,9 @@ pub fn layout_with_motors(model: &Model, q0: &[f64], motors: bool, stepped: &[bo
         .flat_map(|(i, n)| [series(format!("/controller.load_angle[{i}]"), format!("{n} load angle (el. °)")), series(format!("/controller.lost_steps[{i}]"), format!("{n} lost steps"))])
         .collect();
     let right = if steppers.is_empty() {
-        json!({ "first": "Plot!angles", "second": "Plot!torques", "direction": "column", "splitPercentage": 50 })
+        json!({ "first": "Plot!angles", "second": torques, "direction": "column", "splitPercentage": 34 })
     } else {
-        json!({ "first": "Plot!angles", "second": { "first": "Plot!torques", "second": "Plot!steppers", "direction": "column", "splitPercentage": 50 }, "direction": "column", "splitPercentage": 34 })
+        json!({ "first": "Plot!angles", "second": { "first": torques, "second": "Plot!steppers", "direction": "column", "splitPercentage": 67 }, "direction": "column", "splitPercentage": 25 })
     };
     let visible = |topics: &[&str]| topics.iter().map(|t| (t.to_string(), json!({ "visible": true }))).collect::<serde_json::Map<_, _>>();
     let has_steppers = !steppers.is_empty();
@@ -97,8 +123,7 @@ pub fn layout_with_motors(model: &Model, q0: &[f64], motors: bool, stepped: &[bo
                     }
                 }
             },
-            "Plot!angles": plot(angles),
-            "Plot!torques": plot(torques)
+            "Plot!angles": plot(angles)
         },
         "globalVariables": {},
         "userNodes": {},
@@ -110,6 +135,9 @@ pub fn layout_with_motors(model: &Model, q0: &[f64], motors: bool, stepped: &[bo
             "splitPercentage": 50
         }
     });
+    for (id, panel) in torque_plots {
+        doc["configById"][id] = panel;
+    }
     if has_steppers {
         doc["configById"]["Plot!steppers"] = plot(steppers);
     }
@@ -129,8 +157,51 @@ mod tests {
     fn the_committed_layout_is_the_box_models() {
         let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
         let model = crate::model::load_urdf(&root.join(crate::builtin::DEFAULT_URDF)).unwrap();
-        let committed: Value = serde_json::from_str(&std::fs::read_to_string(root.join("assets/foxglove/armscope_layout.json")).unwrap()).unwrap();
-        assert_eq!(committed, layout(&model, &vec![0.0; model.dof()]), "regenerate assets/foxglove/armscope_layout.json");
+        let path = root.join("assets/foxglove/armscope_layout.json");
+        let expected = layout(&model, &vec![0.0; model.dof()]);
+        if std::env::var_os("ARMSCOPE_REGENERATE").is_some() {
+            std::fs::write(&path, serde_json::to_string_pretty(&expected).unwrap() + "\n").unwrap();
+        }
+        let committed: Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+        assert_eq!(committed, expected, "regenerate assets/foxglove/armscope_layout.json (ARMSCOPE_REGENERATE=1 cargo test the_committed_layout)");
+    }
+
+    /// The panel ids the layout tree places, in order.
+    fn placed(tree: &Value, out: &mut Vec<String>) {
+        match tree {
+            Value::String(id) => out.push(id.clone()),
+            Value::Object(split) => {
+                placed(&split["first"], out);
+                placed(&split["second"], out);
+            }
+            _ => panic!("not a layout tree: {tree}"),
+        }
+    }
+
+    #[test]
+    fn every_joint_has_its_own_torque_plot_with_its_axis() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+        let model = crate::model::load_urdf(&root.join(crate::builtin::DEFAULT_URDF)).unwrap();
+        let n = model.dof();
+        let axes: Vec<TorqueAxis> = (0..n).map(|i| TorqueAxis::new(0.1 * (i + 1) as f64, 35.0)).collect();
+        let l = layout_with_motors(&model, &vec![0.0; n], true, &[false, true, false, false, false, false], &axes);
+        // the tree places every configured panel exactly once, and only those
+        let mut ids = Vec::new();
+        placed(&l["layout"], &mut ids);
+        let mut configured: Vec<String> = l["configById"].as_object().unwrap().keys().cloned().collect();
+        let mut sorted = ids.clone();
+        sorted.sort();
+        configured.sort();
+        assert_eq!(sorted, configured);
+        for (i, axis) in axes.iter().enumerate() {
+            let panel = &l["configById"][format!("Plot!torque{i}")];
+            assert_eq!(panel["maxYValue"], json!(axis.half_range));
+            assert_eq!(panel["minYValue"], json!(-axis.half_range));
+            assert_eq!(panel["paths"][1]["value"], json!(format!("/controller.torque_limit[{i}]")));
+        }
+        // the torque plots are placed in joint order
+        let torque_ids: Vec<&String> = ids.iter().filter(|id| id.starts_with("Plot!torque")).collect();
+        assert_eq!(torque_ids, (0..n).map(|i| format!("Plot!torque{i}")).collect::<Vec<_>>().iter().collect::<Vec<_>>());
     }
 
     #[test]
@@ -141,6 +212,6 @@ mod tests {
         let l = layout(&model, &[0.0]);
         let labels: Vec<&str> = l["configById"]["Plot!angles"]["paths"].as_array().unwrap().iter().map(|p| p["label"].as_str().unwrap()).collect();
         assert_eq!(labels, ["shoulder_pan angle", "shoulder_pan target"]);
-        assert_eq!(l["configById"]["Plot!torques"]["paths"][0]["label"], "shoulder_pan torque");
+        assert_eq!(l["configById"]["Plot!torque0"]["paths"][0]["label"], "shoulder_pan torque");
     }
 }

@@ -482,9 +482,7 @@ impl Recorder for McapRecorder {
         let file = match &self.options.file {
             Some(path) => {
                 // the Foxglove layout for this model, beside the recording
-                let layout = super::foxglove_layout::layout_with_motors(model, &e.initial_state().0, e.motors.is_some(), &e.stepped_joints());
-                let layout_path = super::foxglove_layout::layout_path(path);
-                std::fs::write(&layout_path, serde_json::to_string_pretty(&layout).unwrap_or_default()).map_err(|err| Error::output(&layout_path, err))?;
+                write_layout(run, path, &run.torque_axes)?;
                 Some(super::output_file::create_replacing(path).map_err(|err| self.err(err))?)
             }
             None => None,
@@ -715,7 +713,14 @@ impl Recorder for McapRecorder {
     }
 
     fn finish(&mut self, run: &RunInfo, summary: &Summary) -> Result<(), Error> {
-        let _ = run;
+        // the torque plots' scale from what the run's drives settled to
+        if let Some(path) = &self.options.file {
+            let settled = |i: usize| summary.peak_abs_torque_after_settle.get(i).copied().flatten();
+            let axes: Vec<_> = run.torque_axes.iter().enumerate().map(|(i, axis)| axis.after_run(settled(i))).collect();
+            if axes != run.torque_axes {
+                write_layout(run, path, &axes)?;
+            }
+        }
         let mut meta = BTreeMap::new();
         meta.insert("summary".into(), serde_json::to_string(summary).unwrap_or_default());
         meta.insert("status".into(), serde_json::to_string(&summary.status).unwrap_or_default());
@@ -733,6 +738,14 @@ impl Recorder for McapRecorder {
         }
         Ok(())
     }
+}
+
+/// The Foxglove layout for the run, beside its recording `mcap`.
+fn write_layout(run: &RunInfo, mcap: &std::path::Path, torque_axes: &[super::torque_axis::TorqueAxis]) -> Result<(), Error> {
+    let e = run.experiment;
+    let layout = super::foxglove_layout::layout_with_motors(&e.model, &e.initial_state().0, e.motors.is_some(), &e.stepped_joints(), torque_axes);
+    let layout_path = super::foxglove_layout::layout_path(mcap);
+    std::fs::write(&layout_path, serde_json::to_string_pretty(&layout).unwrap_or_default()).map_err(|err| Error::output(&layout_path, err))
 }
 
 #[cfg(test)]

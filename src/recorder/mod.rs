@@ -14,6 +14,7 @@ pub(crate) mod rrd_file;
 mod summary_json;
 pub mod telemetry;
 mod threaded;
+pub mod torque_axis;
 mod worker;
 mod trace;
 mod tutorial_csv;
@@ -42,6 +43,8 @@ pub struct RunInfo<'a> {
     pub trajectory: String,
     /// The commanded tool path, every 10 ms (computed once for all recorders).
     pub commanded_tool_path: Vec<nalgebra::Vector3<f64>>,
+    /// Each joint's torque plot scale: the motion's own torque, the limit beside it where near.
+    pub torque_axes: Vec<torque_axis::TorqueAxis>,
 }
 
 pub trait Recorder {

@@ -12,9 +12,10 @@ use crate::model::{Geometry, Model};
 use crate::sample::Sample;
 use crate::spatial::Pose;
 use crate::summary::Summary;
-use rerun::blueprint::{Blueprint, BlueprintActivation, BlueprintPanel, Grid, Horizontal, SelectionPanel, Spatial3DView, TimePanel, TimeSeriesView, Vertical};
+use rerun::blueprint::{Blueprint, BlueprintActivation, BlueprintPanel, ContainerLike, Grid, Horizontal, SelectionPanel, Spatial3DView, TimePanel, TimeSeriesView, Vertical};
 use rerun::blueprint::components::{PanelState, PlayState};
 use rerun::{RecordingStream, TimeColumn};
+use super::torque_axis::TorqueAxis;
 use std::collections::VecDeque;
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -543,19 +544,31 @@ pub fn joint_color(j: usize) -> rerun::Color {
 /// The layout the file opens to: the arm in 3D with the tool's position below it, and per joint
 /// its angle against the target and its torque against the motor's limits, saturated steps marked.
 /// With steppers driven open loop (`stepped`), a third row: each one's load angle and lost steps.
-pub fn blueprint(joint_names: &[String], stepped: &[bool], prefix: &str) -> Blueprint {
+/// Each torque view's y range is `torque_axes`' (the motion's own torque, the limit beside it where
+/// near; [`TorqueAxis`]): returned beside the blueprint as (view, half range), for [`send_blueprint`].
+pub fn blueprint(joint_names: &[String], stepped: &[bool], torque_axes: &[TorqueAxis], prefix: &str) -> (Blueprint, Vec<(rerun::EntityPath, f64)>) {
     let angle_views = joint_names.iter().map(|j| {
         TimeSeriesView::new(format!("{j} angle vs target"))
             .with_origin(format!("{prefix}joints/{j}"))
             .with_contents(["$origin/position"])
             .into()
     });
-    let torque_views = joint_names.iter().map(|j| {
-        TimeSeriesView::new(format!("{j} torque vs ±limit"))
-            .with_origin(format!("{prefix}joints/{j}"))
-            .with_contents(["$origin/torque", "$origin/torque_limit", "$origin/saturated_torque", "$origin/friction"])
-            .into()
-    });
+    let mut torque_ranges = Vec::new();
+    let torque_views: Vec<ContainerLike> = joint_names
+        .iter()
+        .enumerate()
+        .map(|(i, j)| {
+            let axis = torque_axes.get(i);
+            let view: ContainerLike = TimeSeriesView::new(axis.map_or_else(|| format!("{j} torque vs ±limit"), |a| a.title(j)))
+                .with_origin(format!("{prefix}joints/{j}"))
+                .with_contents(["$origin/torque", "$origin/torque_limit", "$origin/saturated_torque", "$origin/friction"])
+                .into();
+            if let (Some(axis), ContainerLike::View(v)) = (axis, &view) {
+                torque_ranges.push((v.blueprint_path(), axis.half_range));
+            }
+            view
+        })
+        .collect();
     let columns = joint_names.len().div_ceil(2).clamp(1, 4) as u32;
     let left = Vertical::new([
         Spatial3DView::new("arm").with_origin(format!("{prefix}world")).into(),
@@ -577,10 +590,52 @@ pub fn blueprint(joint_names: &[String], stepped: &[bool], prefix: &str) -> Blue
         rows.push(Grid::new(stepper_views).with_grid_columns(columns).with_name("steppers").into());
     }
     let right = Vertical::new(rows);
-    Blueprint::new(Horizontal::new([left.into(), right.into()]).with_column_shares([2.0, 3.0]))
+    let blueprint = Blueprint::new(Horizontal::new([left.into(), right.into()]).with_column_shares([2.0, 3.0]))
         .with_time_panel(TimePanel::new().with_timeline(TIMELINE).with_play_state(PlayState::Following).with_state(PanelState::Collapsed))
         .with_selection_panel(SelectionPanel::new().with_state(PanelState::Collapsed))
-        .with_blueprint_panel(BlueprintPanel::new().with_state(PanelState::Collapsed))
+        .with_blueprint_panel(BlueprintPanel::new().with_state(PanelState::Collapsed));
+    (blueprint, torque_ranges)
+}
+
+/// Send `blueprint` to `rec` with each listed view's y axis set to ±half range (a `ScalarAxis`
+/// property; the user can still zoom). rerun 0.36's Rust builder keeps view properties
+/// crate-private (only the graph and map views expose theirs), so the blueprint is built into
+/// memory and the axis properties are logged into the same blueprint store, at the views' own
+/// paths (`view/<id>/ScalarAxis`, as the Python SDK writes them), before its activation (the
+/// viewer copies a blueprint when it activates it: later messages would not reach the copy).
+pub fn send_blueprint(rec: &RecordingStream, blueprint: &Blueprint, axis_ranges: &[(rerun::EntityPath, f64)]) -> rerun::RecordingStreamResult<()> {
+    use rerun::external::re_log_types::LogMsg;
+    let activation = BlueprintActivation { make_active: true, make_default: true };
+    if axis_ranges.is_empty() {
+        return blueprint.send(rec, activation);
+    }
+    let application = rec.store_info().map(|info| info.application_id().clone()).unwrap_or_else(|| rerun::ApplicationId::from("armscope"));
+    let (staging, staged) = rerun::RecordingStreamBuilder::new(application).memory()?;
+    blueprint.send(&staging, activation)?;
+    let mut messages = staged.take();
+    let Some(command) = messages.iter().find_map(|m| match m {
+        LogMsg::BlueprintActivationCommand(c) => Some(c.clone()),
+        _ => None,
+    }) else {
+        return blueprint.send(rec, activation);
+    };
+    let store = command.blueprint_id.clone();
+    messages.retain(|m| !matches!(m, LogMsg::BlueprintActivationCommand(_)) && *m.store_id() == store);
+    messages.extend(axis_messages(&store, axis_ranges)?);
+    rec.send_blueprint(messages, command);
+    Ok(())
+}
+
+/// The blueprint store's messages setting each view's `ScalarAxis` range.
+fn axis_messages(store: &rerun::StoreId, axis_ranges: &[(rerun::EntityPath, f64)]) -> rerun::RecordingStreamResult<Vec<rerun::external::re_log_types::LogMsg>> {
+    use rerun::external::re_log_types::LogMsg;
+    use rerun::external::re_sdk_types::blueprint::archetypes::ScalarAxis;
+    let (axes, staged) = rerun::RecordingStreamBuilder::new(store.application_id().clone()).recording_id(store.recording_id().clone()).blueprint().memory()?;
+    axes.set_time_sequence("blueprint", 0);
+    for (view, half_range) in axis_ranges {
+        axes.log(format!("{view}/ScalarAxis"), &ScalarAxis::new().with_range(rerun::components::Range1D(rerun::datatypes::Range1D([-half_range, *half_range]))))?;
+    }
+    Ok(staged.take().into_iter().filter(|m| matches!(m, LogMsg::ArrowMsg(..)) && m.store_id() == store).collect())
 }
 
 /// The run's configuration as Markdown, for the recording.
@@ -640,7 +695,12 @@ impl Recorder for RerunRecorder {
         self.steps_per_trail_point = ((1.0 / TRAIL_RATE_HZ) / e.config.dt).round().max(1.0) as usize;
         self.steps_per_pose = super::steps_per_pose(e.config.dt);
 
-        blueprint(&self.joint_names, &self.stepped, "").send(&rec, BlueprintActivation { make_active: true, make_default: true }).map_err(|x| self.err(x))?;
+        // the layout: a live viewer needs it now (scaled by the motion's torque); a file gets it at
+        // the end, scaled by what the run did as well
+        if self.live {
+            let (layout, torque_ranges) = blueprint(&self.joint_names, &self.stepped, &run.torque_axes, "");
+            send_blueprint(&rec, &layout, &torque_ranges).map_err(|x| self.err(x))?;
+        }
         self.log_static_scene(&rec, model)?;
         self.log_series_styles(&rec)?;
         rec.log_static("config", &rerun::TextDocument::from_markdown(config_markdown(run))).map_err(|x| self.err(x))?;
@@ -723,9 +783,17 @@ impl Recorder for RerunRecorder {
         Ok(())
     }
 
-    fn finish(&mut self, _run: &RunInfo, summary: &Summary) -> Result<(), Error> {
+    fn finish(&mut self, run: &RunInfo, summary: &Summary) -> Result<(), Error> {
         self.flush_block(true)?;
         let Some(rec) = self.rec.take() else { return Ok(()) };
+        // the layout, its torque plots scaled by what the run's drives settled to as well: sent
+        // now to a file, again to a live viewer where the scale changed (its second layout)
+        let settled = |i: usize| summary.peak_abs_torque_after_settle.get(i).copied().flatten();
+        let axes: Vec<_> = run.torque_axes.iter().enumerate().map(|(i, axis)| axis.after_run(settled(i))).collect();
+        if !self.live || axes != run.torque_axes {
+            let (layout, torque_ranges) = blueprint(&self.joint_names, &self.stepped, &axes, "");
+            send_blueprint(&rec, &layout, &torque_ranges).map_err(|x| self.err(x))?;
+        }
         if self.path.points().len() > 1 {
             rec.log_static("world/tool/path", &rerun::LineStrips3D::new([self.path.points().to_vec()]).with_colors([rerun::Color::from_rgb(230, 60, 60)]).with_radii([0.001]))
                 .map_err(|x| self.err(x))?;

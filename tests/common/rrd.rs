@@ -25,6 +25,8 @@ pub struct Rrd {
     pub chunks: Vec<Chunk>,
     /// how many blueprint stores the file holds
     pub blueprints: usize,
+    /// the blueprints' chunks (the layout: views, their names and properties)
+    pub blueprint_chunks: Vec<Chunk>,
     /// problems `rerun rrd verify` would report
     pub verify_errors: Vec<String>,
     /// Rerun component columns checked against Rerun's reflection
@@ -38,6 +40,7 @@ impl Rrd {
         let mut decoder = re_log_encoding::DecoderApp::decode_lazy(std::io::BufReader::new(file));
         let mut chunks = Vec::new();
         let mut blueprints = BTreeSet::new();
+        let mut blueprint_chunks = Vec::new();
         let mut verify_errors = Vec::new();
         let mut recording_chunks = 0usize;
         let mut verified_columns = 0usize;
@@ -59,6 +62,7 @@ impl Rrd {
             }
             if store.is_blueprint() {
                 blueprints.insert(store.clone());
+                blueprint_chunks.push(Chunk::from_arrow_msg(&arrow_msg).expect("a valid blueprint chunk"));
                 continue;
             }
             recording_chunks += 1;
@@ -87,7 +91,37 @@ impl Rrd {
             }
             Err(e) => verify_errors.push(format!("corrupt RRD manifest: {e}")),
         }
-        Self { chunks, blueprints: blueprints.len(), verify_errors, verified_columns }
+        Self { chunks, blueprints: blueprints.len(), blueprint_chunks, verify_errors, verified_columns }
+    }
+
+    /// The blueprint's views by their display name, each with its y axis range where the blueprint
+    /// sets one (`ScalarAxis:range` at `/view/<id>/ScalarAxis`, as the viewer reads it); where a
+    /// value was logged again at a later blueprint time, the latest.
+    pub fn view_axis_ranges(&self) -> BTreeMap<String, Option<[f64; 2]>> {
+        let latest = |entity: &str, component: &str| {
+            self.blueprint_chunks
+                .iter()
+                .filter(|c| c.entity_path().to_string() == entity)
+                .filter_map(|c| {
+                    let time = c.timelines().iter().find(|(name, _)| name.as_str() == "blueprint").map_or(i64::MIN, |(_, t)| t.times_raw()[0]);
+                    c.components().0.values().find(|col| col.descriptor.component.as_str() == component).filter(|col| !col.list_array.is_null(0)).map(|col| (time, col.list_array.value(0)))
+                })
+                .max_by_key(|(time, _)| *time)
+                .map(|(_, value)| value)
+        };
+        let mut views = BTreeMap::new();
+        for chunk in &self.blueprint_chunks {
+            let entity = chunk.entity_path().to_string();
+            let Some(id) = entity.strip_prefix("/view/").filter(|rest| !rest.contains('/')) else { continue };
+            let Some(name) = latest(&entity, "ViewBlueprint:display_name") else { continue };
+            let name = name.as_string::<i32>().value(0).to_string();
+            let range = latest(&format!("/view/{id}/ScalarAxis"), "ScalarAxis:range").map(|r| {
+                let v = numbers(r.as_ref());
+                [v[0], v[1]]
+            });
+            views.insert(name, range);
+        }
+        views
     }
 
     pub fn entities(&self) -> BTreeMap<String, EntityInfo> {
