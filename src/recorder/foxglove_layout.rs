@@ -47,7 +47,20 @@ fn camera(model: &Model, q: &[f64]) -> ([f64; 3], f64) {
 /// The layout for `model`, whose run starts at joint positions `q0` (torque plots scaled by the
 /// viewer: the committed layout, for live runs of any command).
 pub fn layout(model: &Model, q0: &[f64]) -> Value {
-    layout_with_motors(model, q0, false, &[], &[])
+    layout_for_run(model, q0, &RunPlots::default())
+}
+
+/// What a run's plots show beyond angles and torques.
+#[derive(Default)]
+pub struct RunPlots<'a> {
+    /// `--motors`: each joint's speed-dependent torque limit beside its torque.
+    pub motors: bool,
+    /// Some joint has friction (its URDF's or its gearbox's): each joint's friction torque too.
+    pub friction: bool,
+    /// Per joint, driven open loop (stepper mode): a plot of load angles and lost steps.
+    pub stepped: &'a [bool],
+    /// Per joint, its torque plot's range.
+    pub torque_axes: &'a [TorqueAxis],
 }
 
 /// `panels` side by side (`direction` "row") or stacked ("column"), each given an equal share.
@@ -60,10 +73,10 @@ fn split_evenly(mut panels: Vec<Value>, direction: &str) -> Value {
     json!({ "first": split_evenly(panels, direction), "second": split_evenly(second, direction), "direction": direction, "splitPercentage": share })
 }
 
-/// With `--motors` (`motors`): each joint's speed-dependent torque limit beside its torque; with
-/// steppers driven open loop (`stepped`): a third plot of their load angles and lost steps. Each
-/// joint's torque plot spans ±`torque_axes[i].half_range` when given.
-pub fn layout_with_motors(model: &Model, q0: &[f64], motors: bool, stepped: &[bool], torque_axes: &[TorqueAxis]) -> Value {
+/// The layout of a run of `model` from `q0` showing `plots`. Each joint's torque plot spans
+/// ±`plots.torque_axes[i].half_range` when given.
+pub fn layout_for_run(model: &Model, q0: &[f64], plots: &RunPlots) -> Value {
+    let RunPlots { motors, friction, stepped, torque_axes } = *plots;
     let (target, distance) = camera(model, q0);
     let names: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();
     let angles = names
@@ -78,7 +91,8 @@ pub fn layout_with_motors(model: &Model, q0: &[f64], motors: bool, stepped: &[bo
         .enumerate()
         .map(|(i, n)| {
             let limit = motors.then(|| series(format!("/controller.torque_limit[{i}]"), format!("{n} limit")));
-            let paths = std::iter::once(series(format!("/controller.torque[{i}]"), format!("{n} torque"))).chain(limit).collect();
+            let friction = friction.then(|| series(format!("/controller.friction[{i}]"), format!("{n} friction")));
+            let paths = std::iter::once(series(format!("/controller.torque[{i}]"), format!("{n} torque"))).chain(limit).chain(friction).collect();
             let mut panel = plot(paths);
             if let Some(axis) = torque_axes.get(i) {
                 panel["minYValue"] = json!(-axis.half_range);
@@ -184,7 +198,8 @@ mod tests {
         let model = crate::model::load_urdf(&root.join(crate::builtin::DEFAULT_URDF)).unwrap();
         let n = model.dof();
         let axes: Vec<TorqueAxis> = (0..n).map(|i| TorqueAxis::new(0.1 * (i + 1) as f64, 35.0)).collect();
-        let l = layout_with_motors(&model, &vec![0.0; n], true, &[false, true, false, false, false, false], &axes);
+        let stepped = [false, true, false, false, false, false];
+        let l = layout_for_run(&model, &vec![0.0; n], &RunPlots { motors: true, friction: true, stepped: &stepped, torque_axes: &axes });
         // the tree places every configured panel exactly once, and only those
         let mut ids = Vec::new();
         placed(&l["layout"], &mut ids);
@@ -198,6 +213,7 @@ mod tests {
             assert_eq!(panel["maxYValue"], json!(axis.half_range));
             assert_eq!(panel["minYValue"], json!(-axis.half_range));
             assert_eq!(panel["paths"][1]["value"], json!(format!("/controller.torque_limit[{i}]")));
+            assert_eq!(panel["paths"][2]["value"], json!(format!("/controller.friction[{i}]")));
         }
         // the torque plots are placed in joint order
         let torque_ids: Vec<&String> = ids.iter().filter(|id| id.starts_with("Plot!torque")).collect();

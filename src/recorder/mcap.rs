@@ -743,7 +743,9 @@ impl Recorder for McapRecorder {
 /// The Foxglove layout for the run, beside its recording `mcap`.
 fn write_layout(run: &RunInfo, mcap: &std::path::Path, torque_axes: &[super::torque_axis::TorqueAxis]) -> Result<(), Error> {
     let e = run.experiment;
-    let layout = super::foxglove_layout::layout_with_motors(&e.model, &e.initial_state().0, e.motors.is_some(), &e.stepped_joints(), torque_axes);
+    let stepped = e.stepped_joints();
+    let plots = super::foxglove_layout::RunPlots { motors: e.motors.is_some(), friction: e.joint_has_friction().contains(&true), stepped: &stepped, torque_axes };
+    let layout = super::foxglove_layout::layout_for_run(&e.model, &e.initial_state().0, &plots);
     let layout_path = super::foxglove_layout::layout_path(mcap);
     std::fs::write(&layout_path, serde_json::to_string_pretty(&layout).unwrap_or_default()).map_err(|err| Error::output(&layout_path, err))
 }
