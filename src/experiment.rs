@@ -8,7 +8,7 @@ use crate::control::within_effort::{MOTION_LOAD, START_LOAD, carried_wave, holda
 use crate::plant::{JointFriction, ContinuousPlant, DiscretePlant, Plant, Tolerances};
 use crate::actuator::{MotorSet, OpenLoopSteppers, load_motor_file};
 use crate::model::{Actuator, LoadOptions, Model, load_urdf_with};
-use crate::diagnose::analysis::LoopPlant;
+use crate::control::sampled_loop::LoopPlant;
 use crate::control::trajectory::{Hold, JointSchedule, JointStep, JointWave, RampIn, Trajectory, Wave};
 use nalgebra::Vector3;
 use std::sync::Arc;

@@ -34,7 +34,7 @@ fn mesh_model_has_transmissions_meshes_and_the_tutorials_proportions() {
     let total: f64 = model.joints.iter().map(|j| j.inertia.mass).sum::<f64>() + 0.782;
     assert!((total - 2.27).abs() < 0.01, "total mass {total}");
     // effective inertias of the distal joints are of the tutorial's order (3e-5 and 6e-6)
-    let gains = armscope::control::gains::auto_tune(&model, &[vec![0.0; 6]], 0.001, true, armscope::diagnose::analysis::LoopPlant::Discrete);
+    let gains = armscope::control::gains::auto_tune(&model, &[vec![0.0; 6]], 0.001, true, armscope::control::sampled_loop::LoopPlant::Discrete);
     let inertia = gains.effective_inertia.unwrap();
     assert!(inertia[3] > 1e-5 && inertia[3] < 6e-5, "J4 {}", inertia[3]);
     assert!(inertia[4] > 2e-6 && inertia[4] < 1.2e-5, "J5 {}", inertia[4]);

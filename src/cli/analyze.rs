@@ -30,7 +30,7 @@ pub struct AnalyzeArgs {
     pub wave: WaveArgs,
     /// The plant in the loop.
     #[arg(long, value_enum, default_value = "discrete")]
-    pub plant: crate::diagnose::analysis::LoopPlant,
+    pub plant: crate::control::sampled_loop::LoopPlant,
     /// Print the result as JSON.
     #[arg(long)]
     pub json: bool,

@@ -34,7 +34,7 @@ pub struct EnvelopeArgs {
 
 /// `armscope envelope`.
 pub fn envelope(args: &EnvelopeArgs) -> Result<i32, Error> {
-    use crate::diagnose::analysis::{Linearization, LoopPlant, spectral_radius, stabilizing_kd};
+    use crate::control::sampled_loop::{Linearization, LoopPlant, spectral_radius, stabilizing_kd};
     use crate::diagnose::envelope::sweep;
     let freqs = args.freqs.clone().unwrap_or_else(|| (0..10).map(|i| 0.25 * 64f64.powf(i as f64 / 9.0)).map(|f| (f * 100.0).round() / 100.0).collect());
     let amps = args.amps.clone().unwrap_or_else(|| (0..10).map(|i| 5.0 + 55.0 * i as f64 / 9.0).map(|a| a.round()).collect());

@@ -1,6 +1,6 @@
 //! Controller gains: the tutorial's for its box model, otherwise tuned from the mass matrix.
 
-use crate::diagnose::analysis::{Linearization, LoopPlant, modes_over, worst_radius};
+use crate::control::sampled_loop::{Linearization, LoopPlant, modes_over, worst_radius};
 use crate::model::Model;
 use serde::Serialize;
 

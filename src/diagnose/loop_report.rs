@@ -2,7 +2,7 @@
 //! radius at a pose (and along the command), the joints that drive an instability, the largest
 //! stable control period, and derivative gains that would make it stable — as text or JSON.
 
-use super::analysis::{Linearization, LoopPlant, largest_stable_period, spectral_radius, stabilizing_kd_over, worst_radius};
+use crate::control::sampled_loop::{Linearization, LoopPlant, largest_stable_period, spectral_radius, stabilizing_kd_over, worst_radius};
 use crate::experiment::Experiment;
 use serde_json::{Value, json};
 use std::path::Path;
