@@ -9,6 +9,7 @@ mod lossy_gear;
 mod open_loop;
 mod servo;
 mod stepper;
+pub mod thermal;
 
 pub use catalogue::{Catalogue, load_motor_file};
 pub use lossy_gear::LossyGear;
