@@ -121,6 +121,12 @@ impl Experiment {
         }
     }
 
+    /// Per coordinate, its motor's thermal data and gear ratio (`--motors`, where the catalogue
+    /// gives the motor's thermal data; None elsewhere).
+    pub fn motor_heat(&self) -> Vec<Option<(crate::actuator::thermal::WindingHeat, f64)>> {
+        self.motors.as_ref().map_or_else(|| vec![None; self.model.dof()], |m| m.heat())
+    }
+
     /// Per coordinate, the gearbox losses of the joint's drive train (`--motors`; None without).
     pub fn gears(&self) -> Vec<Option<crate::actuator::LossyGear>> {
         self.motors.as_ref().map_or_else(|| vec![None; self.model.dof()], |m| m.gears())

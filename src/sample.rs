@@ -38,6 +38,9 @@ pub struct Sample<'a> {
     pub friction: &'a [f64],
     /// Per joint with friction: stuck (q̇ exactly 0, held by friction); empty without friction.
     pub stuck: &'a [bool],
+    /// Per joint, its motor's winding temperature, °C (NaN where the motor has no thermal data;
+    /// empty when no motor of the run has).
+    pub winding_temperature: &'a [f64],
     pub tool_position: Vector3<f64>,
     /// Where the command puts the tool (forward kinematics of cmd).
     pub tool_target: Vector3<f64>,

@@ -52,6 +52,9 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
     let started = Instant::now();
     let mut status = RunStatus::Completed;
     let mut audit = EnergyAudit::new(experiment);
+    // the motors' windings, where their thermal data is known
+    let mut heat = crate::actuator::thermal::RunHeat::new(&experiment.motor_heat(), dt);
+    let no_temperatures: Vec<f64> = Vec::new();
 
     for k in 0..=experiment.steps {
         let t = k as f64 * dt;
@@ -97,6 +100,7 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
             at_limit: &at_limit,
             friction: &friction,
             stuck: &stuck,
+            winding_temperature: if heat.any() { &heat.winding_temperature } else { &no_temperatures },
             tool_position: frame_pose(model, &data, model.tool_frame).translation,
             tool_target: frame_pose_in(model, &command_poses, model.tool_frame).translation,
             body_pose: &data.body_pose,
@@ -110,6 +114,10 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
                 status = RunStatus::Interrupted { time: t };
             }
             break;
+        }
+        if heat.any() {
+            // the motors carry this step's torque (a stepper's as it stood at the control step)
+            heat.step(&u);
         }
         if let Some(a) = audit.as_mut() {
             // the loop's passes left the kinematics and body velocities at (q_k, q̇_k) in data
@@ -154,6 +162,9 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
         }
     }
     let mut summary = stats.finish(status, started.elapsed().as_secs_f64());
+    if heat.any() {
+        summary.winding = heat.summary();
+    }
     summary.energy_balance = audit.map(|a| EnergyBalance { created: a.created, work: a.work });
     for r in recorders.iter_mut() {
         r.finish(&info, &summary)?;

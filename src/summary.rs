@@ -64,6 +64,13 @@ pub struct Summary {
     /// shorter): the motion's own demand, the start aside.
     #[serde(default)]
     pub peak_abs_torque_after_settle: Vec<Option<f64>>,
+    /// Per joint, the RMS of its torque over the run's control steps, N·m (what heats a motor: the
+    /// vendors' check against the continuous rating).
+    #[serde(default)]
+    pub rms_torque: Vec<f64>,
+    /// Per joint whose motor has thermal data: its winding over the run (empty when no motor has).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub winding: Vec<Option<crate::actuator::thermal::WindingSummary>>,
     /// Per joint, the largest |friction torque| over the run, N·m (empty without friction).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub peak_friction_torque: Vec<f64>,
@@ -117,6 +124,7 @@ pub struct SummaryBuilder {
     peak_torque: Vec<f64>,
     peak_torque_in_window: Vec<f64>,
     peak_friction: Vec<f64>,
+    sum_squared_torque: Vec<f64>,
     stuck_steps: Vec<u64>,
     effort: Vec<f64>,
     lowest_limit: Vec<f64>,
@@ -148,6 +156,7 @@ impl SummaryBuilder {
             peak_torque: vec![0.0; n],
             peak_torque_in_window: vec![0.0; n],
             peak_friction: Vec::new(),
+            sum_squared_torque: vec![0.0; n],
             stuck_steps: Vec::new(),
             lowest_limit: effort.clone(),
             peak_share: vec![0.0; n],
@@ -200,6 +209,7 @@ impl SummaryBuilder {
                 self.saturated_in_window[i] += (in_window && s.saturated[i]) as u64;
                 self.chatter_steps[i] += s.chatter[i] as u64;
                 self.peak_torque[i] = self.peak_torque[i].max(s.u[i].abs());
+                self.sum_squared_torque[i] += s.u[i] * s.u[i];
                 if in_window {
                     self.peak_torque_in_window[i] = self.peak_torque_in_window[i].max(s.u[i].abs());
                 }
@@ -262,6 +272,8 @@ impl SummaryBuilder {
             chatter_percent: share_of_control_steps(&self.chatter_steps),
             peak_abs_torque: self.peak_torque.clone(),
             peak_abs_torque_after_settle: self.peak_torque_in_window.iter().map(|&p| (window_control_steps > 0).then_some(p)).collect(),
+            rms_torque: self.sum_squared_torque.iter().map(|&s| if self.control_steps == 0 { 0.0 } else { (s / self.control_steps as f64).sqrt() }).collect(),
+            winding: Vec::new(),
             peak_friction_torque: self.peak_friction.clone(),
             stuck_percent: share_of_control_steps(&self.stuck_steps),
             effort_limit: self.effort.clone(),

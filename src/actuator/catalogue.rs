@@ -95,7 +95,25 @@ fn drive_train_from(source: &Path, name: &str, t: &toml::Table) -> Result<DriveT
     let kind = fields.string("kind")?;
     let (gear_ratio, rated) = (fields.optional_positive("gearbox_ratio")?.unwrap_or(1.0), fields.optional_positive("gearbox_rated_torque")?.unwrap_or(f64::INFINITY));
     let gear = fields.gear("gearbox_")?;
-    let common = ["kind", "gearbox_ratio", "gearbox_efficiency", "gearbox_backdrive_efficiency", "gearbox_breakaway_torque", "gearbox_viscous", "gearbox_rated_torque", "rotor_inertia", "source"];
+    let heat = fields.heat()?;
+    let common = [
+        "kind",
+        "gearbox_ratio",
+        "gearbox_efficiency",
+        "gearbox_backdrive_efficiency",
+        "gearbox_breakaway_torque",
+        "gearbox_viscous",
+        "gearbox_rated_torque",
+        "rotor_inertia",
+        "source",
+        "torque_constant",
+        "terminal_resistance",
+        "thermal_resistance_winding_housing",
+        "thermal_resistance_housing_ambient",
+        "thermal_time_constant_winding",
+        "thermal_time_constant_motor",
+        "max_winding_temperature",
+    ];
     let motor: Box<dyn Motor> = match kind.as_str() {
         "stepper" => {
             fields.known(&[&common[..], &["holding_torque", "step_angle", "inductance", "current", "supply_voltage", "pull_out", "resistance", "mass", "detent_torque"]].concat())?;
@@ -118,13 +136,15 @@ fn drive_train_from(source: &Path, name: &str, t: &toml::Table) -> Result<DriveT
                 pull_out,
             })
         }
-        "servo" => {
-            fields.known(&[&common[..], &["stall_torque", "no_load_speed", "mass", "voltage"]].concat())?;
+        // a bus servo (its gearbox inside: numbers at the horn) or a bare DC/BLDC motor: both a
+        // straight torque–speed line from the stall torque to the no-load speed
+        "servo" | "dc" => {
+            fields.known(&[&common[..], &["stall_torque", "no_load_speed", "mass", "voltage", "inductance", "nominal_torque"]].concat())?;
             Box::new(DcServo { name: name.to_string(), stall_torque: fields.positive("stall_torque")?, no_load_speed: fields.positive("no_load_speed")?, rotor_inertia: fields.non_negative("rotor_inertia")? })
         }
-        other => return Err(fail(source, format!("{what}: field 'kind' is '{other}', expected 'stepper' or 'servo'"))),
+        other => return Err(fail(source, format!("{what}: field 'kind' is '{other}', expected 'stepper', 'servo' or 'dc'"))),
     };
-    Ok(DriveTrain { motor, gear_ratio, gear, rated_torque: rated })
+    Ok(DriveTrain { motor, gear_ratio, gear, rated_torque: rated, heat })
 }
 
 /// A TOML table's fields, each checked with an error naming the file, the entry and the field.
@@ -177,6 +197,38 @@ impl Fields<'_> {
             None => efficiency,
         };
         Ok(LossyGear { efficiency, backdrive_efficiency, breakaway_torque: self.non_negative(&format!("{prefix}breakaway_torque"))?, viscous: self.non_negative(&format!("{prefix}viscous"))? })
+    }
+
+    /// The motor's thermal data: all of torque_constant, terminal_resistance (Ω at 25 °C),
+    /// thermal_resistance_winding_housing, thermal_resistance_housing_ambient (K/W),
+    /// thermal_time_constant_winding, thermal_time_constant_motor (s) and max_winding_temperature
+    /// (°C), or none of them (the motor is then not thermally checked).
+    fn heat(&self) -> Result<Option<super::thermal::WindingHeat>, Error> {
+        const FIELDS: [&str; 7] = [
+            "torque_constant",
+            "terminal_resistance",
+            "thermal_resistance_winding_housing",
+            "thermal_resistance_housing_ambient",
+            "thermal_time_constant_winding",
+            "thermal_time_constant_motor",
+            "max_winding_temperature",
+        ];
+        let given: Vec<&str> = FIELDS.iter().copied().filter(|f| self.table.contains_key(*f)).collect();
+        if given.is_empty() {
+            return Ok(None);
+        }
+        if let Some(missing) = FIELDS.iter().find(|f| !given.contains(f)) {
+            return Err(self.err(missing, &format!("is missing: a thermal model needs all of {}", FIELDS.join(", "))));
+        }
+        let thermal = super::thermal::ThermalData {
+            resistance_25: self.positive("terminal_resistance")?,
+            winding_to_housing: self.positive("thermal_resistance_winding_housing")?,
+            housing_to_ambient: self.positive("thermal_resistance_housing_ambient")?,
+            winding_time_constant: self.positive("thermal_time_constant_winding")?,
+            motor_time_constant: self.positive("thermal_time_constant_motor")?,
+            max_winding_temperature: self.positive("max_winding_temperature")?,
+        };
+        Ok(Some(super::thermal::WindingHeat { thermal, torque_constant: self.positive("torque_constant")? }))
     }
 
     fn non_negative(&self, field: &str) -> Result<f64, Error> {

@@ -52,13 +52,15 @@ pub struct DriveTrain {
     pub gear: LossyGear,
     /// The gearbox's rated output torque, N·m (infinite when not limited).
     pub rated_torque: f64,
+    /// The motor's thermal data, where its datasheet gives it (None: not thermally checked).
+    pub heat: Option<thermal::WindingHeat>,
 }
 
 impl DriveTrain {
     /// A drive train whose gearbox loses the same fraction both ways (η_b = η) and has no friction
     /// at no load.
     pub fn new(motor: Box<dyn Motor>, gear_ratio: f64, efficiency: f64, rated_torque: f64) -> Self {
-        Self { motor, gear_ratio, gear: LossyGear::with_efficiency(efficiency), rated_torque }
+        Self { motor, gear_ratio, gear: LossyGear::with_efficiency(efficiency), rated_torque, heat: None }
     }
 
     /// The gearbox's efficiency when the motor drives, η.
@@ -124,6 +126,7 @@ impl DriveTrain {
             gear: self.gear.followed_by(gear_ratio, &next),
             gear_ratio: self.gear_ratio * gear_ratio,
             motor: self.motor,
+            heat: self.heat,
         }
     }
 
@@ -198,6 +201,11 @@ impl MotorSet {
     /// Per coordinate, the gearbox losses of the joint's drive train (None without one).
     pub fn gears(&self) -> Vec<Option<LossyGear>> {
         self.joints.iter().map(|d| d.as_ref().map(|d| d.gear)).collect()
+    }
+
+    /// Per coordinate, its motor's thermal data and the gear ratio between them (None without one).
+    pub fn heat(&self) -> Vec<Option<(thermal::WindingHeat, f64)>> {
+        self.joints.iter().map(|d| d.as_ref().and_then(|d| d.heat.map(|h| (h, d.gear_ratio)))).collect()
     }
 
     /// Whether any joint has a stepper.

@@ -90,7 +90,7 @@ impl OpenLoopSteppers {
     pub fn new(motors: &MotorSet, start: &[f64], inertia: &[f64], load: &[f64]) -> Option<Self> {
         let mut joints = Vec::new();
         for (j, drive) in motors.joints.iter().enumerate() {
-            let Some(DriveTrain { motor, gear_ratio, gear, rated_torque }) = drive else { continue };
+            let Some(DriveTrain { motor, gear_ratio, gear, rated_torque, .. }) = drive else { continue };
             let Some(stepper) = motor.as_stepper() else { continue };
             let micro = motors.microsteps.get(j).copied().flatten().unwrap_or(1) as f64;
             let mut joint = SteppedJoint {

@@ -72,6 +72,95 @@ impl ThermalData {
     }
 }
 
+/// A motor's thermal data with what turns its torque into current: I = |τ_motor| / K_t.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WindingHeat {
+    pub thermal: ThermalData,
+    /// N·m/A.
+    pub torque_constant: f64,
+}
+
+/// The ambient temperature of every run, °C (the datasheets' reference).
+pub const AMBIENT_TEMPERATURE: f64 = 25.0;
+
+/// What a run did to one motor's winding.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct WindingSummary {
+    /// The hottest the winding got, °C.
+    pub peak_temperature: f64,
+    /// Its permissible limit, °C.
+    pub max_temperature: f64,
+    /// The run's RMS motor current, A.
+    pub rms_current: f64,
+    /// The winding's steady temperature at that RMS current, °C (None: thermal runaway).
+    pub steady_temperature: Option<f64>,
+    /// Seconds after the run's end at which the winding would reach its limit if the motion went on
+    /// at the run's RMS current (0: reached during the run; None: never).
+    pub time_to_limit: Option<f64>,
+}
+
+/// Every joint's motor heat over a run: per joint with thermal data, its winding and housing.
+#[derive(Clone, Debug)]
+pub struct RunHeat {
+    motors: Vec<Option<(MotorHeat, f64)>>,
+    /// Winding temperature per joint, °C (NaN for joints without thermal data).
+    pub winding_temperature: Vec<f64>,
+    peak: Vec<f64>,
+    sum_squared_current: Vec<f64>,
+    steps: u64,
+}
+
+impl RunHeat {
+    /// Per joint: its motor's heat data and gear ratio N (the joint torque u is N·τ_motor).
+    pub fn new(heat: &[Option<(WindingHeat, f64)>], dt: f64) -> Self {
+        let motors: Vec<_> = heat.iter().map(|h| h.map(|(w, ratio)| (MotorHeat::new(w.thermal, AMBIENT_TEMPERATURE, dt), w.torque_constant * ratio))).collect();
+        let winding_temperature = winding_temperature_of(&motors);
+        let n = heat.len();
+        Self { peak: winding_temperature_of(&motors), motors, winding_temperature, sum_squared_current: vec![0.0; n], steps: 0 }
+    }
+
+    /// Whether any joint's motor has thermal data.
+    pub fn any(&self) -> bool {
+        self.motors.iter().any(Option::is_some)
+    }
+
+    /// One control step carrying the joint torques `u` (held over it).
+    pub fn step(&mut self, u: &[f64]) {
+        self.steps += 1;
+        for (i, motor) in self.motors.iter_mut().enumerate() {
+            let Some((heat, newton_metres_per_amp)) = motor else { continue };
+            let current = u[i].abs() / *newton_metres_per_amp;
+            self.sum_squared_current[i] += current * current;
+            heat.step(current);
+            self.winding_temperature[i] = heat.winding_temperature();
+            self.peak[i] = self.peak[i].max(self.winding_temperature[i]);
+        }
+    }
+
+    /// Per joint with thermal data, what the run did to its winding.
+    pub fn summary(&self) -> Vec<Option<WindingSummary>> {
+        self.motors
+            .iter()
+            .enumerate()
+            .map(|(i, motor)| {
+                let (heat, _) = motor.as_ref()?;
+                let rms_current = (self.sum_squared_current[i] / self.steps.max(1) as f64).sqrt();
+                Some(WindingSummary {
+                    peak_temperature: self.peak[i],
+                    max_temperature: heat.data.max_winding_temperature,
+                    rms_current,
+                    steady_temperature: heat.data.steady_winding_temperature(rms_current, heat.ambient),
+                    time_to_limit: if self.peak[i] >= heat.data.max_winding_temperature { Some(0.0) } else { heat.time_to_limit(rms_current) },
+                })
+            })
+            .collect()
+    }
+}
+
+fn winding_temperature_of(motors: &[Option<(MotorHeat, f64)>]) -> Vec<f64> {
+    motors.iter().map(|m| m.as_ref().map_or(f64::NAN, |(m, _)| m.winding_temperature())).collect()
+}
+
 /// One motor's winding and housing temperatures over a run.
 #[derive(Clone, Debug)]
 pub struct MotorHeat {

@@ -162,6 +162,17 @@ pub fn write_summary(out: &mut dyn Write, s: &Summary) -> std::io::Result<()> {
     if s.peak_abs_torque_after_settle.iter().any(|p| p.is_some()) {
         writeln!(out, "{}   (t >= {} s: the motion's own)", row("  after settling", s.peak_abs_torque_after_settle.iter().map(|p| p.map_or("n/a".into(), |p| format!("{p:.3}"))).collect()), s.error_window_start)?;
     }
+    writeln!(out, "{}", row("RMS |u| (N·m)", s.rms_torque.iter().map(|p| format!("{p:.3}")).collect()))?;
+    if s.winding.iter().any(Option::is_some) {
+        let cell = |f: &dyn Fn(&crate::actuator::thermal::WindingSummary) -> String| s.winding.iter().map(|w| w.as_ref().map_or("-".to_string(), f)).collect::<Vec<_>>();
+        writeln!(out, "{}", row("winding peak (°C)", cell(&|w| format!("{:.1}", w.peak_temperature))))?;
+        writeln!(out, "{}   (at the run's RMS current, 25 °C ambient)", row("  steady / limit (°C)", cell(&|w| format!("{}/{:.0}", w.steady_temperature.map_or("runaway".into(), |t| format!("{t:.0}")), w.max_temperature))))?;
+        writeln!(out, "{}   (going on at the run's RMS current)", row("  limit reached in", cell(&|w| w.time_to_limit.map_or("never".into(), |t| if t == 0.0 { "reached".into() } else { format!("{t:.0} s") }))))?;
+        let unchecked: Vec<&str> = s.joints.iter().zip(&s.winding).filter(|(_, w)| w.is_none()).map(|(j, _)| j.as_str()).collect();
+        if !unchecked.is_empty() {
+            writeln!(out, "  not thermally checked (no thermal data for their motors): {}", unchecked.join(", "))?;
+        }
+    }
     if !s.stuck_percent.is_empty() {
         writeln!(out, "{}", row("peak friction (N·m)", s.peak_friction_torque.iter().map(|p| format!("{p:.3}")).collect()))?;
         writeln!(out, "{}", row("stuck (%)", s.stuck_percent.iter().map(|p| format!("{p:.1}")).collect()))?;

@@ -61,6 +61,8 @@ pub struct RunPlots<'a> {
     pub stepped: &'a [bool],
     /// Per joint, its torque plot's range.
     pub torque_axes: &'a [TorqueAxis],
+    /// Per joint, its motor has thermal data: a plot of the winding temperatures.
+    pub heated: &'a [bool],
 }
 
 /// `panels` side by side (`direction` "row") or stacked ("column"), each given an equal share.
@@ -76,7 +78,7 @@ fn split_evenly(mut panels: Vec<Value>, direction: &str) -> Value {
 /// The layout of a run of `model` from `q0` showing `plots`. Each joint's torque plot spans
 /// ±`plots.torque_axes[i].half_range` when given.
 pub fn layout_for_run(model: &Model, q0: &[f64], plots: &RunPlots) -> Value {
-    let RunPlots { motors, friction, stepped, torque_axes } = *plots;
+    let RunPlots { motors, friction, stepped, torque_axes, heated } = *plots;
     let (target, distance) = camera(model, q0);
     let names: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();
     let angles = names
@@ -118,6 +120,12 @@ pub fn layout_for_run(model: &Model, q0: &[f64], plots: &RunPlots) -> Value {
     };
     let visible = |topics: &[&str]| topics.iter().map(|t| (t.to_string(), json!({ "visible": true }))).collect::<serde_json::Map<_, _>>();
     let has_steppers = !steppers.is_empty();
+    let temperatures: Vec<Value> = names
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| heated.get(*i).copied().unwrap_or(false))
+        .map(|(i, n)| series(format!("/controller.winding_temperature[{i}]"), format!("{n} winding (°C)")))
+        .collect();
     let mut doc = json!({
         "configById": {
             "3D!arm": {
@@ -151,6 +159,12 @@ pub fn layout_for_run(model: &Model, q0: &[f64], plots: &RunPlots) -> Value {
     });
     for (id, panel) in torque_plots {
         doc["configById"][id] = panel;
+    }
+    if !temperatures.is_empty() {
+        // below the arm: the windings heat over minutes, the plot beside the 3D view reads it
+        doc["configById"]["Plot!temperatures"] = plot(temperatures);
+        let arm = doc["layout"]["first"].take();
+        doc["layout"]["first"] = json!({ "first": arm, "second": "Plot!temperatures", "direction": "column", "splitPercentage": 70 });
     }
     if has_steppers {
         doc["configById"]["Plot!steppers"] = plot(steppers);
@@ -199,7 +213,8 @@ mod tests {
         let n = model.dof();
         let axes: Vec<TorqueAxis> = (0..n).map(|i| TorqueAxis::new(0.1 * (i + 1) as f64, 35.0)).collect();
         let stepped = [false, true, false, false, false, false];
-        let l = layout_for_run(&model, &vec![0.0; n], &RunPlots { motors: true, friction: true, stepped: &stepped, torque_axes: &axes });
+        let heated = [false, true, false, false, false, false];
+        let l = layout_for_run(&model, &vec![0.0; n], &RunPlots { motors: true, friction: true, stepped: &stepped, torque_axes: &axes, heated: &heated });
         // the tree places every configured panel exactly once, and only those
         let mut ids = Vec::new();
         placed(&l["layout"], &mut ids);
@@ -215,6 +230,9 @@ mod tests {
             assert_eq!(panel["paths"][1]["value"], json!(format!("/controller.torque_limit[{i}]")));
             assert_eq!(panel["paths"][2]["value"], json!(format!("/controller.friction[{i}]")));
         }
+        // the one motor with thermal data: its winding temperature
+        assert_eq!(l["configById"]["Plot!temperatures"]["paths"].as_array().unwrap().len(), 1);
+        assert_eq!(l["configById"]["Plot!temperatures"]["paths"][0]["value"], "/controller.winding_temperature[1]");
         // the torque plots are placed in joint order
         let torque_ids: Vec<&String> = ids.iter().filter(|id| id.starts_with("Plot!torque")).collect();
         assert_eq!(torque_ids, (0..n).map(|i| format!("Plot!torque{i}")).collect::<Vec<_>>().iter().collect::<Vec<_>>());

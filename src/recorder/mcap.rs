@@ -602,6 +602,7 @@ impl Recorder for McapRecorder {
             motor_speed: vec![0.0; n],
             friction: if has_friction { vec![0.0; n] } else { Vec::new() },
             stuck: if has_friction { vec![0; n] } else { Vec::new() },
+            winding_temperature: Vec::new(),
         };
         self.motors = e.motors.clone();
         self.scene = scene_from_model(model).map_err(|(path, err)| Error::output(&path, err))?;
@@ -667,6 +668,8 @@ impl Recorder for McapRecorder {
             tel.lost_steps[j] = s.lost_steps[j];
             tel.motor_speed[j] = self.motors.as_ref().and_then(|m| m.motor_speed(j, s.v[j])).unwrap_or(0.0);
         }
+        tel.winding_temperature.clear();
+        tel.winding_temperature.extend_from_slice(s.winding_temperature);
         if !s.friction.is_empty() {
             tel.friction.copy_from_slice(s.friction);
             for (flag, &stuck) in tel.stuck.iter_mut().zip(s.stuck) {
@@ -744,7 +747,8 @@ impl Recorder for McapRecorder {
 fn write_layout(run: &RunInfo, mcap: &std::path::Path, torque_axes: &[super::torque_axis::TorqueAxis]) -> Result<(), Error> {
     let e = run.experiment;
     let stepped = e.stepped_joints();
-    let plots = super::foxglove_layout::RunPlots { motors: e.motors.is_some(), friction: e.joint_has_friction().contains(&true), stepped: &stepped, torque_axes };
+    let heated: Vec<bool> = e.motor_heat().iter().map(Option::is_some).collect();
+    let plots = super::foxglove_layout::RunPlots { motors: e.motors.is_some(), friction: e.joint_has_friction().contains(&true), stepped: &stepped, torque_axes, heated: &heated };
     let layout = super::foxglove_layout::layout_for_run(&e.model, &e.initial_state().0, &plots);
     let layout_path = super::foxglove_layout::layout_path(mcap);
     std::fs::write(&layout_path, serde_json::to_string_pretty(&layout).unwrap_or_default()).map_err(|err| Error::output(&layout_path, err))

@@ -65,6 +65,8 @@ struct JointColumns {
     motor_speed: Vec<f64>,
     /// With joint friction: `joints/<joint>/friction`, [friction torque, stuck 0/1] per step.
     friction: Vec<f64>,
+    /// A motor with thermal data: `joints/<joint>/winding_temperature`, °C per step.
+    winding: Vec<f64>,
 }
 
 impl JointColumns {
@@ -80,11 +82,12 @@ impl JointColumns {
             lost_steps: Vec::new(),
             motor_speed: Vec::new(),
             friction: Vec::new(),
+            winding: Vec::new(),
         }
     }
 
     fn clear(&mut self) {
-        for c in [&mut self.position, &mut self.torque, &mut self.status, &mut self.saturated_times, &mut self.saturated_torque, &mut self.limit, &mut self.load_angle, &mut self.lost_steps, &mut self.motor_speed, &mut self.friction] {
+        for c in [&mut self.position, &mut self.torque, &mut self.status, &mut self.saturated_times, &mut self.saturated_torque, &mut self.limit, &mut self.load_angle, &mut self.lost_steps, &mut self.motor_speed, &mut self.friction, &mut self.winding] {
             c.clear();
         }
     }
@@ -133,6 +136,8 @@ pub struct RerunRecorder {
     /// Messages for the user (no viewer found, …).
     pub notices: Vec<String>,
     notice_sink: Option<Box<dyn Fn(&str) + Send>>,
+    /// Per joint: its motor has thermal data (its winding temperature is recorded).
+    heated: Vec<bool>,
 }
 
 /// Steps per block in a file-only recording: ~4 s of simulation per chunk (fewer, larger chunks
@@ -175,6 +180,7 @@ impl RerunRecorder {
             last_flush: Instant::now(),
             notices: Vec::new(),
             notice_sink: None,
+            heated: Vec::new(),
         }
     }
 
@@ -326,6 +332,7 @@ impl RerunRecorder {
                 ("lost_steps", lines(&[format!("{name} lost steps (full)")], &[red], &[2.0])),
                 ("motor_speed", lines(&[format!("{name} motor speed (rev/s)")], &[c], &[1.5])),
                 ("friction", lines(&[format!("{name} friction (N·m)"), format!("{name} stuck (0/1)")], &[rerun::Color::from_rgb(150, 100, 200), rerun::Color::from_rgb(100, 100, 100)], &[1.0, 1.0])),
+                ("winding_temperature", lines(&[format!("{name} winding (°C)")], &[c], &[1.5])),
             ];
             for (leaf, style) in styles {
                 rec.log_static(format!("{base}/{leaf}"), &style).map_err(e)?;
@@ -374,6 +381,9 @@ impl RerunRecorder {
             }
             if !c.friction.is_empty() {
                 send(&format!("{base}/friction"), time.clone(), scalars(&c.friction, 2))?;
+            }
+            if !c.winding.is_empty() {
+                send(&format!("{base}/winding_temperature"), time.clone(), scalars(&c.winding, 1))?;
             }
             if self.stepped[j] {
                 send(&format!("{base}/load_angle"), time.clone(), scalars(&c.load_angle, 1))?;
@@ -546,7 +556,7 @@ pub fn joint_color(j: usize) -> rerun::Color {
 /// With steppers driven open loop (`stepped`), a third row: each one's load angle and lost steps.
 /// Each torque view's y range is `torque_axes`' (the motion's own torque, the limit beside it where
 /// near; [`TorqueAxis`]): returned beside the blueprint as (view, half range), for [`send_blueprint`].
-pub fn blueprint(joint_names: &[String], stepped: &[bool], torque_axes: &[TorqueAxis], prefix: &str) -> (Blueprint, Vec<(rerun::EntityPath, f64)>) {
+pub fn blueprint(joint_names: &[String], stepped: &[bool], heated: &[bool], torque_axes: &[TorqueAxis], prefix: &str) -> (Blueprint, Vec<(rerun::EntityPath, f64)>) {
     let angle_views = joint_names.iter().map(|j| {
         TimeSeriesView::new(format!("{j} angle vs target"))
             .with_origin(format!("{prefix}joints/{j}"))
@@ -570,12 +580,18 @@ pub fn blueprint(joint_names: &[String], stepped: &[bool], torque_axes: &[Torque
         })
         .collect();
     let columns = joint_names.len().div_ceil(2).clamp(1, 4) as u32;
-    let left = Vertical::new([
+    let mut left_views: Vec<ContainerLike> = vec![
         Spatial3DView::new("arm").with_origin(format!("{prefix}world")).into(),
         TimeSeriesView::new("tool position").with_origin(format!("{prefix}tool")).into(),
         TimeSeriesView::new("tool tip error").with_origin(format!("{prefix}tool_error")).into(),
-    ])
-    .with_row_shares([4.0, 1.0, 1.0]);
+    ];
+    let mut left_shares = vec![4.0, 1.0, 1.0];
+    let windings: Vec<String> = joint_names.iter().zip(heated).filter(|(_, h)| **h).map(|(j, _)| format!("/{prefix}joints/{j}/winding_temperature")).collect();
+    if !windings.is_empty() {
+        left_views.push(TimeSeriesView::new("motor winding temperature (°C)").with_origin(format!("/{prefix}joints")).with_contents(windings).into());
+        left_shares.push(1.0);
+    }
+    let left = Vertical::new(left_views).with_row_shares(left_shares);
     let stepper_views: Vec<_> = joint_names
         .iter()
         .zip(stepped.iter().chain(std::iter::repeat(&false)))
@@ -679,6 +695,7 @@ impl Recorder for RerunRecorder {
         self.joint_names = model.joints.iter().map(|j| j.name.clone()).collect();
         self.effort = e.controller().effort;
         self.stepped = e.stepped_joints();
+        self.heated = e.motor_heat().iter().map(Option::is_some).collect();
         self.motors = e.motors.clone();
         let cap = FILE_BLOCK_STEPS + 1;
         self.times = Vec::with_capacity(cap);
@@ -698,7 +715,7 @@ impl Recorder for RerunRecorder {
         // the layout: a live viewer needs it now (scaled by the motion's torque); a file gets it at
         // the end, scaled by what the run did as well
         if self.live {
-            let (layout, torque_ranges) = blueprint(&self.joint_names, &self.stepped, &run.torque_axes, "");
+            let (layout, torque_ranges) = blueprint(&self.joint_names, &self.stepped, &self.heated, &run.torque_axes, "");
             send_blueprint(&rec, &layout, &torque_ranges).map_err(|x| self.err(x))?;
         }
         self.log_static_scene(&rec, model)?;
@@ -747,6 +764,9 @@ impl Recorder for RerunRecorder {
             if !s.friction.is_empty() {
                 c.friction.extend_from_slice(&[s.friction[j], flag(s.stuck[j])]);
             }
+            if self.heated[j] {
+                c.winding.push(s.winding_temperature[j]);
+            }
             if s.saturated[j] {
                 c.saturated_times.push(s.t);
                 c.saturated_torque.push(s.u[j]);
@@ -791,7 +811,7 @@ impl Recorder for RerunRecorder {
         let settled = |i: usize| summary.peak_abs_torque_after_settle.get(i).copied().flatten();
         let axes: Vec<_> = run.torque_axes.iter().enumerate().map(|(i, axis)| axis.after_run(settled(i))).collect();
         if !self.live || axes != run.torque_axes {
-            let (layout, torque_ranges) = blueprint(&self.joint_names, &self.stepped, &axes, "");
+            let (layout, torque_ranges) = blueprint(&self.joint_names, &self.stepped, &self.heated, &axes, "");
             send_blueprint(&rec, &layout, &torque_ranges).map_err(|x| self.err(x))?;
         }
         if self.path.points().len() > 1 {

@@ -60,6 +60,10 @@ pub struct ControllerTelemetry {
     /// 1 where the joint is stuck, held still by its friction (empty when no joint has friction).
     #[prost(uint32, repeated, tag = "15")]
     pub stuck: Vec<u32>,
+    /// Each joint's motor winding temperature, °C (NaN where its motor has no thermal data; empty
+    /// when no motor of the run has).
+    #[prost(double, repeated, tag = "16")]
+    pub winding_temperature: Vec<f64>,
 }
 
 /// The schema as MCAP's protobuf profile wants it: a serialized FileDescriptorSet. Kept next to
@@ -91,6 +95,7 @@ pub fn file_descriptor_set() -> Vec<u8> {
             field("motor_speed", 13, true, Type::Double),
             field("friction", 14, true, Type::Double),
             field("stuck", 15, true, Type::Uint32),
+            field("winding_temperature", 16, true, Type::Double),
         ],
         ..Default::default()
     };

@@ -40,6 +40,7 @@ struct SampleBlock {
     at_limit: Vec<bool>,
     friction: Vec<f64>,
     stuck: Vec<bool>,
+    winding_temperature: Vec<f64>,
     tool: Vec<Vector3<f64>>,
     tool_target: Vec<Vector3<f64>>,
     body_pose: Vec<Pose>,
@@ -68,6 +69,7 @@ impl SampleBlock {
             at_limit: Vec::with_capacity(capacity * n),
             friction: Vec::new(),
             stuck: Vec::new(),
+            winding_temperature: Vec::new(),
             tool: Vec::with_capacity(capacity),
             tool_target: Vec::with_capacity(capacity),
             body_pose: Vec::with_capacity(capacity * bodies),
@@ -96,6 +98,7 @@ impl SampleBlock {
         self.at_limit.extend_from_slice(s.at_limit);
         self.friction.extend_from_slice(s.friction);
         self.stuck.extend_from_slice(s.stuck);
+        self.winding_temperature.extend_from_slice(s.winding_temperature);
         self.tool.push(s.tool_position);
         self.tool_target.push(s.tool_target);
         self.body_pose.extend_from_slice(s.body_pose);
@@ -122,6 +125,7 @@ impl SampleBlock {
             // (all samples of a run have friction, or none has)
             friction: if self.friction.is_empty() { &[] } else { &self.friction[a..b] },
             stuck: if self.stuck.is_empty() { &[] } else { &self.stuck[a..b] },
+            winding_temperature: if self.winding_temperature.is_empty() { &[] } else { &self.winding_temperature[a..b] },
             tool_position: self.tool[i],
             tool_target: self.tool_target[i],
             body_pose: &self.body_pose[i * self.bodies..(i + 1) * self.bodies],
@@ -134,7 +138,7 @@ impl Reusable for SampleBlock {
         self.k.clear();
         self.t.clear();
         self.is_final.clear();
-        for v in [&mut self.q, &mut self.v, &mut self.cmd, &mut self.cmd_dot, &mut self.u, &mut self.tau_g, &mut self.torque_limit, &mut self.load_angle] {
+        for v in [&mut self.q, &mut self.v, &mut self.cmd, &mut self.cmd_dot, &mut self.u, &mut self.tau_g, &mut self.torque_limit, &mut self.load_angle, &mut self.winding_temperature] {
             v.clear();
         }
         self.lost_steps.clear();

@@ -1,0 +1,117 @@
+//! Motor heat in a run (issue 21 item 3): the two-node winding model of a catalogue motor with
+//! thermal data, integrated in `run`, in the summary and in both recordings; RMS torque per joint.
+
+mod common;
+
+use armscope::actuator::thermal::{AMBIENT_TEMPERATURE, MotorHeat, ThermalData};
+use armscope::recorder::ControllerTelemetry;
+use common::rrd::Rrd;
+use common::{box_urdf, read_csv, repo};
+use prost::Message as _;
+use std::path::Path;
+use std::process::Command;
+
+/// The catalogue's maxon EC 45 flat 30 W (assets/motors/catalogue.toml, from its datasheet).
+const EC45: ThermalData = ThermalData { winding_to_housing: 3.96, housing_to_ambient: 5.7, winding_time_constant: 11.5, motor_time_constant: 251.0, resistance_25: 4.83, max_winding_temperature: 125.0 };
+const EC45_TORQUE_CONSTANT: f64 = 0.051;
+const RATIO: f64 = 100.0;
+
+/// A motor file giving the box model's shoulder (J2) the EC 45 flat through a 100:1 reduction.
+fn motor_file(dir: &Path) -> String {
+    let path = dir.join("thermal.toml");
+    std::fs::write(&path, format!("[joints.J2]\nmotor = \"EC45flat-30W-24V\"\ngear_ratio = {RATIO}\nefficiency = 0.9\n")).unwrap();
+    path.to_str().unwrap().to_string()
+}
+
+fn run(args: &[&str]) -> (i32, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_armscope")).args(args).current_dir(repo()).output().unwrap();
+    (out.status.code().unwrap_or(-1), String::from_utf8_lossy(&out.stderr).into_owned() + &String::from_utf8_lossy(&out.stdout))
+}
+
+/// Holding the arm still, the shoulder's motor carries a constant current; after 10 motor time
+/// constants (e^−10 of the rise left: < 0.01 K) its winding sits at the closed-form steady state
+/// T_amb + (R_th1 + R_th2)·I²·R(T), within the bar's 0.5 K.
+#[test]
+fn a_motor_holding_a_constant_torque_settles_at_the_closed_form_temperature() {
+    let dir = tempfile::tempdir().unwrap();
+    let summary_path = dir.path().join("summary.json");
+    let duration = (10.0 * EC45.motor_time_constant).to_string();
+    let (code, out) = run(&["run", "--quiet", "--urdf", box_urdf().to_str().unwrap(), "--motors", &motor_file(dir.path()), "--static", "--duration", &duration, "--no-rrd", "--no-mcap", "--summary-json", summary_path.to_str().unwrap()]);
+    assert_eq!(code, 0, "{out}");
+    let summary: serde_json::Value = serde_json::from_str::<serde_json::Value>(&std::fs::read_to_string(&summary_path).unwrap()).unwrap()["summary"].clone();
+    let holding = summary["rms_torque"][1].as_f64().unwrap();
+    assert!(holding > 1.0, "the shoulder holds the arm: {holding} N·m");
+    let current = holding / (RATIO * EC45_TORQUE_CONSTANT);
+    let alpha = 0.0039;
+    let gain = (EC45.winding_to_housing + EC45.housing_to_ambient) * current * current * EC45.resistance_25;
+    let closed_form = (AMBIENT_TEMPERATURE + gain * (1.0 - 25.0 * alpha)) / (1.0 - gain * alpha);
+    let winding = &summary["winding"][1];
+    let peak = winding["peak_temperature"].as_f64().unwrap();
+    assert!((peak - closed_form).abs() < 0.5, "winding {peak} °C vs the closed form {closed_form} °C");
+    assert!((winding["steady_temperature"].as_f64().unwrap() - closed_form).abs() < 1e-6, "{winding} vs {closed_form}");
+    assert!(winding["time_to_limit"].is_null(), "{closed_form} °C is below the 125 °C limit: never");
+    // the other joints have no motor with thermal data, and the console says so
+    assert!(summary["winding"][0].is_null());
+}
+
+/// Both recordings carry the winding temperature of the torque the motor actually gave: an
+/// independent integration of the trace's J2 torque, step by step, equals the `.rrd`'s and the
+/// `.mcap`'s series; the summary's RMS torque is the trace's.
+#[test]
+fn recordings_carry_the_winding_temperature_of_the_torque_the_motor_gave() {
+    let dir = tempfile::tempdir().unwrap();
+    let (rrd, mcap, trace, summary_path) = (dir.path().join("t.rrd"), dir.path().join("t.mcap"), dir.path().join("trace.csv"), dir.path().join("s.json"));
+    let (code, out) = run(&[
+        "run", "--urdf", box_urdf().to_str().unwrap(), "--motors", &motor_file(dir.path()), "--duration", "12",
+        "--rrd", rrd.to_str().unwrap(), "--mcap", mcap.to_str().unwrap(), "--trace", trace.to_str().unwrap(), "--summary-json", summary_path.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{out}");
+    assert!(out.contains("winding peak (°C)") && out.contains("not thermally checked"), "{out}");
+    let trace = read_csv(&trace);
+    let u = trace.column("u2");
+    let mut heat = MotorHeat::new(EC45, AMBIENT_TEMPERATURE, 1e-3);
+    let mut expected = Vec::with_capacity(u.len());
+    for &torque in &u {
+        expected.push(heat.winding_temperature());
+        heat.step(torque.abs() / (RATIO * EC45_TORQUE_CONSTANT));
+    }
+    assert!(expected.last().unwrap() - AMBIENT_TEMPERATURE > 5.0, "the shoulder's winding warms: {:?}", expected.last());
+    let recorded: Vec<f64> = Rrd::open(&rrd).series("/joints/J2/winding_temperature").into_iter().map(|(_, v)| v[0]).collect();
+    assert_eq!(recorded.len(), expected.len());
+    let bytes = std::fs::read(&mcap).unwrap();
+    let telemetry: Vec<f64> = mcap::MessageStream::new(&bytes)
+        .unwrap()
+        .map(|m| m.unwrap())
+        .filter(|m| m.channel.topic == "/controller")
+        .map(|m| ControllerTelemetry::decode(&m.data[..]).unwrap().winding_temperature[1])
+        .collect();
+    assert_eq!(telemetry.len(), expected.len());
+    for (k, want) in expected.iter().enumerate() {
+        assert!((recorded[k] - want).abs() < 1e-9, "rrd step {k}: {} vs {want}", recorded[k]);
+        assert!((telemetry[k] - want).abs() < 1e-9, "mcap step {k}: {} vs {want}", telemetry[k]);
+    }
+    // RMS over the control steps (the last sample's torque is never applied)
+    let summary: serde_json::Value = serde_json::from_str::<serde_json::Value>(&std::fs::read_to_string(&summary_path).unwrap()).unwrap()["summary"].clone();
+    for j in 0..6 {
+        let u = trace.column(&format!("u{}", j + 1));
+        let steps = &u[..u.len() - 1];
+        let rms = (steps.iter().map(|x| x * x).sum::<f64>() / steps.len() as f64).sqrt();
+        assert!((summary["rms_torque"][j].as_f64().unwrap() - rms).abs() < 1e-9 * rms.max(1.0), "J{} RMS", j + 1);
+    }
+    let peak = summary["winding"][1]["peak_temperature"].as_f64().unwrap();
+    assert_eq!(peak, expected.iter().copied().fold(f64::MIN, f64::max));
+}
+
+/// A catalogue entry with part of a thermal model is refused with one line naming the file, the
+/// motor and the missing field.
+#[test]
+fn a_partial_thermal_model_is_named() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("mine.toml"), "[hot]\nkind = \"dc\"\nstall_torque = 0.2\nno_load_speed = 400\nrotor_inertia = 1e-6\ntorque_constant = 0.05\nterminal_resistance = 2\nthermal_resistance_winding_housing = 3\nthermal_resistance_housing_ambient = 5\nthermal_time_constant_winding = 10\nmax_winding_temperature = 125\n").unwrap();
+    std::fs::write(dir.path().join("motors.toml"), "catalogue = \"mine.toml\"\n[joints.J2]\nmotor = \"hot\"\ngear_ratio = 50\n").unwrap();
+    let (code, out) = run(&["run", "--quiet", "--urdf", box_urdf().to_str().unwrap(), "--motors", dir.path().join("motors.toml").to_str().unwrap(), "--duration", "0.1", "--no-rrd", "--no-mcap"]);
+    assert_ne!(code, 0);
+    let line = out.lines().find(|l| l.contains("error")).unwrap_or_else(|| panic!("{out}"));
+    assert!(line.contains("mine.toml") && line.contains("motor 'hot'") && line.contains("'thermal_time_constant_motor' is missing"), "{line}");
+    assert!(!out.contains("panicked"));
+}
