@@ -256,12 +256,12 @@ fn a_servo_brakes_with_its_stall_torque_and_a_stepper_is_symmetric() {
 fn a_lossy_gear_gives_less_driving_and_more_braking() {
     let servo = || Box::new(DcServo { name: "v".into(), stall_torque: 1.0, no_load_speed: 100.0, rotor_inertia: 0.0 });
     let gear = LossyGear { efficiency: 0.8, backdrive_efficiency: 0.5, breakaway_torque: 0.1, viscous: 0.01 };
-    let drive = DriveTrain { motor: servo(), gear_ratio: 10.0, gear, rated_torque: f64::INFINITY, heat: None };
+    let drive = DriveTrain { motor: servo(), gear_ratio: 10.0, gear, rated_torque: f64::INFINITY, heat: None, continuous_torque: None };
     // at 2 rad/s the motor turns at 20 rad/s: 0.8 N·m with the motion, its 1 N·m stall braking
     assert!((drive.available(1.0, 2.0) - (0.8 * 8.0 - 0.1 - 0.02)).abs() < 1e-12);
     assert!((drive.available(-1.0, 2.0) - (10.0 / 0.5 + 0.1 + 0.02)).abs() < 1e-12);
     assert!((drive.available(1.0, 0.0) - (0.8 * 10.0 - 0.1)).abs() < 1e-12);
-    let worm = DriveTrain { motor: servo(), gear_ratio: 10.0, gear: LossyGear { backdrive_efficiency: -0.2, ..gear }, rated_torque: 30.0, heat: None };
+    let worm = DriveTrain { motor: servo(), gear_ratio: 10.0, gear: LossyGear { backdrive_efficiency: -0.2, ..gear }, rated_torque: 30.0, heat: None, continuous_torque: None };
     assert_eq!(worm.available(-1.0, 2.0), 30.0);
     assert!((worm.available(1.0, 2.0) - (0.8 * 8.0 - 0.1 - 0.02)).abs() < 1e-12);
 }

@@ -139,12 +139,13 @@ fn drive_train_from(source: &Path, name: &str, t: &toml::Table) -> Result<DriveT
         // a bus servo (its gearbox inside: numbers at the horn) or a bare DC/BLDC motor: both a
         // straight torque–speed line from the stall torque to the no-load speed
         "servo" | "dc" => {
-            fields.known(&[&common[..], &["stall_torque", "no_load_speed", "mass", "voltage", "inductance", "nominal_torque"]].concat())?;
+            fields.known(&[&common[..], &["stall_torque", "no_load_speed", "mass", "voltage", "inductance", "continuous_torque"]].concat())?;
             Box::new(DcServo { name: name.to_string(), stall_torque: fields.positive("stall_torque")?, no_load_speed: fields.positive("no_load_speed")?, rotor_inertia: fields.non_negative("rotor_inertia")? })
         }
         other => return Err(fail(source, format!("{what}: field 'kind' is '{other}', expected 'stepper', 'servo' or 'dc'"))),
     };
-    Ok(DriveTrain { motor, gear_ratio, gear, rated_torque: rated, heat })
+    let continuous_torque = fields.optional_positive("continuous_torque")?;
+    Ok(DriveTrain { motor, gear_ratio, gear, rated_torque: rated, heat, continuous_torque })
 }
 
 /// A TOML table's fields, each checked with an error naming the file, the entry and the field.

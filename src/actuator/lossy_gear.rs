@@ -81,6 +81,22 @@ impl LossyGear {
         motor_torque + coulomb - self.viscous * speed
     }
 
+    /// The motor's torque at the joint, |u| (before the losses), that gives the joint `joint_torque`
+    /// at `speed` (at rest: as if moving with the torque): driving the motion, (|τ + c·q̇| + F_b)/η;
+    /// held back by it, η_b·(|τ + c·q̇| − F_b) (the friction helps; 0 when it holds alone or the gear
+    /// locks). The inverse of [`Self::output_torque`], for sizing.
+    pub fn motor_torque_for(&self, joint_torque: f64, speed: f64) -> f64 {
+        let along = joint_torque + self.viscous * speed;
+        let direction = if speed != 0.0 { speed.signum() } else { along.signum() };
+        if along * direction >= 0.0 {
+            (along.abs() + self.breakaway_torque) / self.efficiency
+        } else if self.self_locking() {
+            0.0
+        } else {
+            self.backdrive_efficiency * (along.abs() - self.breakaway_torque).max(0.0)
+        }
+    }
+
     /// This gear followed by another of ratio `ratio` (the joint turns `ratio` times slower than
     /// this gear's output): the efficiencies multiply (a self-locking stage locks the train), the
     /// first stage's breakaway and viscous losses are seen through the second (×η₂·N₂, ×N₂²).
@@ -145,5 +161,21 @@ mod tests {
         let worm = LossyGear { backdrive_efficiency: -0.1, ..b };
         assert!(a.followed_by(4.0, &worm).self_locking() && worm.followed_by(2.0, &a).self_locking());
         assert_eq!(LossyGear::LOSSLESS.followed_by(3.0, &LossyGear::LOSSLESS), LossyGear::LOSSLESS);
+    }
+
+    #[test]
+    fn motor_torque_for_inverts_output_torque() {
+        let gear = LossyGear { efficiency: 0.8, backdrive_efficiency: 0.5, breakaway_torque: 0.1, viscous: 0.02 };
+        for speed in [-1.5, 1.5] {
+            for torque in [-2.0, -0.7, 0.7, 2.0] {
+                let along = torque + gear.viscous * speed;
+                let u = along.signum() * gear.motor_torque_for(torque, speed);
+                let back = gear.output_torque(u, speed.signum(), speed);
+                assert!((back - torque).abs() < 1e-12, "speed {speed}, torque {torque}: u = {u} gives {back}");
+            }
+        }
+        // a load the friction holds alone, and a self-locking gear: the motor gives nothing
+        assert_eq!(gear.motor_torque_for(-0.05, 1.0), 0.0);
+        assert_eq!(LossyGear { backdrive_efficiency: -0.2, ..gear }.motor_torque_for(-2.0, 1.0), 0.0);
     }
 }

@@ -54,13 +54,17 @@ pub struct DriveTrain {
     pub rated_torque: f64,
     /// The motor's thermal data, where its datasheet gives it (None: not thermally checked).
     pub heat: Option<thermal::WindingHeat>,
+    /// The motor's continuous (rated) torque at its shaft, N·m, where its datasheet gives it: the
+    /// vendors' RMS check (None: not checked; an open-loop stepper draws its set current whatever
+    /// the load, so its heat is the driver's setting, not the motion's).
+    pub continuous_torque: Option<f64>,
 }
 
 impl DriveTrain {
     /// A drive train whose gearbox loses the same fraction both ways (η_b = η) and has no friction
     /// at no load.
     pub fn new(motor: Box<dyn Motor>, gear_ratio: f64, efficiency: f64, rated_torque: f64) -> Self {
-        Self { motor, gear_ratio, gear: LossyGear::with_efficiency(efficiency), rated_torque, heat: None }
+        Self { motor, gear_ratio, gear: LossyGear::with_efficiency(efficiency), rated_torque, heat: None, continuous_torque: None }
     }
 
     /// The gearbox's efficiency when the motor drives, η.
@@ -127,6 +131,7 @@ impl DriveTrain {
             gear_ratio: self.gear_ratio * gear_ratio,
             motor: self.motor,
             heat: self.heat,
+            continuous_torque: self.continuous_torque,
         }
     }
 

@@ -62,6 +62,10 @@ pub struct SizeArgs {
     /// Simulations at once (default: all cores).
     #[arg(long)]
     pub jobs: Option<usize>,
+    /// How long the motion goes on, hours, for the thermal check of motors with thermal data
+    /// (default: the motion's own duration).
+    #[arg(long, value_name = "HOURS")]
+    pub duty: Option<f64>,
 }
 
 /// `JOINT=SPEC` or `SPEC`, where SPEC is `A-B`, `A-B:STEP`, a number, or a comma list of these.
@@ -189,6 +193,11 @@ pub fn size(args: &SizeArgs) -> Result<i32, Error> {
     if !(args.efficiency > 0.0 && args.efficiency <= 1.0) {
         return Err(Error::flag("--efficiency", format!("must be in (0, 1] (got {})", args.efficiency)));
     }
+    if let Some(hours) = args.duty {
+        if !(hours > 0.0 && hours.is_finite()) {
+            return Err(Error::flag("--duty", format!("must be a positive number of hours (got {hours})")));
+        }
+    }
     if !(1..=1024).contains(&args.microsteps) {
         return Err(Error::flag("--microsteps", "must be 1 to 1024"));
     }
@@ -229,7 +238,7 @@ pub fn size(args: &SizeArgs) -> Result<i32, Error> {
     let ratios = parse_ratios(&args.ratios, &joint_names)?;
     let jobs = args.jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
     let started = std::time::Instant::now();
-    let request = SizeRequest { motions, model, payload_kg: args.payload, catalogue, motors, ratios, margin: args.margin, efficiency: args.efficiency, microsteps: args.microsteps, jobs };
+    let request = SizeRequest { motions, model, payload_kg: args.payload, catalogue, motors, ratios, margin: args.margin, efficiency: args.efficiency, microsteps: args.microsteps, jobs, duty: args.duty.map(|hours| hours * 3600.0) };
     let report = size_joints(&request)?;
 
     std::fs::create_dir_all(&args.out).map_err(|e| Error::output(&args.out, e))?;

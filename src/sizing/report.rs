@@ -56,6 +56,11 @@ impl SizeReport {
             self.microsteps,
             self.motors.join(", ")
         );
+        md += &format!(
+            "Duty checks (beside the peak torque on the curve): each motor's RMS torque with the margin against its continuous rating, and the winding of a motor with thermal data over {} at that RMS current, from 25 °C ambient.{}\n\n",
+            if self.duty_seconds >= 3600.0 { format!("{} h", (self.duty_seconds / 3.6).round() / 1000.0) } else { format!("{:.0} s", self.duty_seconds) },
+            if self.duty_unchecked.is_empty() { String::new() } else { format!(" Not duty-checked (no continuous rating, no thermal data in the catalogue): {}.", self.duty_unchecked.join(", ")) }
+        );
         md += "| joint | motor | ratio | at rest (N·m) | torque to spare | speed to spare | simulated | runner-up |\n|---|---|---|---|---|---|---|---|\n";
         for js in &self.joints {
             if js.candidates.is_empty() {

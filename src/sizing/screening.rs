@@ -48,6 +48,8 @@ pub struct SizeRequest {
     pub microsteps: u32,
     /// Simulations at once.
     pub jobs: usize,
+    /// How long the motion goes on, s, for the thermal check (None: the motions' own duration).
+    pub duty: Option<f64>,
 }
 
 /// Why a candidate cannot carry the motion, at the instant where it falls shortest.
@@ -62,6 +64,10 @@ pub enum Shortfall {
     Gearbox { at: Instant, need: f64, rated: f64 },
     /// Without its own rotor's J_r·N² the motion would fit: the reflected inertia breaks it.
     ReflectedInertia { at: Instant, reflected: f64, need: f64, available: f64 },
+    /// The motor's RMS torque over the motion (with the margin) exceeds its continuous rating.
+    Rms { need: f64, continuous: f64 },
+    /// The winding would pass its limit within the duty at the motion's RMS current (with the margin).
+    Thermal { current: f64, reaches_limit_after: f64, duty: f64, max_temperature: f64 },
 }
 
 /// An instant of the motion: a time in one of its experiments (named when the motion has several).
@@ -100,6 +106,13 @@ impl Shortfall {
             Shortfall::ReflectedInertia { at, reflected, need, available } => {
                 let (need, available) = distinct(*need, *available);
                 format!("reflected inertia: the rotor's J_r·N² = {reflected:.3} kg·m² raises the need to {need} N·m at {at}, gets {available}")
+            }
+            Shortfall::Rms { need, continuous } => {
+                let (need_s, continuous_s) = distinct(*need, *continuous);
+                format!("RMS torque: the motor's {need_s} N·m RMS with the margin is {:.0} % over its continuous {continuous_s} N·m", 100.0 * (need / continuous - 1.0))
+            }
+            Shortfall::Thermal { current, reaches_limit_after, duty, max_temperature } => {
+                format!("heat: at {current:.2} A RMS with the margin the winding reaches its {max_temperature:.0} °C after {reaches_limit_after:.0} s, within the {duty:.0} s duty")
             }
         }
     }
@@ -185,6 +198,11 @@ pub struct SizeReport {
     /// The chosen set passed its full simulation on every motion.
     pub verified: bool,
     pub simulations: usize,
+    /// The duty the thermal check used, s.
+    pub duty_seconds: f64,
+    /// Candidate motors whose duty was not checked, as they lack a continuous rating and thermal
+    /// data (with what each lacks).
+    pub duty_unchecked: Vec<String>,
 }
 
 /// The commanded motion of every experiment, per joint: speed, acceleration and the torque without
@@ -272,11 +290,60 @@ fn rate(drive: &DriveTrain, motion: &Motion, j: usize, margin: f64) -> (f64, f64
     (worst, torque_headroom, speed_headroom, Some(shortfall))
 }
 
+/// The vendors' duty checks of one candidate on joint `j`'s motion, beside the peak check: the
+/// motor's RMS torque (the motion's, with its rotor and the gearbox's losses, times 1 + margin)
+/// against its continuous rating, and with thermal data, the winding at that RMS current (through
+/// K_t) against its limit over `duty` seconds from ambient. Returns the larger share (≤ 1 passes)
+/// and why it fails.
+fn rate_duty(drive: &DriveTrain, motion: &Motion, j: usize, margin: f64, duty: f64) -> (f64, Option<Shortfall>) {
+    if drive.continuous_torque.is_none() && drive.heat.is_none() {
+        return (0.0, None);
+    }
+    let reflected = drive.reflected_inertia();
+    let samples = motion.t.len().max(1) as f64;
+    let mean_square: f64 = (0..motion.t.len())
+        .map(|i| {
+            let torque = motion.torque[j][i] + reflected * motion.acceleration[j][i];
+            // at the motor's shaft: through the gear's losses, over the ratio
+            (drive.gear.motor_torque_for(torque, motion.speed[j][i]) / drive.gear_ratio).powi(2)
+        })
+        .sum::<f64>()
+        / samples;
+    let need = (1.0 + margin) * mean_square.sqrt();
+    let (mut share, mut shortfall) = (0.0f64, None);
+    if let Some(continuous) = drive.continuous_torque {
+        share = need / continuous;
+        if share > 1.0 {
+            shortfall = Some(Shortfall::Rms { need, continuous });
+        }
+    }
+    if let Some(heat) = drive.heat {
+        let current = need / heat.torque_constant;
+        let winding = crate::actuator::thermal::MotorHeat::new(heat.thermal, crate::actuator::thermal::AMBIENT_TEMPERATURE, 1.0);
+        let thermal_share = match winding.time_to_limit(current) {
+            Some(after) => {
+                if after <= duty && shortfall.is_none() {
+                    shortfall = Some(Shortfall::Thermal { current, reaches_limit_after: after, duty, max_temperature: heat.thermal.max_winding_temperature });
+                }
+                if after > 0.0 { duty / after } else { f64::INFINITY }
+            }
+            // never reaches it: the steady rise's share of the allowed rise
+            None => match heat.thermal.steady_winding_temperature(current, winding.ambient) {
+                Some(steady) => (steady - winding.ambient) / (heat.thermal.max_winding_temperature - winding.ambient),
+                None => f64::INFINITY,
+            },
+        };
+        share = share.max(thermal_share);
+    }
+    (share, shortfall)
+}
+
 /// Size every actuated joint; see the module's notes for the method.
 pub fn size(request: &SizeRequest) -> Result<SizeReport, Error> {
     let model = &request.model;
     let n = model.dof();
     let motion = commanded_motion(request)?;
+    let duty = request.duty.unwrap_or_else(|| request.motions.iter().map(|(_, config)| config.duration).sum());
     let mut joints: Vec<JointSizing> = Vec::new();
     for j in 0..n {
         let mut candidates = Vec::new();
@@ -285,7 +352,10 @@ pub fn size(request: &SizeRequest) -> Result<SizeReport, Error> {
                 let mass_kg = request.catalogue.mass(motor).unwrap_or(f64::NAN);
                 for &ratio in &request.ratios[j] {
                     let drive = drive_train(&request.catalogue, motor, ratio, request.efficiency)?;
-                    let (share, torque_headroom, speed_headroom, shortfall) = rate(&drive, &motion, j, request.margin);
+                    let (peak_share, torque_headroom, speed_headroom, peak_shortfall) = rate(&drive, &motion, j, request.margin);
+                    let (duty_share, duty_shortfall) = rate_duty(&drive, &motion, j, request.margin, duty);
+                    let share = peak_share.max(duty_share);
+                    let shortfall = peak_shortfall.or(duty_shortfall);
                     candidates.push(Candidate { motor: motor.clone(), mass_kg, ratio, total_ratio: drive.gear_ratio, torque_at_rest: drive.torque_limit(0.0), share, torque_headroom, speed_headroom, shortfall });
                 }
             }
@@ -436,6 +506,13 @@ pub fn size(request: &SizeRequest) -> Result<SizeReport, Error> {
         rounds,
         verified,
         simulations,
+        duty_seconds: duty,
+        duty_unchecked: request
+            .motors
+            .iter()
+            .filter(|m| request.catalogue.drive_train(m).and_then(Result::ok).is_some_and(|d| d.continuous_torque.is_none() && d.heat.is_none()))
+            .cloned()
+            .collect(),
     })
 }
 
