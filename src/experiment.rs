@@ -422,7 +422,7 @@ fn apply_motor_set(set: MotorSet, model: &mut Model) -> MotorSet {
     for (joint, drive) in set.joints.iter().enumerate() {
         let Some(drive) = drive else { continue };
         actuators.retain(|a| a.joint != joint);
-        actuators.push(Actuator { name: drive.motor.name().to_string(), joint, effort: drive.torque_limit(0.0), gear_ratio: drive.gear_ratio, rotor_inertia: drive.motor.rotor_inertia() });
+        actuators.push(Actuator { name: drive.motor.name().to_string(), joint, effort: drive.torque_limit(0.0), gear_ratio: drive.gear_ratio, rotor_inertia: drive.shaft_inertia() });
     }
     model.set_actuators(actuators);
     set

@@ -21,7 +21,10 @@ fn size(dir: &Path, catalogue: &str, duration: &str, extra: &[&str]) -> Value {
     std::fs::write(dir.join("pendulum.urdf"), PENDULUM).unwrap();
     std::fs::write(dir.join("catalogue.toml"), catalogue).unwrap();
     let out = dir.join(format!("out{}", extra.join("_")));
-    let args: Vec<String> = ["armscope", "size", "--urdf", dir.join("pendulum.urdf").to_str().unwrap(), "--catalogue", dir.join("catalogue.toml").to_str().unwrap(), "--freq", "0.5", "--amp-deg", "5", "--duration", duration, "--out", out.to_str().unwrap()]
+    // the file's own motors only (it adds to the built-in catalogue)
+    let own: toml::Table = catalogue.parse().unwrap();
+    let candidates = own.keys().cloned().collect::<Vec<_>>().join(",");
+    let args: Vec<String> = ["armscope", "size", "--urdf", dir.join("pendulum.urdf").to_str().unwrap(), "--catalogue", dir.join("catalogue.toml").to_str().unwrap(), "--candidates", &candidates, "--freq", "0.5", "--amp-deg", "5", "--duration", duration, "--out", out.to_str().unwrap()]
         .iter()
         .chain(extra)
         .map(|s| s.to_string())

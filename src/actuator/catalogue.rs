@@ -1,6 +1,9 @@
 //! Motor catalogues and motor files (TOML).
 //!
-//! A catalogue (`assets/motors/catalogue.toml`, built in) names real motors:
+//! A catalogue (`assets/motors/catalogue.toml`, built in) names real motors and reductions, each a
+//! table with a `kind` and a `source` (where its numbers were read; `[NAME.sources]` for a field read
+//! elsewhere). A user's catalogue adds to the built-in one and overrides entries of the same name.
+//! Motors:
 //!
 //! ```toml
 //! [17HS4401]
@@ -17,12 +20,18 @@
 //! # given), gearbox_breakaway_torque (N·m at its output), gearbox_viscous (N·m·s/rad at its output)
 //! ```
 //!
+//! Reductions ([`super::reduction`]): `kind` one of planetary, strain_wave, cycloidal, belt, spur;
+//! `ratios = [..]` (a belt: `driver_teeth` and `driven_teeth`); efficiency, backdrive_efficiency,
+//! backdriving_torque, rated_torque, repeated_peak_torque, momentary_torque (a number or one per
+//! ratio), max_input_speed, input_inertia, backlash (arcmin), mass.
+//!
 //! A motor file (`--motors FILE.toml`) gives joints a motor and a drive train:
 //!
 //! ```toml
 //! catalogue = "my_motors.toml"   # optional, beside this file; the built-in catalogue otherwise
 //! [joints.J1]
 //! motor = "17HS4401"
+//! # reduction = "NPS015"         # a catalogue reduction, at gear_ratio (one of its ratios); or:
 //! gear_ratio = 15                # the reduction after the motor (and after its own gearbox)
 //! efficiency = 0.9               # of that reduction, driving (the joint gets η·N·T)
 //! backdrive_efficiency = 0.85    # optional, when the load drives the motor (η when not given; ≤ 0: self-locking)
@@ -34,6 +43,7 @@
 //! The reduction's losses act as friction at the joint by the direction power flows
 //! ([`super::LossyGear`]).
 
+use super::reduction::{KINDS as REDUCTION_KINDS, Reduction};
 use super::{DcServo, DriveTrain, LossyGear, Motor, MotorSet, PullOut, Stepper};
 use crate::error::Error;
 use crate::model::Model;
@@ -43,12 +53,19 @@ use toml::Value;
 
 pub const DEFAULT_CATALOGUE: &str = "assets/motors/catalogue.toml";
 
-/// Catalogue entries by name, as TOML tables (each made into a motor when a joint uses it).
+/// Catalogue entries by name: motors as TOML tables (each made into a motor when a joint uses it),
+/// reductions parsed.
 #[derive(Debug, Default)]
 pub struct Catalogue {
+    /// The motors.
     pub entries: BTreeMap<String, toml::Table>,
+    pub reductions: BTreeMap<String, Reduction>,
+    /// The file (the user's, when it extends the built-in one).
     pub source: PathBuf,
 }
+
+/// The motor kinds.
+pub const MOTOR_KINDS: [&str; 3] = ["stepper", "servo", "dc"];
 
 fn fail(file: &Path, message: String) -> Error {
     Error::flag("--motors", format!("{}: {message}", file.display()))
@@ -62,13 +79,60 @@ impl Catalogue {
 
     pub fn parse(text: &str, path: &Path) -> Result<Self, Error> {
         let table: toml::Table = text.parse().map_err(|e: toml::de::Error| fail(path, e.message().to_string()))?;
-        let mut entries = BTreeMap::new();
+        let (mut entries, mut reductions) = (BTreeMap::new(), BTreeMap::new());
         for (name, value) in table {
-            let Value::Table(t) = value else { return Err(fail(path, format!("motor '{name}': expected a table"))) };
-            drive_train_from(path, &name, &t)?; // every entry checked at load
-            entries.insert(name, t);
+            let Value::Table(t) = value else { return Err(fail(path, format!("entry '{name}': expected a table"))) };
+            let kind = Fields { file: path, what: &format!("entry '{name}'"), table: &t }.string("kind")?;
+            if REDUCTION_KINDS.contains(&kind.as_str()) {
+                reductions.insert(name.clone(), reduction_from(path, &name, &t)?);
+            } else {
+                drive_train_from(path, &name, &t)?; // every entry checked at load
+                entries.insert(name, t);
+            }
         }
-        Ok(Self { entries, source: path.to_path_buf() })
+        Ok(Self { entries, reductions, source: path.to_path_buf() })
+    }
+
+    /// The built-in catalogue with a user's file on top (its entries added, or replacing the
+    /// built-in ones of the same name).
+    pub fn with_user_file(path: &Path) -> Result<Self, Error> {
+        let mut out = Self::load(Path::new(DEFAULT_CATALOGUE))?;
+        out.extend(Self::load(path)?);
+        Ok(out)
+    }
+
+    /// Add `other`'s entries, replacing ours of the same name; the source becomes `other`'s.
+    pub fn extend(&mut self, other: Catalogue) {
+        for name in other.entries.keys().chain(other.reductions.keys()) {
+            self.entries.remove(name);
+            self.reductions.remove(name);
+        }
+        self.entries.extend(other.entries);
+        self.reductions.extend(other.reductions);
+        self.source = other.source;
+    }
+
+    pub fn reduction(&self, name: &str) -> Option<&Reduction> {
+        self.reductions.get(name)
+    }
+
+    /// The catalogue's reduction names, for messages.
+    pub fn reduction_names(&self) -> String {
+        self.reductions.keys().cloned().collect::<Vec<_>>().join(", ")
+    }
+
+    /// Whether reduction `reduction` can follow motor `motor` (see [`Reduction::fits`]).
+    pub fn fits(&self, motor: &str, reduction: &str) -> bool {
+        let (Some(t), Some(r)) = (self.entries.get(motor), self.reductions.get(reduction)) else { return false };
+        r.fits(t.get("kind").and_then(Value::as_str).unwrap_or(""), t.get("frame").and_then(Value::as_str))
+    }
+
+    /// Where the entry's numbers come from (None: the user's own).
+    pub fn source_of(&self, name: &str) -> Option<String> {
+        match self.entries.get(name) {
+            Some(t) => t.get("source").and_then(Value::as_str).map(str::to_string),
+            None => self.reductions.get(name)?.source.clone(),
+        }
     }
 
     /// The motor named `name` behind its own gearbox (a gearmotor's; ratio 1 for a bare motor), or
@@ -113,10 +177,16 @@ fn drive_train_from(source: &Path, name: &str, t: &toml::Table) -> Result<DriveT
         "thermal_time_constant_winding",
         "thermal_time_constant_motor",
         "max_winding_temperature",
+        "sources",
+        "length",
     ];
+    fields.sources()?;
     let motor: Box<dyn Motor> = match kind.as_str() {
         "stepper" => {
-            fields.known(&[&common[..], &["holding_torque", "step_angle", "inductance", "current", "supply_voltage", "pull_out", "resistance", "mass", "detent_torque"]].concat())?;
+            fields.known(&[&common[..], &["holding_torque", "step_angle", "inductance", "current", "supply_voltage", "pull_out", "resistance", "mass", "detent_torque", "frame"]].concat())?;
+            if t.get("frame").is_some_and(|f| !f.is_str()) {
+                return Err(fields.err("frame", "must be a flange name, e.g. \"NEMA17\""));
+            }
             let pull_out = match t.get("pull_out") {
                 Some(points) => PullOut::Table(fields.points("pull_out", points)?),
                 None => PullOut::Derived { inductance: fields.positive("inductance")?, current: fields.positive("current")?, supply_voltage: fields.positive("supply_voltage")? },
@@ -142,10 +212,87 @@ fn drive_train_from(source: &Path, name: &str, t: &toml::Table) -> Result<DriveT
             fields.known(&[&common[..], &["stall_torque", "no_load_speed", "mass", "voltage", "inductance", "continuous_torque"]].concat())?;
             Box::new(DcServo { name: name.to_string(), stall_torque: fields.positive("stall_torque")?, no_load_speed: fields.positive("no_load_speed")?, rotor_inertia: fields.non_negative("rotor_inertia")? })
         }
-        other => return Err(fail(source, format!("{what}: field 'kind' is '{other}', expected 'stepper', 'servo' or 'dc'"))),
+        other => return Err(fail(source, format!("{what}: field 'kind' is '{other}', expected a motor ('stepper', 'servo', 'dc') or a reduction ({})", REDUCTION_KINDS.join(", ")))),
     };
     let continuous_torque = fields.optional_positive("continuous_torque")?;
-    Ok(DriveTrain { motor, gear_ratio, gear, rated_torque: rated, heat, continuous_torque })
+    let mut drive = DriveTrain::with_gear(motor, gear_ratio, gear, rated);
+    drive.heat = heat;
+    drive.continuous_torque = continuous_torque;
+    Ok(drive)
+}
+
+/// A catalogue reduction; errors name `source`, the entry and the field.
+fn reduction_from(source: &Path, name: &str, t: &toml::Table) -> Result<Reduction, Error> {
+    let what = format!("reduction '{name}'");
+    let fields = Fields { file: source, what: &what, table: t };
+    fields.known(&[
+        "kind", "source", "sources", "ratios", "driver_teeth", "driven_teeth", "efficiency", "backdrive_efficiency", "backdriving_torque", "rated_torque", "repeated_peak_torque", "momentary_torque", "max_input_speed", "input_inertia", "backlash", "mass", "fits",
+    ])?;
+    fields.sources()?;
+    let ratios = match (t.get("ratios"), t.get("driver_teeth"), t.get("driven_teeth")) {
+        (Some(_), None, None) => {
+            let ratios = fields.list("ratios")?;
+            if ratios.iter().any(|&r| r < 1.0) {
+                return Err(fields.err("ratios", "must all be at least 1 (a reduction)"));
+            }
+            ratios
+        }
+        (None, Some(_), Some(_)) => {
+            let (driver, driven) = (fields.list("driver_teeth")?, fields.list("driven_teeth")?);
+            // every pulley pair that reduces, each ratio once
+            let mut ratios: Vec<f64> = driver.iter().flat_map(|a| driven.iter().map(move |b| b / a)).filter(|&r| r > 1.0).collect();
+            ratios.sort_by(f64::total_cmp);
+            ratios.dedup_by(|a, b| (*a - *b).abs() <= 1e-12 * *b);
+            if ratios.is_empty() {
+                return Err(fields.err("driven_teeth", "gives no ratio above 1 with driver_teeth"));
+            }
+            ratios
+        }
+        _ => return Err(fail(source, format!("{what}: give either 'ratios' or both 'driver_teeth' and 'driven_teeth'"))),
+    };
+    let mut sorted = ratios.clone();
+    sorted.sort_by(f64::total_cmp);
+    if sorted != ratios {
+        return Err(fields.err("ratios", "must increase"));
+    }
+    let per_ratio = |field: &str| -> Result<Option<Vec<f64>>, Error> {
+        match t.get(field) {
+            None => Ok(None),
+            Some(Value::Array(_)) => {
+                let list = fields.list(field)?;
+                if list.len() != ratios.len() {
+                    return Err(fields.err(field, &format!("has {} values for {} ratios (one number, or one per ratio)", list.len(), ratios.len())));
+                }
+                Ok(Some(list))
+            }
+            Some(_) => Ok(Some(vec![fields.positive(field)?; ratios.len()])),
+        }
+    };
+    let backdrive_efficiency = match fields.number("backdrive_efficiency")? {
+        Some(x) if x > 1.0 => return Err(fields.err("backdrive_efficiency", &format!("must be at most 1 (got {x}; 0 or less: a self-locking drive)"))),
+        other => other,
+    };
+    Ok(Reduction {
+        name: name.to_string(),
+        kind: fields.string("kind")?,
+        efficiency: fields.optional_fraction("efficiency")?,
+        backdrive_efficiency,
+        backdriving_torque: fields.non_negative("backdriving_torque")?,
+        rated_torque: per_ratio("rated_torque")?,
+        repeated_peak_torque: per_ratio("repeated_peak_torque")?,
+        momentary_torque: per_ratio("momentary_torque")?,
+        max_input_speed: fields.optional_positive("max_input_speed")?,
+        input_inertia: per_ratio("input_inertia")?,
+        backlash: fields.optional_positive("backlash")?,
+        mass: fields.optional_positive("mass")?,
+        fits: match t.get("fits") {
+            None => None,
+            Some(Value::Array(a)) if !a.is_empty() && a.iter().all(Value::is_str) => Some(a.iter().filter_map(Value::as_str).map(str::to_string).collect()),
+            Some(_) => return Err(fields.err("fits", "must be a list of motor flanges, e.g. [\"NEMA17\"]")),
+        },
+        source: t.get("source").and_then(Value::as_str).map(str::to_string),
+        ratios,
+    })
 }
 
 /// A TOML table's fields, each checked with an error naming the file, the entry and the field.
@@ -215,7 +362,8 @@ impl Fields<'_> {
             "max_winding_temperature",
         ];
         let given: Vec<&str> = FIELDS.iter().copied().filter(|f| self.table.contains_key(*f)).collect();
-        if given.is_empty() {
+        // the torque constant alone is no thermal model (it also serves the RMS current)
+        if given.iter().all(|f| *f == "torque_constant") {
             return Ok(None);
         }
         if let Some(missing) = FIELDS.iter().find(|f| !given.contains(f)) {
@@ -230,6 +378,37 @@ impl Fields<'_> {
             max_winding_temperature: self.positive("max_winding_temperature")?,
         };
         Ok(Some(super::thermal::WindingHeat { thermal, torque_constant: self.positive("torque_constant")? }))
+    }
+
+    /// A non-empty list of positive numbers.
+    fn list(&self, field: &str) -> Result<Vec<f64>, Error> {
+        let bad = || self.err(field, "must be a non-empty list of positive numbers");
+        let list = self.table.get(field).and_then(Value::as_array).filter(|a| !a.is_empty()).ok_or_else(bad)?;
+        list.iter().map(|v| v.as_float().or(v.as_integer().map(|i| i as f64)).filter(|x| x.is_finite() && *x > 0.0).ok_or_else(bad)).collect()
+    }
+
+    /// `source` a string and `sources` a table of strings naming fields of the entry.
+    fn sources(&self) -> Result<(), Error> {
+        if let Some(v) = self.table.get("source") {
+            if !v.as_str().is_some_and(|s| !s.trim().is_empty()) {
+                return Err(self.err("source", "must be a non-empty string: where the numbers were read"));
+            }
+        }
+        match self.table.get("sources") {
+            None => Ok(()),
+            Some(Value::Table(t)) => {
+                for (field, v) in t {
+                    if !self.table.contains_key(field) || field == "sources" || field == "source" {
+                        return Err(self.err(&format!("sources.{field}"), "names no field of this entry"));
+                    }
+                    if !v.as_str().is_some_and(|s| !s.trim().is_empty()) {
+                        return Err(self.err(&format!("sources.{field}"), "must be a non-empty string"));
+                    }
+                }
+                Ok(())
+            }
+            Some(_) => Err(self.err("sources", "must be a table: field = \"where it was read\"")),
+        }
     }
 
     fn non_negative(&self, field: &str) -> Result<f64, Error> {
@@ -280,7 +459,7 @@ pub fn load_motor_file(path: &Path, model: &Model) -> Result<MotorSet, Error> {
         return Err(fail(path, format!("unknown key '{k}' (known: catalogue, joints, motors, description)")));
     }
     let mut catalogue = match table.get("catalogue") {
-        Some(Value::String(file)) => Catalogue::load(&path.parent().unwrap_or(Path::new(".")).join(file))?,
+        Some(Value::String(file)) => Catalogue::with_user_file(&path.parent().unwrap_or(Path::new(".")).join(file))?,
         Some(_) => return Err(fail(path, "field 'catalogue' must be a file name".into())),
         None => Catalogue::load(Path::new(DEFAULT_CATALOGUE))?,
     };
@@ -288,7 +467,7 @@ pub fn load_motor_file(path: &Path, model: &Model) -> Result<MotorSet, Error> {
     if let Some(motors) = table.get("motors") {
         let text = toml::to_string(motors).unwrap_or_default();
         let own = Catalogue::parse(&text, path)?;
-        catalogue.entries.extend(own.entries);
+        catalogue.extend(own);
     }
     let joints = match table.get("joints") {
         Some(Value::Table(t)) => t,
@@ -302,19 +481,39 @@ pub fn load_motor_file(path: &Path, model: &Model) -> Result<MotorSet, Error> {
         };
         let Value::Table(t) = value else { return Err(fail(path, format!("{what}: expected a table"))) };
         let fields = Fields { file: path, what: &what, table: t };
-        fields.known(&["motor", "gear_ratio", "efficiency", "backdrive_efficiency", "breakaway_torque", "viscous", "rated_torque", "microsteps", "acceleration"])?;
+        fields.known(&["motor", "reduction", "gear_ratio", "efficiency", "backdrive_efficiency", "breakaway_torque", "viscous", "rated_torque", "microsteps", "acceleration"])?;
         set.acceleration[index] = fields.optional_positive("acceleration")?;
-        let motor_name = fields.string("motor")?;
-        let own = catalogue.drive_train(&motor_name).ok_or_else(|| fail(path, format!("{what}: no motor '{motor_name}' (known: {})", catalogue.names())))??;
-        let ratio = fields.optional_positive("gear_ratio")?.unwrap_or(1.0);
-        let gear = fields.gear("")?;
-        let rated = fields.optional_positive("rated_torque")?.unwrap_or(f64::INFINITY);
         if let Some(m) = fields.optional_positive("microsteps")? {
             if m.fract() != 0.0 || m > 1024.0 {
                 return Err(fields.err("microsteps", "must be a whole number up to 1024"));
             }
             set.microsteps[index] = Some(m as u32);
         }
+        let motor_name = fields.string("motor")?;
+        let own = catalogue.drive_train(&motor_name).ok_or_else(|| fail(path, format!("{what}: no motor '{motor_name}' (known: {})", catalogue.names())))??;
+        if let Some(Value::String(reduction)) = t.get("reduction") {
+            // a catalogue reduction: its own losses and ratings, at one of its ratios
+            if let Some(k) = ["efficiency", "backdrive_efficiency", "breakaway_torque", "viscous", "rated_torque"].iter().find(|k| t.contains_key(**k)) {
+                return Err(fields.err(k, &format!("comes from the catalogue's reduction '{reduction}': leave it out, or give the reduction's numbers without 'reduction'")));
+            }
+            let r = catalogue.reduction(reduction).ok_or_else(|| fields.err("reduction", &format!("names no catalogue reduction '{reduction}' (known: {})", catalogue.reduction_names())))?;
+            let list = r.ratios.iter().map(|x| x.to_string()).collect::<Vec<_>>().join(", ");
+            let ratio = match fields.optional_positive("gear_ratio")? {
+                Some(x) => x,
+                None if r.ratios.len() == 1 => r.ratios[0],
+                None => return Err(fields.err("gear_ratio", &format!("is missing: '{reduction}' comes in {list}"))),
+            };
+            if r.efficiency.is_none() {
+                eprintln!("armscope: notice: {}: {what}: reduction '{reduction}' publishes no efficiency: simulated lossless", path.display());
+            }
+            set.joints[index] = Some(own.then_reduction(r, ratio).ok_or_else(|| fields.err("gear_ratio", &format!("{ratio} is not a ratio of '{reduction}' ({list})")))?);
+            continue;
+        } else if t.contains_key("reduction") {
+            return Err(fields.err("reduction", "must be the name of a catalogue reduction"));
+        }
+        let ratio = fields.optional_positive("gear_ratio")?.unwrap_or(1.0);
+        let gear = fields.gear("")?;
+        let rated = fields.optional_positive("rated_torque")?.unwrap_or(f64::INFINITY);
         set.joints[index] = Some(own.followed_by(ratio, gear, rated));
     }
     Ok(set)

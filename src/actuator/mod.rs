@@ -5,8 +5,10 @@
 //! a model's joints, from a motor file (`--motors FILE.toml`, see [`catalogue`]).
 
 pub mod catalogue;
+pub mod catalogue_listing;
 mod lossy_gear;
 mod open_loop;
+pub mod reduction;
 mod servo;
 mod stepper;
 pub mod thermal;
@@ -14,6 +16,7 @@ pub mod thermal;
 pub use catalogue::{Catalogue, load_motor_file};
 pub use lossy_gear::LossyGear;
 pub use open_loop::{LostSteps, OpenLoopSteppers};
+pub use reduction::{Reduction, Stage};
 pub use servo::DcServo;
 pub use stepper::{PullOut, Stepper};
 
@@ -58,13 +61,26 @@ pub struct DriveTrain {
     /// vendors' RMS check (None: not checked; an open-loop stepper draws its set current whatever
     /// the load, so its heat is the driver's setting, not the motion's).
     pub continuous_torque: Option<f64>,
+    /// The reductions' inertia seen at the motor's shaft, beyond its rotor, kg·m².
+    pub input_inertia: f64,
+    /// The highest motor speed the reductions allow at their inputs, rad/s.
+    pub max_motor_speed: Option<f64>,
+    /// The reductions' rated average torque at the joint (the cubic-mean check), N·m.
+    pub rated_average_torque: Option<f64>,
+    /// The catalogue reductions after the motor, by name (for reports).
+    pub reductions: Vec<String>,
 }
 
 impl DriveTrain {
     /// A drive train whose gearbox loses the same fraction both ways (η_b = η) and has no friction
     /// at no load.
     pub fn new(motor: Box<dyn Motor>, gear_ratio: f64, efficiency: f64, rated_torque: f64) -> Self {
-        Self { motor, gear_ratio, gear: LossyGear::with_efficiency(efficiency), rated_torque, heat: None, continuous_torque: None }
+        Self::with_gear(motor, gear_ratio, LossyGear::with_efficiency(efficiency), rated_torque)
+    }
+
+    /// A motor behind one gearbox of the given losses and peak rating, nothing else known of it.
+    pub fn with_gear(motor: Box<dyn Motor>, gear_ratio: f64, gear: LossyGear, rated_torque: f64) -> Self {
+        Self { motor, gear_ratio, gear, rated_torque, heat: None, continuous_torque: None, input_inertia: 0.0, max_motor_speed: None, rated_average_torque: None, reductions: Vec::new() }
     }
 
     /// The gearbox's efficiency when the motor drives, η.
@@ -125,14 +141,46 @@ impl DriveTrain {
     /// ratios multiply and the losses compose ([`LossyGear::followed_by`]); the first gearbox's
     /// rating, at its output, is carried through the second, whose own rating caps it.
     pub fn followed_by(self, gear_ratio: f64, next: LossyGear, rated_torque: f64) -> Self {
+        self.then(&Stage::plain(gear_ratio, next, rated_torque))
+    }
+
+    /// This drive train followed by `stage`: ratios multiply, losses compose, the ratings so far are
+    /// carried through the stage (×η·N) and capped by its own; its input turns at the motor's speed
+    /// over the ratio so far (its speed limit times that ratio bounds the motor), and its input
+    /// inertia reaches the motor's shaft divided by that ratio squared.
+    pub fn then(self, stage: &Stage) -> Self {
+        let through = stage.ratio * stage.gear.efficiency;
+        let rated_average_torque = match (self.rated_average_torque.map(|r| r * through), stage.rated_average_torque) {
+            (Some(a), Some(b)) => Some(a.min(b)),
+            (a, b) => a.or(b),
+        };
+        let max_motor_speed = match (self.max_motor_speed, stage.max_input_speed.map(|w| w * self.gear_ratio)) {
+            (Some(a), Some(b)) => Some(a.min(b)),
+            (a, b) => a.or(b),
+        };
         Self {
-            rated_torque: (self.rated_torque * gear_ratio * next.efficiency).min(rated_torque),
-            gear: self.gear.followed_by(gear_ratio, &next),
-            gear_ratio: self.gear_ratio * gear_ratio,
-            motor: self.motor,
-            heat: self.heat,
-            continuous_torque: self.continuous_torque,
+            rated_torque: (self.rated_torque * through).min(stage.peak_torque),
+            gear: self.gear.followed_by(stage.ratio, &stage.gear),
+            input_inertia: self.input_inertia + stage.input_inertia / (self.gear_ratio * self.gear_ratio),
+            gear_ratio: self.gear_ratio * stage.ratio,
+            rated_average_torque,
+            max_motor_speed,
+            ..self
         }
+    }
+
+    /// This drive train followed by the catalogue reduction `reduction` at `ratio`; None when it has
+    /// no such ratio.
+    pub fn then_reduction(self, reduction: &Reduction, ratio: f64) -> Option<Self> {
+        let stage = reduction.stage(ratio)?;
+        let mut out = self.then(&stage);
+        out.reductions.push(reduction.name.clone());
+        Some(out)
+    }
+
+    /// The inertia turning at the motor's speed: its rotor and the reductions' inputs, kg·m².
+    pub fn shaft_inertia(&self) -> f64 {
+        self.motor.rotor_inertia() + self.input_inertia
     }
 
     /// A stepper's detent torque at the joint, N·T_d(N·offset), with the joint `offset` (rad) from
@@ -141,9 +189,9 @@ impl DriveTrain {
         self.motor.as_stepper().map_or(0.0, |s| self.gear_ratio * s.detent_torque_at(self.gear_ratio * offset))
     }
 
-    /// The rotor's inertia seen at the joint, J_r·N².
+    /// The rotor's (and the reductions' input) inertia seen at the joint, J·N².
     pub fn reflected_inertia(&self) -> f64 {
-        self.motor.rotor_inertia() * self.gear_ratio * self.gear_ratio
+        self.shaft_inertia() * self.gear_ratio * self.gear_ratio
     }
 
     /// The joint speed above which the joint gets less than `fraction` of its torque at rest

@@ -2,6 +2,7 @@
 
 mod analyze;
 mod batch;
+mod catalogue;
 mod compare;
 mod envelope;
 mod model;
@@ -12,6 +13,7 @@ mod trajectory;
 
 pub use analyze::{AnalyzeArgs, analyze};
 pub use batch::{BatchAction, BatchArgs, batch};
+pub use catalogue::{CatalogueArgs, catalogue};
 pub use compare::{CompareArgs, compare};
 pub use envelope::{EnvelopeArgs, envelope};
 pub use model::{ModelArgs, model};
@@ -58,6 +60,8 @@ pub enum Command {
     /// Which motor and which gear ratio per joint for a motion: ranks a catalogue over a range of
     /// ratios, verifies the choice in simulation, writes a motor file for `run --motors`.
     Size(SizeArgs),
+    /// The motors and reductions to choose from, each with its source; --check FILE validates yours.
+    Catalogue(CatalogueArgs),
 }
 
 /// Parse `args` and run; returns the process exit code. Errors are printed as one line.
@@ -99,6 +103,7 @@ fn run_command(command: Command) -> Result<i32, Error> {
         Command::Envelope(args) => envelope(&args),
         Command::Model(args) => model(&args),
         Command::Size(args) => size(&args),
+        Command::Catalogue(args) => catalogue(&args),
     }
 }
 

@@ -2,7 +2,7 @@
 
 use super::*;
 use crate::actuator::Catalogue;
-use crate::sizing::screening::{SizeRequest, size as size_joints};
+use crate::sizing::screening::{Reductions, SizeRequest, size as size_joints};
 
 #[derive(Args, Debug)]
 pub struct SizeArgs {
@@ -31,20 +31,26 @@ pub struct SizeArgs {
     /// A payload at the tool, kg.
     #[arg(long, default_value_t = 0.0)]
     pub payload: f64,
-    /// The motor catalogue (default: the built-in assets/motors/catalogue.toml).
+    /// A catalogue of your own, on top of the built-in assets/motors/catalogue.toml (its entries
+    /// added, or replacing built-in ones of the same name).
     #[arg(long, value_name = "FILE")]
     pub catalogue: Option<PathBuf>,
     /// Only these catalogue motors (comma list; default: every motor with a mass).
     #[arg(long, value_delimiter = ',', num_args = 1)]
     pub candidates: Option<Vec<String>>,
-    /// Gear ratios to try after the motor: a range `1-50` (whole numbers), `1-50:0.5` (a step), a
-    /// list `5,10,15`, or mixed; `JOINT=SPEC` for one joint (repeat the flag).
-    #[arg(long, value_name = "SPEC", default_value = "1-50")]
+    /// Only these catalogue reductions (comma list; default: every one whose efficiency is
+    /// published), each at its own ratios, beside a direct drive.
+    #[arg(long, value_delimiter = ',', num_args = 1, conflicts_with = "ratios")]
+    pub reductions: Option<Vec<String>>,
+    /// Instead of the catalogue's reductions, ideal ones at these ratios (your own gearing): a range
+    /// `1-50` (whole numbers), `1-50:0.5` (a step), a list `5,10,15`, or mixed; `JOINT=SPEC` for
+    /// one joint (repeat the flag).
+    #[arg(long, value_name = "SPEC")]
     pub ratios: Vec<String>,
     /// Headroom on torque and on speed: 0.3 asks for 30 % more than the motion needs.
     #[arg(long, default_value_t = 0.3)]
     pub margin: f64,
-    /// Efficiency of the reduction chosen (a direct drive, ratio 1, is 100 %).
+    /// Efficiency of the ideal reductions of `--ratios` (a direct drive, ratio 1, is 100 %).
     #[arg(long, default_value_t = 0.9)]
     pub efficiency: f64,
     /// Microsteps of the stepper drivers.
@@ -207,8 +213,11 @@ pub fn size(args: &SizeArgs) -> Result<i32, Error> {
     for notice in &model.notices {
         eprintln!("armscope: notice: {notice}");
     }
-    let catalogue_path = args.catalogue.clone().unwrap_or_else(|| PathBuf::from(crate::actuator::catalogue::DEFAULT_CATALOGUE));
-    let catalogue = Catalogue::load(&catalogue_path)?;
+    let catalogue = match &args.catalogue {
+        Some(path) => Catalogue::with_user_file(path)?,
+        None => Catalogue::load(std::path::Path::new(crate::actuator::catalogue::DEFAULT_CATALOGUE))?,
+    };
+    let catalogue_path = catalogue.source.clone();
     let motors: Vec<String> = match &args.candidates {
         Some(names) => {
             for name in names {
@@ -235,10 +244,31 @@ pub fn size(args: &SizeArgs) -> Result<i32, Error> {
         return Err(Error::flag("--candidates", format!("no motor with a mass in {}", catalogue_path.display())));
     }
     let joint_names: Vec<String> = model.joints.iter().map(|j| j.name.clone()).collect();
-    let ratios = parse_ratios(&args.ratios, &joint_names)?;
+    let reductions = if !args.ratios.is_empty() {
+        Reductions::Ideal(parse_ratios(&args.ratios, &joint_names)?)
+    } else {
+        match &args.reductions {
+            Some(names) => {
+                for name in names {
+                    let r = catalogue.reduction(name).ok_or_else(|| Error::flag("--reductions", format!("no reduction '{name}' in the catalogue (known: {})", catalogue.reduction_names())))?;
+                    if !r.sizable() {
+                        eprintln!("armscope: notice: reduction '{name}' publishes no efficiency: sized as lossless, an optimistic bound");
+                    }
+                }
+                Reductions::Catalogue(names.clone())
+            }
+            None => {
+                let (with, without): (Vec<String>, Vec<String>) = catalogue.reductions.keys().cloned().partition(|name| catalogue.reductions[name].sizable());
+                if !without.is_empty() {
+                    eprintln!("armscope: notice: reductions left out, no efficiency published: {} (name them in --reductions to size them lossless)", without.join(", "));
+                }
+                Reductions::Catalogue(with)
+            }
+        }
+    };
     let jobs = args.jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
     let started = std::time::Instant::now();
-    let request = SizeRequest { motions, model, payload_kg: args.payload, catalogue, motors, ratios, margin: args.margin, efficiency: args.efficiency, microsteps: args.microsteps, jobs, duty: args.duty.map(|hours| hours * 3600.0) };
+    let request = SizeRequest { motions, model, payload_kg: args.payload, catalogue, motors, reductions, margin: args.margin, efficiency: args.efficiency, microsteps: args.microsteps, jobs, duty: args.duty.map(|hours| hours * 3600.0) };
     let report = size_joints(&request)?;
 
     std::fs::create_dir_all(&args.out).map_err(|e| Error::output(&args.out, e))?;

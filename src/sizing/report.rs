@@ -19,6 +19,16 @@ fn ratio_text(r: f64) -> String {
     if r.fract() == 0.0 { format!("{r:.0}") } else { format!("{r}") }
 }
 
+impl Candidate {
+    /// The drive train in words: "17HS4401 + NPS015 at 5:1", "17HS4401 at 12:1", "XM430-W350 (direct)".
+    pub fn drive_name(&self) -> String {
+        match (&self.reduction, self.ratio) {
+            (Some(r), ratio) => format!("{} + {r} at {}:1", self.motor, ratio_text(ratio)),
+            (None, ratio) => format!("{} at {}:1", self.motor, ratio_text(ratio)),
+        }
+    }
+}
+
 impl JointSizing {
     /// The last simulation of candidate `c`, in words.
     fn simulation(&self, c: usize) -> Option<String> {
@@ -35,7 +45,7 @@ impl JointSizing {
             None => format!("{} the torque, {} the speed needed", times(x.torque_headroom), times(x.speed_headroom)),
             Some(s) => s.describe(),
         };
-        format!("{} at {}:1 ({:.2} N·m at rest, {fit}{sim})", x.motor, ratio_text(x.ratio), x.torque_at_rest)
+        format!("{} ({:.2} N·m at rest, {:.3} kg, {fit}{sim})", x.drive_name(), x.torque_at_rest, x.mass_kg)
     }
 
     fn candidate(&self, c: Option<usize>) -> Option<&Candidate> {
@@ -47,34 +57,38 @@ impl SizeReport {
     /// Markdown: per joint the choice, the runner-up and why the nearest rejected ones fail.
     pub fn markdown(&self) -> String {
         let mut md = format!(
-            "# Motor sizing for {}\n\nMotion: {}; payload {} kg at the tool; margin {:.0} % on torque and speed; the chosen reduction {:.0} % efficient; {} microsteps.\nCandidates: {}.\n\n",
+            "# Motor sizing for {}\n\nMotion: {}; payload {} kg at the tool; margin {:.0} % on torque and speed; {}; {} microsteps.\nCandidates: {}.\n\n",
             self.model,
             self.motions.join(", "),
             self.payload_kg,
             100.0 * self.margin,
-            100.0 * self.efficiency,
+            if self.reductions.is_empty() { format!("ideal reductions {:.0} % efficient", 100.0 * self.efficiency) } else { format!("reductions from the catalogue ({}) or a direct drive", self.reductions.join(", ")) },
             self.microsteps,
             self.motors.join(", ")
         );
+        if !self.weightless_reductions.is_empty() {
+            md += &format!("Reductions without a published mass, counted as weightless: {}.\n\n", self.weightless_reductions.join(", "));
+        }
         md += &format!(
             "Duty checks (beside the peak torque on the curve): each motor's RMS torque with the margin against its continuous rating, and the winding of a motor with thermal data over {} at that RMS current, from 25 °C ambient.{}\n\n",
             if self.duty_seconds >= 3600.0 { format!("{} h", (self.duty_seconds / 3.6).round() / 1000.0) } else { format!("{:.0} s", self.duty_seconds) },
             if self.duty_unchecked.is_empty() { String::new() } else { format!(" Not duty-checked (no continuous rating, no thermal data in the catalogue): {}.", self.duty_unchecked.join(", ")) }
         );
-        md += "| joint | motor | ratio | at rest (N·m) | torque to spare | speed to spare | simulated | runner-up |\n|---|---|---|---|---|---|---|---|\n";
+        md += "| joint | motor | reduction | ratio | mass (kg) | at rest (N·m) | torque to spare | speed to spare | simulated | runner-up |\n|---|---|---|---|---|---|---|---|---|---|\n";
         for js in &self.joints {
             if js.candidates.is_empty() {
                 continue;
             }
             let Some(c) = js.candidate(js.chosen) else {
-                md += &format!("| {} | none fits | | | | | | |\n", js.joint);
+                md += &format!("| {} | none fits | | | | | | | | |\n", js.joint);
                 continue;
             };
             let sim = js.chosen.and_then(|c| js.simulation(c)).unwrap_or_else(|| "–".to_string());
-            let runner = js.candidate(js.runner_up).map_or("–".to_string(), |r| format!("{} at {}:1", r.motor, ratio_text(r.ratio)));
+            let runner = js.candidate(js.runner_up).map_or("–".to_string(), Candidate::drive_name);
             let top = js.candidates.iter().filter(|x| x.motor == c.motor).map(|x| x.ratio).fold(0.0, f64::max);
             let edge = if c.ratio == top { " (the largest tried)" } else { "" };
-            md += &format!("| {} | {} | {}{edge} | {:.2} | {} | {} | {sim} | {runner} |\n", js.joint, c.motor, ratio_text(c.ratio), c.torque_at_rest, times(c.torque_headroom), times(c.speed_headroom));
+            let reduction = c.reduction.clone().unwrap_or_else(|| if c.ratio == 1.0 { "direct".into() } else { "ideal".into() });
+            md += &format!("| {} | {} | {reduction} | {}{edge} | {:.3} | {:.2} | {} | {} | {sim} | {runner} |\n", js.joint, c.motor, ratio_text(c.ratio), c.mass_kg, c.torque_at_rest, times(c.torque_headroom), times(c.speed_headroom));
         }
         md += &format!(
             "\n{} ({} simulation rounds, {} simulations).\n\nWhy not the nearest rejected candidates:\n\n",
@@ -117,7 +131,10 @@ impl SizeReport {
         toml += &format!("description = \"armscope size: payload {} kg, margin {:.0} %\"\n", self.payload_kg, 100.0 * self.margin);
         for js in &self.joints {
             let Some(c) = js.candidate(js.chosen) else { continue };
-            toml += &format!("\n[joints.{}]\nmotor = {:?}\ngear_ratio = {}\nefficiency = {}\nmicrosteps = {}\n", toml_key(&js.joint), c.motor, c.ratio, if c.ratio == 1.0 { 1.0 } else { self.efficiency }, self.microsteps);
+            toml += &match &c.reduction {
+                Some(r) => format!("\n[joints.{}]\nmotor = {:?}\nreduction = {r:?}\ngear_ratio = {}\nmicrosteps = {}\n", toml_key(&js.joint), c.motor, c.ratio, self.microsteps),
+                None => format!("\n[joints.{}]\nmotor = {:?}\ngear_ratio = {}\nefficiency = {}\nmicrosteps = {}\n", toml_key(&js.joint), c.motor, c.ratio, if c.ratio == 1.0 { 1.0 } else { self.efficiency }, self.microsteps),
+            };
         }
         toml
     }
@@ -133,17 +150,26 @@ impl SizeReport {
                 motors.push(&c.motor);
             }
         }
-        let ratios: Vec<f64> = js.candidates.iter().filter(|c| c.motor == motors[0]).map(|c| c.ratio).collect();
+        // columns: the drive options after the motor (reduction, ratio), by ratio
+        let mut columns: Vec<(f64, Option<&str>)> = js.candidates.iter().map(|c| (c.ratio, c.reduction.as_deref())).collect();
+        columns.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        columns.dedup();
+        let ratios: Vec<f64> = columns.iter().map(|c| c.0).collect();
         let cw = (900 / ratios.len().max(1)).clamp(12, 64);
-        let ch = 40;
+        let ch = (1400 / motors.len().max(1)).clamp(16, 40);
         let (left, bottom, top, right) = (230, 110, 70, 30);
         let (cols, rows) = (ratios.len(), motors.len());
-        let mut canvas = Canvas::new(left + cols * cw + right, top + rows * ch + bottom, [250, 250, 250]);
+        let legend = match js.candidate(js.chosen) {
+            Some(c) => format!("BLACK FRAME: CHOSEN {}. GREY: RUNNER-UP. RED: INFEASIBLE (ABOVE 1). DOT: FAILED IN SIMULATION", c.drive_name().to_uppercase()),
+            None => "NO CANDIDATE FITS. RED: INFEASIBLE (ABOVE 1). DOT: FAILED IN SIMULATION".to_string(),
+        };
+        let width = (left + cols * cw + right).max(Canvas::text_width(&legend, 2) + 16);
+        let mut canvas = Canvas::new(width, top + rows * ch + bottom, [250, 250, 250]);
         let dark = [30, 30, 30];
         let title = format!("{}: NEED X {:.1} / AVAILABLE{}", js.joint, 1.0 + self.margin, if self.payload_kg > 0.0 { format!(", PAYLOAD {} KG", self.payload_kg) } else { String::new() });
         canvas.text(left.min(20), 18, &title, 3, dark);
         for (c, cand) in js.candidates.iter().enumerate() {
-            let (Some(row), Some(col)) = (motors.iter().position(|m| *m == cand.motor), ratios.iter().position(|r| *r == cand.ratio)) else { continue };
+            let (Some(row), Some(col)) = (motors.iter().position(|m| *m == cand.motor), columns.iter().position(|c| c.0 == cand.ratio && c.1 == cand.reduction.as_deref())) else { continue };
             let (x, y) = (left + col * cw, top + (rows - 1 - row) * ch);
             let frame = if Some(c) == js.chosen { Some(dark) } else if Some(c) == js.runner_up { Some([120, 120, 120]) } else { None };
             match frame {
@@ -174,10 +200,6 @@ impl SizeReport {
         let x_label = "GEAR RATIO AFTER THE MOTOR";
         canvas.text(left + (cols * cw).saturating_sub(Canvas::text_width(x_label, 2)) / 2, top + rows * ch + 36, x_label, 2, dark);
         canvas.text(8, top - 22, "MOTOR (LIGHTEST AT THE BOTTOM)", 2, dark);
-        let legend = match js.candidate(js.chosen) {
-            Some(c) => format!("BLACK FRAME: CHOSEN {} AT {}. GREY: RUNNER-UP. RED: INFEASIBLE (ABOVE 1). DOT: FAILED IN SIMULATION", c.motor, ratio_text(c.ratio)),
-            None => "NO CANDIDATE FITS. RED: INFEASIBLE (ABOVE 1). DOT: FAILED IN SIMULATION".to_string(),
-        };
         canvas.text(8, top + rows * ch + 70, &legend, 2, dark);
         canvas
     }

@@ -39,17 +39,27 @@ pub struct SizeRequest {
     pub catalogue: Catalogue,
     /// Candidate motors (catalogue names with a mass).
     pub motors: Vec<String>,
-    /// Per coordinate: the ratios to try after the motor (and after a gearmotor's own gearbox).
-    pub ratios: Vec<Vec<f64>>,
+    /// The reductions to try after the motor (and after a gearmotor's own gearbox).
+    pub reductions: Reductions,
     /// Headroom on torque and on speed: 0.3 asks for 30 % more than the motion needs.
     pub margin: f64,
-    /// Efficiency of the reduction the sweep chooses (1 at ratio 1: a direct drive).
+    /// Efficiency of an ideal reduction (`Reductions::Ideal`; 1 at ratio 1: a direct drive).
     pub efficiency: f64,
     pub microsteps: u32,
     /// Simulations at once.
     pub jobs: usize,
     /// How long the motion goes on, s, for the thermal check (None: the motions' own duration).
     pub duty: Option<f64>,
+}
+
+/// What may follow a motor.
+#[derive(Clone, Debug)]
+pub enum Reductions {
+    /// The catalogue's reductions of these names at each of their ratios, and a direct drive.
+    Catalogue(Vec<String>),
+    /// Per coordinate, ideal reductions at these ratios, of the request's efficiency (the user's own
+    /// gearing, `--ratios`).
+    Ideal(Vec<Vec<f64>>),
 }
 
 /// Why a candidate cannot carry the motion, at the instant where it falls shortest.
@@ -64,6 +74,10 @@ pub enum Shortfall {
     Gearbox { at: Instant, need: f64, rated: f64 },
     /// Without its own rotor's J_r·N² the motion would fit: the reflected inertia breaks it.
     ReflectedInertia { at: Instant, reflected: f64, need: f64, available: f64 },
+    /// The motor turns faster than the reduction's input allows.
+    InputSpeed { at: Instant, motor_speed: f64, limit: f64 },
+    /// The cubic mean of the torque at the reduction's output exceeds its rated (average) torque.
+    GearboxAverage { need: f64, rated: f64 },
     /// The motor's RMS torque over the motion (with the margin) exceeds its continuous rating.
     Rms { need: f64, continuous: f64 },
     /// The winding would pass its limit within the duty at the motion's RMS current (with the margin).
@@ -107,6 +121,13 @@ impl Shortfall {
                 let (need, available) = distinct(*need, *available);
                 format!("reflected inertia: the rotor's J_r·N² = {reflected:.3} kg·m² raises the need to {need} N·m at {at}, gets {available}")
             }
+            Shortfall::InputSpeed { at, motor_speed, limit } => {
+                format!("input speed: the motor turns at {:.0} rpm with the margin at {at}, the reduction allows {:.0} rpm", motor_speed * 60.0 / std::f64::consts::TAU, limit * 60.0 / std::f64::consts::TAU)
+            }
+            Shortfall::GearboxAverage { need, rated } => {
+                let (need_s, rated_s) = distinct(*need, *rated);
+                format!("gearbox average torque: the cubic mean {need_s} N·m with the margin is {:.0} % over its rated {rated_s} N·m", 100.0 * (need / rated - 1.0))
+            }
             Shortfall::Rms { need, continuous } => {
                 let (need_s, continuous_s) = distinct(*need, *continuous);
                 format!("RMS torque: the motor's {need_s} N·m RMS with the margin is {:.0} % over its continuous {continuous_s} N·m", 100.0 * (need / continuous - 1.0))
@@ -131,6 +152,10 @@ fn distinct(a: f64, b: f64) -> (String, String) {
 #[derive(Clone, Debug, Serialize)]
 pub struct Candidate {
     pub motor: String,
+    /// The catalogue reduction after the motor (None: a direct drive, or an ideal reduction).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reduction: Option<String>,
+    /// The motor's and the reduction's mass (a reduction without a published mass counts 0).
     pub mass_kg: f64,
     /// The ratio chosen after the motor.
     pub ratio: f64,
@@ -203,6 +228,10 @@ pub struct SizeReport {
     /// Candidate motors whose duty was not checked, as they lack a continuous rating and thermal
     /// data (with what each lacks).
     pub duty_unchecked: Vec<String>,
+    /// The catalogue reductions tried (empty: ideal reductions of `efficiency`).
+    pub reductions: Vec<String>,
+    /// Reductions tried whose mass is not published (counted as weightless).
+    pub weightless_reductions: Vec<String>,
 }
 
 /// The commanded motion of every experiment, per joint: speed, acceleration and the torque without
@@ -240,10 +269,33 @@ fn commanded_motion(request: &SizeRequest) -> Result<Motion, Error> {
     Ok(motion)
 }
 
-/// The drive train of `motor` behind `ratio` at efficiency `efficiency` (1 for ratio 1).
-pub fn drive_train(catalogue: &Catalogue, motor: &str, ratio: f64, efficiency: f64) -> Result<DriveTrain, Error> {
+/// The drive train of `motor` behind the catalogue's `reduction` at `ratio`, or without one behind an
+/// ideal `ratio` at efficiency `efficiency` (1 for ratio 1).
+pub fn drive_train(catalogue: &Catalogue, motor: &str, reduction: Option<&str>, ratio: f64, efficiency: f64) -> Result<DriveTrain, Error> {
     let own = catalogue.drive_train(motor).ok_or_else(|| Error::flag("--candidates", format!("no motor '{motor}' in {} (known: {})", catalogue.source.display(), catalogue.names())))??;
-    Ok(own.followed_by(ratio, LossyGear::with_efficiency(if ratio == 1.0 { 1.0 } else { efficiency }), f64::INFINITY))
+    match reduction {
+        Some(name) => {
+            let r = catalogue.reduction(name).ok_or_else(|| Error::flag("--reductions", format!("no reduction '{name}' in {} (known: {})", catalogue.source.display(), catalogue.reduction_names())))?;
+            own.then_reduction(r, ratio).ok_or_else(|| Error::flag("--reductions", format!("'{name}' has no ratio {ratio}")))
+        }
+        None => Ok(own.followed_by(ratio, LossyGear::with_efficiency(if ratio == 1.0 { 1.0 } else { efficiency }), f64::INFINITY)),
+    }
+}
+
+/// Per joint, the (reduction, ratio) pairs to try after each motor.
+fn options(request: &SizeRequest, j: usize) -> Vec<(Option<String>, f64)> {
+    match &request.reductions {
+        Reductions::Ideal(ratios) => ratios[j].iter().map(|&r| (None, r)).collect(),
+        Reductions::Catalogue(names) => {
+            let mut out = vec![(None, 1.0)];
+            for name in names {
+                if let Some(r) = request.catalogue.reduction(name) {
+                    out.extend(r.ratios.iter().map(|&ratio| (Some(name.clone()), ratio)));
+                }
+            }
+            out
+        }
+    }
 }
 
 /// Rate one candidate on joint `j`'s commanded motion: its share with the margin, torque and speed
@@ -264,6 +316,15 @@ fn rate(drive: &DriveTrain, motion: &Motion, j: usize, margin: f64) -> (f64, f64
     }
     let torque_headroom = if plain_worst > 0.0 { 1.0 / plain_worst } else { f64::INFINITY };
     let speed_headroom = if top_speed > 0.0 { drive.speed_at_fraction(0.5) / top_speed } else { f64::INFINITY };
+    // the reduction's input speed, with the margin on speed
+    if let Some(limit) = drive.max_motor_speed {
+        let motor_speed = k * drive.gear_ratio * top_speed;
+        if motor_speed > limit && motor_speed / limit > worst {
+            let i = (0..motion.t.len()).max_by(|&a, &b| motion.speed[j][a].abs().total_cmp(&motion.speed[j][b].abs())).unwrap_or(0);
+            let at = Instant { t: motion.t[i], experiment: motion.names.get(motion.experiment[i]).cloned() };
+            return (motor_speed / limit, torque_headroom, speed_headroom, Some(Shortfall::InputSpeed { at, motor_speed, limit }));
+        }
+    }
     if worst <= 1.0 {
         return (worst, torque_headroom, speed_headroom, None);
     }
@@ -296,11 +357,18 @@ fn rate(drive: &DriveTrain, motion: &Motion, j: usize, margin: f64) -> (f64, f64
 /// K_t) against its limit over `duty` seconds from ambient. Returns the larger share (≤ 1 passes)
 /// and why it fails.
 fn rate_duty(drive: &DriveTrain, motion: &Motion, j: usize, margin: f64, duty: f64) -> (f64, Option<Shortfall>) {
-    if drive.continuous_torque.is_none() && drive.heat.is_none() {
-        return (0.0, None);
-    }
     let reflected = drive.reflected_inertia();
     let samples = motion.t.len().max(1) as f64;
+    // the gearbox makers' average torque: the cubic mean at the output (Harmonic Drive's T_av)
+    let gearbox = drive.rated_average_torque.map(|rated| {
+        let cubic = (0..motion.t.len()).map(|i| (motion.torque[j][i] + reflected * motion.acceleration[j][i]).abs().powi(3)).sum::<f64>() / samples;
+        let need = (1.0 + margin) * cubic.cbrt();
+        (need / rated, (need > rated).then_some(Shortfall::GearboxAverage { need, rated }))
+    });
+    let (gearbox_share, gearbox_shortfall) = gearbox.unwrap_or((0.0, None));
+    if drive.continuous_torque.is_none() && drive.heat.is_none() {
+        return (gearbox_share, gearbox_shortfall);
+    }
     let mean_square: f64 = (0..motion.t.len())
         .map(|i| {
             let torque = motion.torque[j][i] + reflected * motion.acceleration[j][i];
@@ -335,7 +403,7 @@ fn rate_duty(drive: &DriveTrain, motion: &Motion, j: usize, margin: f64, duty: f
         };
         share = share.max(thermal_share);
     }
-    (share, shortfall)
+    (share.max(gearbox_share), shortfall.or(gearbox_shortfall))
 }
 
 /// Size every actuated joint; see the module's notes for the method.
@@ -348,22 +416,28 @@ pub fn size(request: &SizeRequest) -> Result<SizeReport, Error> {
     for j in 0..n {
         let mut candidates = Vec::new();
         if model.is_actuated(j) {
+            let options = options(request, j);
             for motor in &request.motors {
-                let mass_kg = request.catalogue.mass(motor).unwrap_or(f64::NAN);
-                for &ratio in &request.ratios[j] {
-                    let drive = drive_train(&request.catalogue, motor, ratio, request.efficiency)?;
+                let motor_mass = request.catalogue.mass(motor).unwrap_or(f64::NAN);
+                for (reduction, ratio) in &options {
+                    if reduction.as_ref().is_some_and(|r| !request.catalogue.fits(motor, r)) {
+                        continue;
+                    }
+                    let ratio = *ratio;
+                    let mass_kg = motor_mass + reduction.as_ref().and_then(|r| request.catalogue.reduction(r)?.mass).unwrap_or(0.0);
+                    let drive = drive_train(&request.catalogue, motor, reduction.as_deref(), ratio, request.efficiency)?;
                     let (peak_share, torque_headroom, speed_headroom, peak_shortfall) = rate(&drive, &motion, j, request.margin);
                     let (duty_share, duty_shortfall) = rate_duty(&drive, &motion, j, request.margin, duty);
                     let share = peak_share.max(duty_share);
                     let shortfall = peak_shortfall.or(duty_shortfall);
-                    candidates.push(Candidate { motor: motor.clone(), mass_kg, ratio, total_ratio: drive.gear_ratio, torque_at_rest: drive.torque_limit(0.0), share, torque_headroom, speed_headroom, shortfall });
+                    candidates.push(Candidate { motor: motor.clone(), reduction: reduction.clone(), mass_kg, ratio, total_ratio: drive.gear_ratio, torque_at_rest: drive.torque_limit(0.0), share, torque_headroom, speed_headroom, shortfall });
                 }
             }
         }
         let mut ranked: Vec<usize> = (0..candidates.len()).filter(|&c| candidates[c].feasible()).collect();
         ranked.sort_by(|&a, &b| {
             let (x, y) = (&candidates[a], &candidates[b]);
-            x.mass_kg.total_cmp(&y.mass_kg).then(x.motor.cmp(&y.motor)).then(x.ratio.total_cmp(&y.ratio))
+            x.mass_kg.total_cmp(&y.mass_kg).then(x.motor.cmp(&y.motor)).then(x.ratio.total_cmp(&y.ratio)).then(x.reduction.cmp(&y.reduction))
         });
         joints.push(JointSizing { joint: model.joints[j].name.clone(), candidates, ranked, chosen: None, runner_up: None, simulated: Vec::new(), nearest_rejected: Vec::new() });
     }
@@ -513,6 +587,14 @@ pub fn size(request: &SizeRequest) -> Result<SizeReport, Error> {
             .filter(|m| request.catalogue.drive_train(m).and_then(Result::ok).is_some_and(|d| d.continuous_torque.is_none() && d.heat.is_none()))
             .cloned()
             .collect(),
+        reductions: match &request.reductions {
+            Reductions::Catalogue(names) => names.clone(),
+            Reductions::Ideal(_) => Vec::new(),
+        },
+        weightless_reductions: match &request.reductions {
+            Reductions::Catalogue(names) => names.iter().filter(|n| request.catalogue.reduction(n).is_some_and(|r| r.mass.is_none())).cloned().collect(),
+            Reductions::Ideal(_) => Vec::new(),
+        },
     })
 }
 
@@ -555,7 +637,7 @@ pub fn motor_set(request: &SizeRequest, joints: &[JointSizing], set: &[Option<us
     for (j, choice) in set.iter().enumerate() {
         if let Some(c) = choice {
             let candidate = &joints[j].candidates[*c];
-            motors.joints[j] = Some(drive_train(&request.catalogue, &candidate.motor, candidate.ratio, request.efficiency)?);
+            motors.joints[j] = Some(drive_train(&request.catalogue, &candidate.motor, candidate.reduction.as_deref(), candidate.ratio, request.efficiency)?);
             motors.microsteps[j] = Some(request.microsteps);
         }
     }
