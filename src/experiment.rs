@@ -7,7 +7,7 @@ use crate::control::gains::{Gains, TUTORIAL_KD, TUTORIAL_KP, auto_tune, is_tutor
 use crate::control::within_effort::{MOTION_LOAD, START_LOAD, carried_wave, holdable_pose, overloaded_by_weight};
 use crate::plant::{JointFriction, ContinuousPlant, DiscretePlant, Plant, Tolerances};
 use crate::actuator::{MotorSet, OpenLoopSteppers, load_motor_file};
-use crate::model::{Actuator, LoadOptions, Model, load_urdf_with};
+use crate::model::{LoadOptions, Model, load_urdf_with};
 use crate::control::sampled_loop::LoopPlant;
 use crate::control::trajectory::{Hold, JointSchedule, JointStep, JointWave, RampIn, Trajectory, Wave};
 use nalgebra::Vector3;
@@ -86,7 +86,10 @@ impl Experiment {
         let mut start = start_pose(&config, &model)?;
         let trajectory = trajectory(&config, &mut model, &mut start)?;
         let mut model = model.with_payload(config.payload);
-        let motors = motors.map(|set| Arc::new(apply_motor_set(set, &mut model)));
+        if let Some(set) = &motors {
+            install_drive_trains(&mut model, set)?;
+        }
+        let motors = motors.map(Arc::new);
         let mut plant = plant_spec(&config)?;
         let steppers = match &motors {
             Some(motors) if config.drive == DriveMode::Stepper && motors.has_steppers() => stepper_setup(&config, &mut model, motors, trajectory.as_ref(), &mut start, &mut plant),
@@ -415,17 +418,32 @@ fn weight_notices(model: &mut Model, start: &[f64]) {
     }
 }
 
-/// Give each joint of a motor set its motor: an actuator whose effort is the torque the drive train
-/// gives at rest, its gear ratio, and the rotor's inertia (so J_r·N² joins M).
-fn apply_motor_set(set: MotorSet, model: &mut Model) -> MotorSet {
-    let mut actuators = std::mem::take(&mut model.actuators);
-    for (joint, drive) in set.joints.iter().enumerate() {
-        let Some(drive) = drive else { continue };
-        actuators.retain(|a| a.joint != joint);
-        actuators.push(Actuator { name: drive.motor.name().to_string(), joint, effort: drive.torque_limit(0.0), gear_ratio: drive.gear_ratio, rotor_inertia: drive.shaft_inertia() });
+/// The drive trains on the arm: each joint's motor (its effort at rest, its rotor's J·N² on M's
+/// diagonal) and its parts as bodies (unless the motor file says the URDF has them), with one notice
+/// of what was added where.
+fn install_drive_trains(model: &mut Model, set: &MotorSet) -> Result<(), Error> {
+    let before = crate::actuator::carried::moving_mass(model);
+    let parts = crate::actuator::carried::install(model, set).map_err(|m| Error::flag("--motors", format!("{}: {m}", set.source.display())))?;
+    let unweighed: Vec<String> = set
+        .joints
+        .iter()
+        .enumerate()
+        .filter(|(j, d)| d.as_ref().is_some_and(|d| d.parts.iter().all(|p| p.name != d.motor.name())) && set.mounts[*j] != crate::actuator::Mount::InUrdf)
+        .map(|(j, d)| format!("{} ({})", model.joints[j].name, d.as_ref().map_or("", |d| d.motor.name())))
+        .collect();
+    if !parts.is_empty() {
+        let on: Vec<String> = parts.iter().map(|p| format!("{} {:.3} kg on {}", p.part.name, p.part.mass, if p.link.is_empty() { "the world" } else { &p.link })).collect();
+        model.notices.push(format!(
+            "drive trains carried on the arm ({}): the moving mass {:.3} → {:.3} kg{}",
+            on.join(", "),
+            before,
+            crate::actuator::carried::moving_mass(model),
+            if unweighed.is_empty() { String::new() } else { format!("; motors without a published mass, not carried: {}", unweighed.join(", ")) }
+        ));
+    } else if !unweighed.is_empty() {
+        model.notices.push(format!("motors without a published mass, not carried on the arm: {}", unweighed.join(", ")));
     }
-    model.set_actuators(actuators);
-    set
+    Ok(())
 }
 
 /// Stepper mode's set-up: the stepper joints start where the command starts (unless `--q0`), held at

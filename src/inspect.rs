@@ -80,7 +80,8 @@ pub fn dynamics_at(model: &Model, states: &[State]) -> Result<Value, Error> {
             "tau_g": tau_g, "Cv": cv, "qdd_no_damping": qdd, "qdd_with_damping": qdd_damped, "link_poses": poses,
         }));
     }
-    Ok(json!({ "joints": model.joints.iter().map(|j| &j.name).collect::<Vec<_>>(), "states": results }))
+    // the rotors' reflected inertia is in M's diagonal (no URDF field holds it): given beside it
+    Ok(json!({ "joints": model.joints.iter().map(|j| &j.name).collect::<Vec<_>>(), "armature": model.armature, "states": results }))
 }
 
 /// The model for people: one line per joint.

@@ -121,6 +121,16 @@ impl Catalogue {
         self.reductions.keys().cloned().collect::<Vec<_>>().join(", ")
     }
 
+    /// A motor's kind ("stepper", "servo", "dc"; "" if unknown).
+    pub fn kind(&self, motor: &str) -> &str {
+        self.entries.get(motor).and_then(|t| t.get("kind")).and_then(Value::as_str).unwrap_or("")
+    }
+
+    /// A stepper's frame ("NEMA17"), if given.
+    pub fn frame(&self, motor: &str) -> Option<&str> {
+        self.entries.get(motor).and_then(|t| t.get("frame")).and_then(Value::as_str)
+    }
+
     /// Whether reduction `reduction` can follow motor `motor` (see [`Reduction::fits`]).
     pub fn fits(&self, motor: &str, reduction: &str) -> bool {
         let (Some(t), Some(r)) = (self.entries.get(motor), self.reductions.get(reduction)) else { return false };
@@ -218,6 +228,12 @@ fn drive_train_from(source: &Path, name: &str, t: &toml::Table) -> Result<DriveT
     let mut drive = DriveTrain::with_gear(motor, gear_ratio, gear, rated);
     drive.heat = heat;
     drive.continuous_torque = continuous_torque;
+    if let Some(mass) = fields.optional_positive("mass")? {
+        // a NEMA frame's number is its flange width in tenths of an inch
+        let diameter = t.get("frame").and_then(Value::as_str).and_then(|f| f.strip_prefix("NEMA")).and_then(|n| n.parse::<f64>().ok()).map(|n| n * 0.1 * 0.0254);
+        let cylinder = diameter.zip(fields.optional_positive("length")?);
+        drive.parts.push(super::Part { name: name.to_string(), mass, cylinder });
+    }
     Ok(drive)
 }
 
@@ -380,6 +396,41 @@ impl Fields<'_> {
         Ok(Some(super::thermal::WindingHeat { thermal, torque_constant: self.positive("torque_constant")? }))
     }
 
+    /// Where a joint's parts sit: `in_urdf = true` (or the file's), else `mount_link` with
+    /// `mount_xyz` (m, in that link's frame; its origin when not given), else at the joint.
+    fn mount(&self, file_in_urdf: bool) -> Result<super::Mount, Error> {
+        let in_urdf = match self.table.get("in_urdf") {
+            None => file_in_urdf,
+            Some(Value::Boolean(b)) => *b,
+            Some(_) => return Err(self.err("in_urdf", "must be true or false")),
+        };
+        let link = match self.table.get("mount_link") {
+            None => None,
+            Some(Value::String(s)) => Some(s.clone()),
+            Some(_) => return Err(self.err("mount_link", "must be a link name")),
+        };
+        let offset = match self.table.get("mount_xyz") {
+            None => [0.0; 3],
+            Some(Value::Array(a)) if a.len() == 3 => {
+                let mut xyz = [0.0; 3];
+                for (x, v) in xyz.iter_mut().zip(a) {
+                    *x = v.as_float().or(v.as_integer().map(|i| i as f64)).filter(|x| x.is_finite()).ok_or_else(|| self.err("mount_xyz", "must be [x, y, z] in metres"))?;
+                }
+                xyz
+            }
+            Some(_) => return Err(self.err("mount_xyz", "must be [x, y, z] in metres")),
+        };
+        if in_urdf && (link.is_some() || self.table.contains_key("mount_xyz")) {
+            return Err(self.err("in_urdf", "and a mount: a drive train already in the URDF's masses is mounted nowhere else"));
+        }
+        Ok(match (in_urdf, link) {
+            (true, _) => super::Mount::InUrdf,
+            (false, Some(link)) => super::Mount::OnLink { link, offset },
+            (false, None) if self.table.contains_key("mount_xyz") => return Err(self.err("mount_xyz", "needs mount_link: the link the offset is in")),
+            (false, None) => super::Mount::AtJoint,
+        })
+    }
+
     /// A non-empty list of positive numbers.
     fn list(&self, field: &str) -> Result<Vec<f64>, Error> {
         let bad = || self.err(field, "must be a non-empty list of positive numbers");
@@ -455,9 +506,14 @@ impl Fields<'_> {
 pub fn load_motor_file(path: &Path, model: &Model) -> Result<MotorSet, Error> {
     let text = crate::builtin::read_to_string(path).map_err(|e| fail(path, format!("cannot read: {e}")))?;
     let table: toml::Table = text.parse().map_err(|e: toml::de::Error| fail(path, e.message().to_string()))?;
-    if let Some(k) = table.keys().find(|k| !["catalogue", "joints", "motors", "description"].contains(&k.as_str())) {
-        return Err(fail(path, format!("unknown key '{k}' (known: catalogue, joints, motors, description)")));
+    if let Some(k) = table.keys().find(|k| !["catalogue", "joints", "motors", "description", "in_urdf"].contains(&k.as_str())) {
+        return Err(fail(path, format!("unknown key '{k}' (known: catalogue, joints, motors, description, in_urdf)")));
     }
+    let all_in_urdf = match table.get("in_urdf") {
+        None => false,
+        Some(Value::Boolean(b)) => *b,
+        Some(_) => return Err(fail(path, "field 'in_urdf' must be true or false".into())),
+    };
     let mut catalogue = match table.get("catalogue") {
         Some(Value::String(file)) => Catalogue::with_user_file(&path.parent().unwrap_or(Path::new(".")).join(file))?,
         Some(_) => return Err(fail(path, "field 'catalogue' must be a file name".into())),
@@ -473,7 +529,7 @@ pub fn load_motor_file(path: &Path, model: &Model) -> Result<MotorSet, Error> {
         Some(Value::Table(t)) => t,
         _ => return Err(fail(path, "no [joints.NAME] tables".into())),
     };
-    let mut set = MotorSet { joints: (0..model.dof()).map(|_| None).collect(), microsteps: vec![None; model.dof()], acceleration: vec![None; model.dof()], source: path.to_path_buf() };
+    let mut set = MotorSet::empty(model.dof(), path);
     for (name, value) in joints {
         let what = format!("joint '{name}'");
         let Some(index) = model.joint_index(name) else {
@@ -481,8 +537,9 @@ pub fn load_motor_file(path: &Path, model: &Model) -> Result<MotorSet, Error> {
         };
         let Value::Table(t) = value else { return Err(fail(path, format!("{what}: expected a table"))) };
         let fields = Fields { file: path, what: &what, table: t };
-        fields.known(&["motor", "reduction", "gear_ratio", "efficiency", "backdrive_efficiency", "breakaway_torque", "viscous", "rated_torque", "microsteps", "acceleration"])?;
+        fields.known(&["motor", "reduction", "gear_ratio", "efficiency", "backdrive_efficiency", "breakaway_torque", "viscous", "rated_torque", "microsteps", "acceleration", "in_urdf", "mount_link", "mount_xyz"])?;
         set.acceleration[index] = fields.optional_positive("acceleration")?;
+        set.mounts[index] = fields.mount(all_in_urdf)?;
         if let Some(m) = fields.optional_positive("microsteps")? {
             if m.fract() != 0.0 || m > 1024.0 {
                 return Err(fields.err("microsteps", "must be a whole number up to 1024"));

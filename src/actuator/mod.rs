@@ -4,6 +4,7 @@
 //! behind a gearbox (ratio, efficiency, rated output torque); a [`MotorSet`] assigns drive trains to
 //! a model's joints, from a motor file (`--motors FILE.toml`, see [`catalogue`]).
 
+pub mod carried;
 pub mod catalogue;
 pub mod catalogue_listing;
 mod lossy_gear;
@@ -13,6 +14,7 @@ mod servo;
 mod stepper;
 pub mod thermal;
 
+pub use carried::{Mount, PlacedPart};
 pub use catalogue::{Catalogue, load_motor_file};
 pub use lossy_gear::LossyGear;
 pub use open_loop::{LostSteps, OpenLoopSteppers};
@@ -44,6 +46,34 @@ pub trait Motor: Debug + Send + Sync {
     }
 }
 
+/// A drive train's part as a body the arm carries: the motor (a solid cylinder where the catalogue
+/// gives its frame and length, a point mass otherwise) or a reduction (a point mass: no dimensions
+/// are published).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Part {
+    pub name: String,
+    pub mass: f64,
+    /// Diameter and length of a solid cylinder along the joint's axis, m.
+    pub cylinder: Option<(f64, f64)>,
+}
+
+impl Part {
+    /// Its inertia in a frame at its centre whose `axis` (unit) is the cylinder's.
+    pub fn inertia(&self, axis: &nalgebra::Vector3<f64>) -> crate::spatial::RigidInertia {
+        let inertia_com = match self.cylinder {
+            Some((diameter, length)) => {
+                let r2 = (0.5 * diameter).powi(2);
+                let along = 0.5 * self.mass * r2;
+                let across = self.mass * (3.0 * r2 + length * length) / 12.0;
+                let a = axis * axis.transpose();
+                (nalgebra::Matrix3::identity() - a) * across + a * along
+            }
+            None => nalgebra::Matrix3::zeros(),
+        };
+        crate::spatial::RigidInertia { mass: self.mass, com: nalgebra::Vector3::zeros(), inertia_com }
+    }
+}
+
 /// A motor behind a gearbox: the joint turns `gear_ratio` times slower than the motor, and the
 /// gearbox's losses act as friction at the joint by the direction power flows ([`LossyGear`]).
 #[derive(Debug)]
@@ -69,6 +99,8 @@ pub struct DriveTrain {
     pub rated_average_torque: Option<f64>,
     /// The catalogue reductions after the motor, by name (for reports).
     pub reductions: Vec<String>,
+    /// The parts whose mass is published: the motor, then its reductions.
+    pub parts: Vec<Part>,
 }
 
 impl DriveTrain {
@@ -80,7 +112,7 @@ impl DriveTrain {
 
     /// A motor behind one gearbox of the given losses and peak rating, nothing else known of it.
     pub fn with_gear(motor: Box<dyn Motor>, gear_ratio: f64, gear: LossyGear, rated_torque: f64) -> Self {
-        Self { motor, gear_ratio, gear, rated_torque, heat: None, continuous_torque: None, input_inertia: 0.0, max_motor_speed: None, rated_average_torque: None, reductions: Vec::new() }
+        Self { motor, gear_ratio, gear, rated_torque, heat: None, continuous_torque: None, input_inertia: 0.0, max_motor_speed: None, rated_average_torque: None, reductions: Vec::new(), parts: Vec::new() }
     }
 
     /// The gearbox's efficiency when the motor drives, η.
@@ -175,7 +207,15 @@ impl DriveTrain {
         let stage = reduction.stage(ratio)?;
         let mut out = self.then(&stage);
         out.reductions.push(reduction.name.clone());
+        if let Some(mass) = reduction.mass {
+            out.parts.push(Part { name: reduction.name.clone(), mass, cylinder: None });
+        }
         Some(out)
+    }
+
+    /// The published mass of its parts, kg.
+    pub fn mass(&self) -> f64 {
+        self.parts.iter().map(|p| p.mass).sum()
     }
 
     /// The inertia turning at the motor's speed: its rotor and the reductions' inputs, kg·m².
@@ -221,11 +261,18 @@ pub struct MotorSet {
     pub microsteps: Vec<Option<u32>>,
     /// Per coordinate, the step generator's acceleration bound, rad/s² at the joint (steppers).
     pub acceleration: Vec<Option<f64>>,
+    /// Per coordinate, where its drive train's parts sit (on the parent link at the joint by default).
+    pub mounts: Vec<Mount>,
     /// The motor file it came from.
     pub source: std::path::PathBuf,
 }
 
 impl MotorSet {
+    /// No motors yet on `dof` coordinates.
+    pub fn empty(dof: usize, source: impl Into<std::path::PathBuf>) -> Self {
+        Self { joints: (0..dof).map(|_| None).collect(), microsteps: vec![None; dof], acceleration: vec![None; dof], mounts: vec![Mount::AtJoint; dof], source: source.into() }
+    }
+
     /// For people: one line per joint with a motor — the motor, the drive train, the torque at rest,
     /// the rotor's inertia at the joint and the joint speed at which the torque runs out.
     pub fn table(&self, joint_names: &[String]) -> String {

@@ -16,14 +16,34 @@ pub struct ModelArgs {
     /// Refuse physically inconsistent link inertias (as Drake does) instead of a notice.
     #[arg(long)]
     pub strict_inertia: bool,
+    /// A motor file: the model with its drive trains (their parts carried on the arm, their rotors
+    /// on M's diagonal), as `run --motors` simulates it.
+    #[arg(long, value_name = "FILE")]
+    pub motors: Option<PathBuf>,
+    /// Write the URDF with the drive trains' parts as links here (needs --motors), so any other
+    /// library can check the model armscope simulates.
+    #[arg(long, value_name = "FILE", requires = "motors")]
+    pub urdf_out: Option<PathBuf>,
 }
 
 
 /// `armscope model`.
 pub fn model(args: &ModelArgs) -> Result<i32, Error> {
-    let model = crate::model::load_urdf_with(&args.urdf, crate::model::LoadOptions { strict_inertia: args.strict_inertia })?;
+    let mut model = crate::model::load_urdf_with(&args.urdf, crate::model::LoadOptions { strict_inertia: args.strict_inertia })?;
     for notice in &model.notices {
         eprintln!("armscope: notice: {notice}");
+    }
+    if let Some(path) = &args.motors {
+        let set = crate::actuator::load_motor_file(path, &model)?;
+        let urdf_mass: f64 = model.frames_mass();
+        let parts = crate::actuator::carried::install(&mut model, &set).map_err(|m| Error::flag("--motors", format!("{}: {m}", path.display())))?;
+        let drive_mass: f64 = parts.iter().map(|p| p.part.mass).sum();
+        eprintln!("armscope: {}: {} parts carried, {drive_mass:.3} kg: the arm's mass {urdf_mass:.3} kg → {:.3} kg", path.display(), parts.len(), urdf_mass + drive_mass);
+        if let Some(out) = &args.urdf_out {
+            let text = crate::actuator::carried::urdf_with_parts(&model.urdf_text, &parts, &model).map_err(|m| Error::flag("--urdf-out", m))?;
+            std::fs::write(out, text).map_err(|e| Error::output(out, e))?;
+            eprintln!("armscope: wrote {}", out.display());
+        }
     }
     if let Some(path) = &args.states {
         let text = std::fs::read_to_string(path).map_err(|e| Error::flag("--states", format!("{}: {e}", path.display())))?;

@@ -47,9 +47,10 @@ pub struct SizeArgs {
     /// one joint (repeat the flag).
     #[arg(long, value_name = "SPEC")]
     pub ratios: Vec<String>,
-    /// Headroom on torque and on speed: 0.3 asks for 30 % more than the motion needs.
-    #[arg(long, default_value_t = 0.3)]
-    pub margin: f64,
+    /// Headroom on torque and on speed: 0.3 asks for 30 % more than the motion needs (default: the
+    /// vendors' per motor kind, 50 % for an open-loop stepper, 30 % for a servo).
+    #[arg(long)]
+    pub margin: Option<f64>,
     /// Efficiency of the ideal reductions of `--ratios` (a direct drive, ratio 1, is 100 %).
     #[arg(long, default_value_t = 0.9)]
     pub efficiency: f64,
@@ -68,6 +69,10 @@ pub struct SizeArgs {
     /// Simulations at once (default: all cores).
     #[arg(long)]
     pub jobs: Option<usize>,
+    /// The URDF's link masses already include the drive trains (a CAD export with the motors in
+    /// it): do not carry the candidates' parts on the arm.
+    #[arg(long)]
+    pub parts_in_urdf: bool,
     /// How long the motion goes on, hours, for the thermal check of motors with thermal data
     /// (default: the motion's own duration).
     #[arg(long, value_name = "HOURS")]
@@ -193,8 +198,8 @@ pub fn size(args: &SizeArgs) -> Result<i32, Error> {
     if !(args.payload >= 0.0 && args.payload.is_finite()) {
         return Err(Error::flag("--payload", "must be a mass in kg, not negative"));
     }
-    if !(args.margin >= 0.0 && args.margin.is_finite()) {
-        return Err(Error::flag("--margin", format!("must be a fraction ≥ 0, e.g. 0.3 for 30 % (got {})", args.margin)));
+    if let Some(margin) = args.margin.filter(|m| !(*m >= 0.0 && m.is_finite())) {
+        return Err(Error::flag("--margin", format!("must be a fraction ≥ 0, e.g. 0.3 for 30 % (got {margin})")));
     }
     if !(args.efficiency > 0.0 && args.efficiency <= 1.0) {
         return Err(Error::flag("--efficiency", format!("must be in (0, 1] (got {})", args.efficiency)));
@@ -268,7 +273,7 @@ pub fn size(args: &SizeArgs) -> Result<i32, Error> {
     };
     let jobs = args.jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
     let started = std::time::Instant::now();
-    let request = SizeRequest { motions, model, payload_kg: args.payload, catalogue, motors, reductions, margin: args.margin, efficiency: args.efficiency, microsteps: args.microsteps, jobs, duty: args.duty.map(|hours| hours * 3600.0) };
+    let request = SizeRequest { motions, model, payload_kg: args.payload, catalogue, motors, reductions, margin: args.margin, efficiency: args.efficiency, microsteps: args.microsteps, jobs, duty: args.duty.map(|hours| hours * 3600.0), carry_parts: !args.parts_in_urdf };
     let report = size_joints(&request)?;
 
     std::fs::create_dir_all(&args.out).map_err(|e| Error::output(&args.out, e))?;

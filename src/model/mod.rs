@@ -233,6 +233,11 @@ impl Model {
         }
     }
 
+    /// The mass of every link of its URDF, kg (those fixed to the world too).
+    pub fn frames_mass(&self) -> f64 {
+        urdf_rs::read_from_string(&self.urdf_text).map_or(0.0, |robot| robot.links.iter().map(|l| l.inertial.mass.value).sum())
+    }
+
     /// The model with a point mass of `kg` at the tool frame's origin (a payload; none for 0).
     pub fn with_payload(mut self, kg: f64) -> Model {
         if kg > 0.0 {

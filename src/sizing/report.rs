@@ -48,24 +48,115 @@ impl JointSizing {
         format!("{} ({:.2} N·m at rest, {:.3} kg, {fit}{sim})", x.drive_name(), x.torque_at_rest, x.mass_kg)
     }
 
+    /// The check that binds the chosen candidate: the one its share comes from on paper, or the
+    /// full simulation's peak when that used more.
+    fn binding(&self, c: &Candidate) -> &'static str {
+        let simulated = self.chosen.and_then(|i| self.simulated.iter().rev().find(|s| s.candidate == i)).map_or(0.0, |s| s.peak_torque_share * (1.0 + c.margin));
+        if simulated > c.share {
+            return "peak torque in the full run";
+        }
+        match c.binding.as_deref() {
+            Some("gearbox average torque") => "gearbox average torque",
+            Some("RMS torque") => "RMS torque",
+            Some("winding temperature over the duty") => "winding temperature over the duty",
+            Some("reduction input speed") => "reduction input speed",
+            _ => "peak torque on the curve",
+        }
+    }
+
     fn candidate(&self, c: Option<usize>) -> Option<&Candidate> {
         c.map(|c| &self.candidates[c])
     }
 }
 
 impl SizeReport {
+    /// The margins in words: "margin 30 %" (`--margin`) or the vendors' per kind.
+    fn margin_text(&self) -> String {
+        match self.margin {
+            Some(m) => format!("margin {:.0} %", 100.0 * m),
+            None => format!(
+                "the vendors' margins ({}: Parker and MotionControlTips ask 50 % of an open-loop stepper, 10–30 % of a closed-loop servo; --margin sets one)",
+                self.margins.iter().map(|(kind, m)| format!("{kind} {:.0} %", 100.0 * m)).collect::<Vec<_>>().join(", ")
+            ),
+        }
+    }
+
+    /// The bill of materials in Markdown: per joint the motor, its reduction and ratio, the masses,
+    /// the use (peak and RMS), the binding check; the total; what to buy.
+    pub fn bill_of_materials(&self) -> String {
+        let mut md = String::from("## Bill of materials\n\n| joint | motor | reduction | ratio | mass (kg) | peak use (simulated) | RMS motor torque (N·m) | inertia ratio | binding check |\n|---|---|---|---|---|---|---|---|---|\n");
+        let mut total = 0.0;
+        let mut count: Vec<(String, usize)> = Vec::new();
+        for js in &self.joints {
+            let Some(c) = js.candidate(js.chosen) else { continue };
+            total += c.mass_kg;
+            for part in std::iter::once(&c.motor).chain(c.reduction.iter()) {
+                match count.iter_mut().find(|(p, _)| p == part) {
+                    Some((_, n)) => *n += 1,
+                    None => count.push((part.clone(), 1)),
+                }
+            }
+            let peak = js.chosen.and_then(|i| js.simulated.iter().rev().find(|s| s.candidate == i && s.passed)).map_or("–".to_string(), |s| format!("{:.0} %", 100.0 * s.peak_torque_share));
+            let ratio = c.inertia_ratio.map_or("n/p".to_string(), |r| format!("{r:.1}:1{}", if js.inertia_ratio_above.is_some() { " ⚠" } else { "" }));
+            md += &format!(
+                "| {} | {} | {} | {} | {:.3} | {peak} | {:.4} | {ratio} | {} |\n",
+                js.joint,
+                c.motor,
+                c.reduction.as_deref().unwrap_or(if c.ratio == 1.0 { "direct" } else { "ideal" }),
+                ratio_text(c.ratio),
+                c.mass_kg,
+                c.rms_motor_torque,
+                js.binding(c)
+            );
+        }
+        md += &format!("\nDrive trains: {total:.3} kg in all. To order: {}.\n", count.iter().map(|(p, n)| format!("{n} × {p}")).collect::<Vec<_>>().join(", "));
+        let notes: Vec<String> = self
+            .joints
+            .iter()
+            .filter_map(|js| {
+                let c = js.candidate(js.chosen)?;
+                let mut out = Vec::new();
+                if let Some((guideline, whom)) = &js.inertia_ratio_above {
+                    out.push(format!("{}: the load's inertia is {:.1}× the rotor's at the joint, above the {guideline:.0}:1 guideline for {whom}", js.joint, c.inertia_ratio.unwrap_or(0.0)));
+                }
+                if let Some(l) = js.lowest_rms.filter(|&l| Some(l) != js.chosen) {
+                    let x = &js.candidates[l];
+                    let optimum = js.optimal_ratio.map_or(String::new(), |n| format!("; on a pure inertia load the optimum would be N* = √(rms τ / (η·J·rms q̈)) = {n:.0}"));
+                    out.push(format!("{}: the feasible drive of this motor with the lowest RMS motor torque is {} ({:.4} N·m against {:.4}{optimum})", js.joint, x.drive_name(), x.rms_motor_torque, c.rms_motor_torque));
+                }
+                Some(out)
+            })
+            .flatten()
+            .collect();
+        if !notes.is_empty() {
+            md += &format!("\n{}\n", notes.iter().map(|n| format!("- {n}")).collect::<Vec<_>>().join("\n"));
+        }
+        md += "\nThe motor file: `motors.toml` (and `--motors-out`), for `armscope run --motors`.\n";
+        md
+    }
+
     /// Markdown: per joint the choice, the runner-up and why the nearest rejected ones fail.
     pub fn markdown(&self) -> String {
         let mut md = format!(
-            "# Motor sizing for {}\n\nMotion: {}; payload {} kg at the tool; margin {:.0} % on torque and speed; {}; {} microsteps.\nCandidates: {}.\n\n",
+            "# Motor sizing for {}\n\nMotion: {}; payload {} kg at the tool; {} on torque and speed; {}; {} microsteps.\nCandidates: {}.\n\n",
             self.model,
             self.motions.join(", "),
             self.payload_kg,
-            100.0 * self.margin,
+            self.margin_text(),
             if self.reductions.is_empty() { format!("ideal reductions {:.0} % efficient", 100.0 * self.efficiency) } else { format!("reductions from the catalogue ({}) or a direct drive", self.reductions.join(", ")) },
             self.microsteps,
             self.motors.join(", ")
         );
+        md += &if self.parts_in_urdf {
+            format!("The drive trains are in the URDF's masses (--parts-in-urdf): nothing carried; the arm {:.3} kg, the chosen drive trains {:.3} kg of it.\n\n", self.arm_mass_kg, self.drive_mass_kg)
+        } else {
+            format!(
+                "Each candidate's motor and reduction are carried on the arm (on the parent link of its joint, at the joint), each joint sized with the parts beyond it already chosen: the arm {:.3} kg without drive trains, {:.3} kg with the chosen ones ({:.3} kg).\n\n",
+                self.arm_mass_kg,
+                self.arm_mass_kg + self.drive_mass_kg,
+                self.drive_mass_kg
+            )
+        };
         if !self.weightless_reductions.is_empty() {
             md += &format!("Reductions without a published mass, counted as weightless: {}.\n\n", self.weightless_reductions.join(", "));
         }
@@ -113,22 +204,27 @@ impl SizeReport {
                 md += &format!("  - {}\n", js.describe(r));
             }
         }
+        md += "\n";
+        md += &self.bill_of_materials();
         md
     }
 
     /// The choice as a motor file for `armscope run --motors`.
     pub fn motor_file(&self, catalogue: Option<&str>) -> String {
         let mut toml = format!(
-            "# Written by `armscope size` for {}: motion {}, payload {} kg, margin {:.0} %.\n# Each joint's motor and the reduction after it; run it with `armscope run --motors THIS_FILE`.\n",
+            "# Written by `armscope size` for {}: motion {}, payload {} kg, {}.\n# Each joint's motor and the reduction after it; run it with `armscope run --motors THIS_FILE`.\n",
             self.model,
             self.motions.join(", "),
             self.payload_kg,
-            100.0 * self.margin
+            self.margin_text()
         );
         if let Some(path) = catalogue {
             toml += &format!("catalogue = {:?}\n", path);
         }
-        toml += &format!("description = \"armscope size: payload {} kg, margin {:.0} %\"\n", self.payload_kg, 100.0 * self.margin);
+        toml += &format!("description = \"armscope size: payload {} kg\"\n", self.payload_kg);
+        if self.parts_in_urdf {
+            toml += "# sized with --parts-in-urdf: the URDF's masses hold the drive trains\nin_urdf = true\n";
+        }
         for js in &self.joints {
             let Some(c) = js.candidate(js.chosen) else { continue };
             toml += &match &c.reduction {
@@ -166,7 +262,7 @@ impl SizeReport {
         let width = (left + cols * cw + right).max(Canvas::text_width(&legend, 2) + 16);
         let mut canvas = Canvas::new(width, top + rows * ch + bottom, [250, 250, 250]);
         let dark = [30, 30, 30];
-        let title = format!("{}: NEED X {:.1} / AVAILABLE{}", js.joint, 1.0 + self.margin, if self.payload_kg > 0.0 { format!(", PAYLOAD {} KG", self.payload_kg) } else { String::new() });
+        let title = format!("{}: NEED X (1 + MARGIN) / AVAILABLE{}", js.joint, if self.payload_kg > 0.0 { format!(", PAYLOAD {} KG", self.payload_kg) } else { String::new() });
         canvas.text(left.min(20), 18, &title, 3, dark);
         for (c, cand) in js.candidates.iter().enumerate() {
             let (Some(row), Some(col)) = (motors.iter().position(|m| *m == cand.motor), columns.iter().position(|c| c.0 == cand.ratio && c.1 == cand.reduction.as_deref())) else { continue };

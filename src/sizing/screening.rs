@@ -41,8 +41,9 @@ pub struct SizeRequest {
     pub motors: Vec<String>,
     /// The reductions to try after the motor (and after a gearmotor's own gearbox).
     pub reductions: Reductions,
-    /// Headroom on torque and on speed: 0.3 asks for 30 % more than the motion needs.
-    pub margin: f64,
+    /// Headroom on torque and on speed: 0.3 asks for 30 % more than the motion needs. None: the
+    /// vendors' margin for each motor kind ([`vendor_margin`]).
+    pub margin: Option<f64>,
     /// Efficiency of an ideal reduction (`Reductions::Ideal`; 1 at ratio 1: a direct drive).
     pub efficiency: f64,
     pub microsteps: u32,
@@ -50,6 +51,27 @@ pub struct SizeRequest {
     pub jobs: usize,
     /// How long the motion goes on, s, for the thermal check (None: the motions' own duration).
     pub duty: Option<f64>,
+    /// Carry the candidates' parts on the arm (false: the URDF's masses already include them).
+    pub carry_parts: bool,
+}
+
+/// The vendors' torque margin for a motor of `kind` driven `open_loop`: 50 % for an open-loop stepper
+/// (Parker; MotionControlTips' "pick a torque margin to prevent stepper stalls"), 30 % for a
+/// closed-loop servo (Parker asks at least 10 %; the top of the 10–30 % range, as a sizing with
+/// catalogue uncertainty should) — ../shared/reference/sizing.md [K3, K5].
+pub fn vendor_margin(kind: &str, open_loop: bool) -> f64 {
+    if kind == "stepper" && open_loop { 0.5 } else { 0.3 }
+}
+
+/// The load-to-rotor inertia ratio guideline for a motor of `kind` (and a stepper's `frame`), with
+/// its source: Oriental Motor, open-loop NEMA17–34 steppers ≤ 10:1, NEMA8–14 ≤ 5:1, closed-loop
+/// servos ≤ 30:1 (sizing.md [K2]).
+pub fn inertia_ratio_guideline(kind: &str, frame: Option<&str>, open_loop: bool) -> (f64, &'static str) {
+    match (kind, open_loop) {
+        ("stepper", true) if frame.is_some_and(|f| ["NEMA8", "NEMA11", "NEMA14"].contains(&f)) => (5.0, "an open-loop NEMA8–14 stepper (Oriental Motor)"),
+        ("stepper", true) => (10.0, "an open-loop NEMA17–34 stepper (Oriental Motor)"),
+        _ => (30.0, "a closed-loop servo (Oriental Motor)"),
+    }
 }
 
 /// What may follow a motor.
@@ -171,6 +193,16 @@ pub struct Candidate {
     /// motion's top speed (×).
     pub speed_headroom: f64,
     pub shortfall: Option<Shortfall>,
+    /// The margin it was rated with (the vendors' for its kind unless `--margin`).
+    pub margin: f64,
+    /// The motor's RMS torque over the motion at its shaft (through the gear's losses), N·m.
+    pub rms_motor_torque: f64,
+    /// The load's inertia over the rotor's (and the reductions' input) at the joint, J_L/(J·N²);
+    /// None when the rotor's inertia is not published.
+    pub inertia_ratio: Option<f64>,
+    /// The check its share comes from, where not the peak torque on the curve.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub binding: Option<String>,
 }
 
 impl Candidate {
@@ -206,6 +238,15 @@ pub struct JointSizing {
     /// The rejected candidates nearest the choice: the same motor one ratio below and above the
     /// feasible band, and the next lighter motor at its best ratio.
     pub nearest_rejected: Vec<usize>,
+    /// RMS of the motion's torque at the joint without any rotor, N·m, and of its acceleration, rad/s².
+    pub rms_load_torque: f64,
+    pub rms_acceleration: f64,
+    /// The feasible candidate of the chosen motor with the lowest RMS motor torque.
+    pub lowest_rms: Option<usize>,
+    /// The vendors' optimal ratio N* for the chosen motor and its efficiency (pure inertia load).
+    pub optimal_ratio: Option<f64>,
+    /// The chosen drive's inertia ratio above the vendor's guideline for its kind: (guideline, for whom).
+    pub inertia_ratio_above: Option<(f64, String)>,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -213,7 +254,10 @@ pub struct SizeReport {
     pub model: String,
     pub motions: Vec<String>,
     pub payload_kg: f64,
-    pub margin: f64,
+    /// `--margin`, or None: the vendors' margin per motor kind (`margins`).
+    pub margin: Option<f64>,
+    /// The margin used per motor kind.
+    pub margins: Vec<(String, f64)>,
     pub efficiency: f64,
     pub microsteps: u32,
     pub motors: Vec<String>,
@@ -228,6 +272,12 @@ pub struct SizeReport {
     /// Candidate motors whose duty was not checked, as they lack a continuous rating and thermal
     /// data (with what each lacks).
     pub duty_unchecked: Vec<String>,
+    /// The URDF's mass, kg.
+    pub arm_mass_kg: f64,
+    /// The chosen drive trains' published mass, kg (carried on the arm unless `parts_in_urdf`).
+    pub drive_mass_kg: f64,
+    /// The URDF's masses already include the drive trains (nothing carried).
+    pub parts_in_urdf: bool,
     /// The catalogue reductions tried (empty: ideal reductions of `efficiency`).
     pub reductions: Vec<String>,
     /// Reductions tried whose mass is not published (counted as weightless).
@@ -245,17 +295,30 @@ struct Motion {
     speed: Vec<Vec<f64>>,
     acceleration: Vec<Vec<f64>>,
     torque: Vec<Vec<f64>>,
+    /// Per joint, the largest M_jj over the motion without any rotor: the load's inertia at the joint.
+    load_inertia: Vec<f64>,
 }
 
-fn commanded_motion(request: &SizeRequest) -> Result<Motion, Error> {
-    let n = request.model.dof();
+fn commanded_motion(request: &SizeRequest, model: &Model) -> Result<Motion, Error> {
+    let n = model.dof();
     let names = if request.motions.len() > 1 { request.motions.iter().map(|(name, _)| name.clone()).collect() } else { Vec::new() };
-    let mut motion = Motion { t: Vec::new(), experiment: Vec::new(), names, speed: vec![Vec::new(); n], acceleration: vec![Vec::new(); n], torque: vec![Vec::new(); n] };
+    let mut motion = Motion { t: Vec::new(), experiment: Vec::new(), names, speed: vec![Vec::new(); n], acceleration: vec![Vec::new(); n], torque: vec![Vec::new(); n], load_inertia: vec![0.0; n] };
     for (index, (_, config)) in request.motions.iter().enumerate() {
-        let experiment = Experiment::with_model(RunConfig { motors: None, ..config.clone() }, request.model.clone())?;
+        let experiment = Experiment::with_model(RunConfig { motors: None, ..config.clone() }, model.clone())?;
         let mut model = (*experiment.model).clone();
         model.armature = vec![0.0; n];
         let dt = config.dt;
+        // the load's inertia at each joint, at up to 2000 instants of the motion
+        let mut data = crate::dynamics::Data::new(&model);
+        let (mut q, mut qd) = (vec![0.0; n], vec![0.0; n]);
+        let samples = 2000.min((config.duration / dt) as usize).max(1);
+        for k in 0..=samples {
+            experiment.trajectory.sample(config.duration * k as f64 / samples as f64, &mut q, &mut qd);
+            let m = crate::dynamics::crba(&model, &mut data, &q);
+            for j in 0..n {
+                motion.load_inertia[j] = motion.load_inertia[j].max(m[(j, j)]);
+            }
+        }
         along_commanded_motion(&model, experiment.trajectory.as_ref(), config.duration, dt, |t, qd, qdd, tau| {
             motion.t.push(t);
             motion.experiment.push(index);
@@ -356,7 +419,7 @@ fn rate(drive: &DriveTrain, motion: &Motion, j: usize, margin: f64) -> (f64, f64
 /// against its continuous rating, and with thermal data, the winding at that RMS current (through
 /// K_t) against its limit over `duty` seconds from ambient. Returns the larger share (≤ 1 passes)
 /// and why it fails.
-fn rate_duty(drive: &DriveTrain, motion: &Motion, j: usize, margin: f64, duty: f64) -> (f64, Option<Shortfall>) {
+fn rate_duty(drive: &DriveTrain, motion: &Motion, j: usize, margin: f64, duty: f64) -> (f64, Option<Shortfall>, &'static str) {
     let reflected = drive.reflected_inertia();
     let samples = motion.t.len().max(1) as f64;
     // the gearbox makers' average torque: the cubic mean at the output (Harmonic Drive's T_av)
@@ -366,8 +429,9 @@ fn rate_duty(drive: &DriveTrain, motion: &Motion, j: usize, margin: f64, duty: f
         (need / rated, (need > rated).then_some(Shortfall::GearboxAverage { need, rated }))
     });
     let (gearbox_share, gearbox_shortfall) = gearbox.unwrap_or((0.0, None));
+    const AVERAGE: &str = "gearbox average torque";
     if drive.continuous_torque.is_none() && drive.heat.is_none() {
-        return (gearbox_share, gearbox_shortfall);
+        return (gearbox_share, gearbox_shortfall, AVERAGE);
     }
     let mean_square: f64 = (0..motion.t.len())
         .map(|i| {
@@ -378,7 +442,7 @@ fn rate_duty(drive: &DriveTrain, motion: &Motion, j: usize, margin: f64, duty: f
         .sum::<f64>()
         / samples;
     let need = (1.0 + margin) * mean_square.sqrt();
-    let (mut share, mut shortfall) = (0.0f64, None);
+    let (mut share, mut shortfall, mut binding) = (0.0f64, None, "RMS torque");
     if let Some(continuous) = drive.continuous_torque {
         share = need / continuous;
         if share > 1.0 {
@@ -401,19 +465,65 @@ fn rate_duty(drive: &DriveTrain, motion: &Motion, j: usize, margin: f64, duty: f
                 None => f64::INFINITY,
             },
         };
-        share = share.max(thermal_share);
+        if thermal_share > share {
+            (share, binding) = (thermal_share, "winding temperature over the duty");
+        }
     }
-    (share.max(gearbox_share), shortfall.or(gearbox_shortfall))
+    if gearbox_share > share {
+        (share, binding) = (gearbox_share, AVERAGE);
+    }
+    (share, shortfall.or(gearbox_shortfall), binding)
+}
+
+/// The motor's RMS torque at its shaft over joint `j`'s motion, without margin.
+fn rms_motor_torque(drive: &DriveTrain, motion: &Motion, j: usize) -> f64 {
+    let reflected = drive.reflected_inertia();
+    let samples = motion.t.len().max(1) as f64;
+    ((0..motion.t.len()).map(|i| (drive.gear.motor_torque_for(motion.torque[j][i] + reflected * motion.acceleration[j][i], motion.speed[j][i]) / drive.gear_ratio).powi(2)).sum::<f64>() / samples).sqrt()
+}
+
+/// The ratio with the lowest RMS motor torque for a pure inertia load, the vendors' optimum
+/// N* = √(rms τ_load / (η·J·rms q̈)) (van de Straete's; sizing.md §1), for a motor of shaft inertia
+/// `shaft_inertia` behind efficiency `efficiency`; None without a rotor inertia or acceleration.
+pub fn optimal_ratio(rms_load_torque: f64, rms_acceleration: f64, shaft_inertia: f64, efficiency: f64) -> Option<f64> {
+    (shaft_inertia > 0.0 && rms_acceleration > 0.0).then(|| (rms_load_torque / (efficiency * shaft_inertia * rms_acceleration)).sqrt())
+}
+
+impl SizeRequest {
+    /// Open-loop steppers: the motions run in stepper mode.
+    pub fn open_loop(&self) -> bool {
+        self.motions.first().is_some_and(|(_, c)| c.drive == crate::config::DriveMode::Stepper)
+    }
+
+    /// The margin for a candidate of `motor`: `--margin`, else the vendors' for its kind.
+    pub fn margin_for(&self, motor: &str) -> f64 {
+        self.margin.unwrap_or_else(|| vendor_margin(self.catalogue.kind(motor), self.open_loop()))
+    }
 }
 
 /// Size every actuated joint; see the module's notes for the method.
 pub fn size(request: &SizeRequest) -> Result<SizeReport, Error> {
     let model = &request.model;
     let n = model.dof();
-    let motion = commanded_motion(request)?;
     let duty = request.duty.unwrap_or_else(|| request.motions.iter().map(|(_, config)| config.duration).sum());
-    let mut joints: Vec<JointSizing> = Vec::new();
-    for j in 0..n {
+    // from the tool inward: each joint rated on the motion of the arm carrying the parts already
+    // chosen beyond it (a motor sits on or before its own joint, so joint j carries those of k > j)
+    let mut joints: Vec<JointSizing> = (0..n).map(|j| JointSizing { joint: model.joints[j].name.clone(), candidates: Vec::new(), ranked: Vec::new(), chosen: None, runner_up: None, simulated: Vec::new(), nearest_rejected: Vec::new(), rms_load_torque: 0.0, rms_acceleration: 0.0, lowest_rms: None, optimal_ratio: None, inertia_ratio_above: None }).collect();
+    let mut motion = commanded_motion(request, model)?;
+    let mut carried_so_far = 0.0;
+    for j in (0..n).rev() {
+        if request.carry_parts && model.is_actuated(j) {
+            let set: Vec<Option<usize>> = (0..n).map(|k| if k > j { joints[k].ranked.first().copied() } else { None }).collect();
+            let motors = motor_set(request, &joints, &set)?;
+            let parts = crate::actuator::carried::placed_parts(model, &motors).map_err(|m| Error::flag("--motors", m))?;
+            let mass: f64 = parts.iter().map(|p| p.part.mass).sum();
+            if mass != carried_so_far {
+                let mut carrying = model.clone();
+                crate::actuator::carried::carry(&mut carrying, &parts);
+                motion = commanded_motion(request, &carrying)?;
+                carried_so_far = mass;
+            }
+        }
         let mut candidates = Vec::new();
         if model.is_actuated(j) {
             let options = options(request, j);
@@ -426,11 +536,22 @@ pub fn size(request: &SizeRequest) -> Result<SizeReport, Error> {
                     let ratio = *ratio;
                     let mass_kg = motor_mass + reduction.as_ref().and_then(|r| request.catalogue.reduction(r)?.mass).unwrap_or(0.0);
                     let drive = drive_train(&request.catalogue, motor, reduction.as_deref(), ratio, request.efficiency)?;
-                    let (peak_share, torque_headroom, speed_headroom, peak_shortfall) = rate(&drive, &motion, j, request.margin);
-                    let (duty_share, duty_shortfall) = rate_duty(&drive, &motion, j, request.margin, duty);
+                    let margin = request.margin_for(motor);
+                    let (peak_share, torque_headroom, speed_headroom, peak_shortfall) = rate(&drive, &motion, j, margin);
+                    let (duty_share, duty_shortfall, duty_binding) = rate_duty(&drive, &motion, j, margin, duty);
+                    let binding = if duty_share > peak_share {
+                        Some(duty_binding.to_string())
+                    } else if matches!(peak_shortfall, Some(Shortfall::InputSpeed { .. })) || drive.max_motor_speed.is_some_and(|w| (1.0 + margin) * drive.gear_ratio * motion.speed[j].iter().fold(0.0f64, |a, v| a.max(v.abs())) >= peak_share * w) {
+                        Some("reduction input speed".to_string())
+                    } else {
+                        None
+                    };
+                    let reflected = drive.reflected_inertia();
+                    let inertia_ratio = (reflected > 0.0).then(|| motion.load_inertia[j] / reflected);
+                    let rms_motor_torque = rms_motor_torque(&drive, &motion, j);
                     let share = peak_share.max(duty_share);
                     let shortfall = peak_shortfall.or(duty_shortfall);
-                    candidates.push(Candidate { motor: motor.clone(), reduction: reduction.clone(), mass_kg, ratio, total_ratio: drive.gear_ratio, torque_at_rest: drive.torque_limit(0.0), share, torque_headroom, speed_headroom, shortfall });
+                    candidates.push(Candidate { motor: motor.clone(), reduction: reduction.clone(), mass_kg, ratio, total_ratio: drive.gear_ratio, torque_at_rest: drive.torque_limit(0.0), share, torque_headroom, speed_headroom, shortfall, margin, rms_motor_torque, inertia_ratio, binding });
                 }
             }
         }
@@ -439,7 +560,11 @@ pub fn size(request: &SizeRequest) -> Result<SizeReport, Error> {
             let (x, y) = (&candidates[a], &candidates[b]);
             x.mass_kg.total_cmp(&y.mass_kg).then(x.motor.cmp(&y.motor)).then(x.ratio.total_cmp(&y.ratio)).then(x.reduction.cmp(&y.reduction))
         });
-        joints.push(JointSizing { joint: model.joints[j].name.clone(), candidates, ranked, chosen: None, runner_up: None, simulated: Vec::new(), nearest_rejected: Vec::new() });
+        joints[j].candidates = candidates;
+        joints[j].ranked = ranked;
+        let rms = |x: &[f64]| (x.iter().map(|v| v * v).sum::<f64>() / x.len().max(1) as f64).sqrt();
+        joints[j].rms_load_torque = rms(&motion.torque[j]);
+        joints[j].rms_acceleration = rms(&motion.acceleration[j]);
     }
 
     // simulate: the set of each joint's current pick, and beside it each joint's next candidate
@@ -470,7 +595,7 @@ pub fn size(request: &SizeRequest) -> Result<SizeReport, Error> {
         let mut failing = false;
         for &j in &sizable {
             let candidate = current[j].expect("every sizable joint has a pick in the loop");
-            let check = check(candidate, &whole[j], request.margin);
+            let check = check(candidate, &whole[j], joints[j].candidates[candidate].margin);
             if !check.passed {
                 failing = true;
                 // what fails in the full run is torque: the full run used the share s of what the
@@ -478,7 +603,7 @@ pub fn size(request: &SizeRequest) -> Result<SizeReport, Error> {
                 // motor passes only with the headroom scaled by s·(1 + m), so move past the others
                 let failed = &joints[j].candidates[candidate];
                 let used = check.peak_torque_share.max(if check.lost_steps > 0 { 1.0 } else { 0.0 });
-                let scale = if extrapolate { (used * (1.0 + request.margin)).max(1.0) } else { 0.0 };
+                let scale = if extrapolate { (used * (1.0 + failed.margin)).max(1.0) } else { 0.0 };
                 let (motor, needed) = (failed.motor.clone(), failed.torque_headroom * scale);
                 let js = &joints[j];
                 pick[j] += 1;
@@ -496,7 +621,8 @@ pub fn size(request: &SizeRequest) -> Result<SizeReport, Error> {
         for ((joint, set), result) in sets[1..].iter().zip(results) {
             let j = joint.expect("the others are one joint's next candidate");
             let candidate = set[j].expect("set above");
-            joints[j].simulated.push(check(candidate, &result?[j], request.margin));
+            let margin = joints[j].candidates[candidate].margin;
+            joints[j].simulated.push(check(candidate, &result?[j], margin));
         }
         if !failing {
             verified = true;
@@ -524,7 +650,7 @@ pub fn size(request: &SizeRequest) -> Result<SizeReport, Error> {
             let mut still = Vec::new();
             for ((j, set), result) in probes.into_iter().zip(results) {
                 let candidate = set[j].expect("set above");
-                let probe = check(candidate, &result?[j], request.margin);
+                let probe = check(candidate, &result?[j], joints[j].candidates[candidate].margin);
                 let passed = probe.passed;
                 joints[j].simulated.push(probe);
                 if passed {
@@ -540,7 +666,10 @@ pub fn size(request: &SizeRequest) -> Result<SizeReport, Error> {
             let set = picked(&joints, &pick);
             let whole = simulate_set(request, &joints, &set)?;
             simulations += 1;
-            let checks: Vec<SimulatedCheck> = sizable.iter().map(|&j| check(set[j].expect("sizable"), &whole[j], request.margin)).collect();
+            let checks: Vec<SimulatedCheck> = sizable.iter().map(|&j| {
+                let c = set[j].expect("sizable");
+                check(c, &whole[j], joints[j].candidates[c].margin)
+            }).collect();
             let passed = checks.iter().all(|c| c.passed);
             for (&j, c) in sizable.iter().zip(checks) {
                 joints[j].simulated.push(c);
@@ -567,12 +696,36 @@ pub fn size(request: &SizeRequest) -> Result<SizeReport, Error> {
         // the runner-up: the next candidate that passed its own simulation, else the next ranked
         js.runner_up = js.ranked.iter().skip(pick[j] + 1).copied().find(|&c| js.simulated.iter().any(|s| s.candidate == c && s.passed)).or_else(|| js.ranked.get(pick[j] + 1).copied());
         js.nearest_rejected = nearest_rejected(js);
+        if let Some(c) = js.chosen {
+            let chosen = js.candidates[c].clone();
+            js.lowest_rms = js.ranked.iter().copied().filter(|&x| js.candidates[x].motor == chosen.motor).min_by(|&a, &b| js.candidates[a].rms_motor_torque.total_cmp(&js.candidates[b].rms_motor_torque));
+            let drive = drive_train(&request.catalogue, &chosen.motor, chosen.reduction.as_deref(), chosen.ratio, request.efficiency)?;
+            js.optimal_ratio = optimal_ratio(js.rms_load_torque, js.rms_acceleration, drive.shaft_inertia(), drive.gear.efficiency);
+            let (guideline, whom) = inertia_ratio_guideline(request.catalogue.kind(&chosen.motor), request.catalogue.frame(&chosen.motor), request.open_loop());
+            if chosen.inertia_ratio.is_some_and(|r| r > guideline) {
+                js.inertia_ratio_above = Some((guideline, whom.to_string()));
+            }
+        }
     }
+    let drive_mass_kg = {
+        let set: Vec<Option<usize>> = joints.iter().map(|js| js.chosen).collect();
+        motor_set(request, &joints, &set)?.joints.iter().flatten().map(|d| d.mass()).sum()
+    };
     Ok(SizeReport {
         model: model.name.clone(),
         motions: request.motions.iter().map(|(name, _)| name.clone()).collect(),
         payload_kg: request.payload_kg,
         margin: request.margin,
+        margins: {
+            let mut m: Vec<(String, f64)> = Vec::new();
+            for motor in &request.motors {
+                let kind = request.catalogue.kind(motor).to_string();
+                if !m.iter().any(|(k, _)| *k == kind) {
+                    m.push((kind, request.margin_for(motor)));
+                }
+            }
+            m
+        },
         efficiency: request.efficiency,
         microsteps: request.microsteps,
         motors: request.motors.clone(),
@@ -587,6 +740,9 @@ pub fn size(request: &SizeRequest) -> Result<SizeReport, Error> {
             .filter(|m| request.catalogue.drive_train(m).and_then(Result::ok).is_some_and(|d| d.continuous_torque.is_none() && d.heat.is_none()))
             .cloned()
             .collect(),
+        arm_mass_kg: model.frames_mass(),
+        drive_mass_kg,
+        parts_in_urdf: !request.carry_parts,
         reductions: match &request.reductions {
             Reductions::Catalogue(names) => names.clone(),
             Reductions::Ideal(_) => Vec::new(),
@@ -633,7 +789,10 @@ fn check(candidate: usize, run: &JointRun, margin: f64) -> SimulatedCheck {
 /// The motor set of per-joint candidates (None: the joint keeps its URDF effort).
 pub fn motor_set(request: &SizeRequest, joints: &[JointSizing], set: &[Option<usize>]) -> Result<MotorSet, Error> {
     let n = set.len();
-    let mut motors = MotorSet { joints: (0..n).map(|_| None).collect(), microsteps: vec![None; n], acceleration: vec![None; n], source: "armscope size".into() };
+    let mut motors = MotorSet::empty(n, "armscope size");
+    if !request.carry_parts {
+        motors.mounts = vec![crate::actuator::Mount::InUrdf; n];
+    }
     for (j, choice) in set.iter().enumerate() {
         if let Some(c) = choice {
             let candidate = &joints[j].candidates[*c];
@@ -695,3 +854,29 @@ fn nearest_rejected(js: &JointSizing) -> Vec<usize> {
     }
     out
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// On a pure inertia load τ = I·q̈ the motor's RMS torque through N is rms q̈·(I/(η·N) + J·N):
+    /// least at N = √(I/(η·J)), which the formula gives from the RMS of torque and acceleration.
+    #[test]
+    fn the_optimal_ratio_minimises_the_rms_motor_torque_of_an_inertia_load() {
+        let (inertia, rotor, efficiency, acceleration) = (0.02, 5.4e-6, 0.8, 3.0);
+        let n = optimal_ratio(inertia * acceleration, acceleration, rotor, efficiency).unwrap();
+        let rms_motor = |n: f64| acceleration * (inertia / (efficiency * n) + rotor * n);
+        assert!((n - (inertia / (efficiency * rotor)).sqrt()).abs() < 1e-9);
+        assert!(rms_motor(n) < rms_motor(n * 1.001) && rms_motor(n) < rms_motor(n / 1.001));
+        assert_eq!(optimal_ratio(1.0, 1.0, 0.0, 0.9), None, "no rotor inertia, no optimum");
+    }
+
+    #[test]
+    fn the_vendors_margins_and_inertia_guidelines_by_kind() {
+        assert_eq!((vendor_margin("stepper", true), vendor_margin("stepper", false), vendor_margin("servo", true), vendor_margin("dc", false)), (0.5, 0.3, 0.3, 0.3));
+        assert_eq!(inertia_ratio_guideline("stepper", Some("NEMA14"), true).0, 5.0);
+        assert_eq!(inertia_ratio_guideline("stepper", Some("NEMA17"), true).0, 10.0);
+        assert_eq!(inertia_ratio_guideline("servo", None, true).0, 30.0);
+    }
+}
+
