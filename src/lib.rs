@@ -7,6 +7,7 @@ pub mod actuator;
 pub mod allocator;
 pub mod batch;
 pub mod builtin;
+pub mod canvas;
 pub mod cli;
 pub mod config;
 pub mod control;

@@ -6,7 +6,6 @@
 
 pub mod carried;
 pub mod catalogue;
-pub mod catalogue_listing;
 mod lossy_gear;
 mod open_loop;
 pub mod reduction;

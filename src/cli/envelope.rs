@@ -73,7 +73,7 @@ pub fn envelope(args: &EnvelopeArgs) -> Result<i32, Error> {
         let values: Vec<Vec<f64>> = (0..amps.len()).map(|a| (0..freqs.len()).map(|f| env.cell(a, f).demand[j]).collect()).collect();
         let limit = if args.motors.motors.is_some() { "AT SPEED".to_string() } else { format!("{} NM", env.effort[j]) };
         let title = format!("{name} NEEDED TORQUE / LIMIT ({limit}){}", if args.payload > 0.0 { format!(", PAYLOAD {} KG", args.payload) } else { String::new() });
-        let canvas = crate::diagnose::heatmap::heatmap(&title, "WAVE FREQUENCY (RAD/S)", &x_ticks, "AMPLITUDE (DEG)", &y_ticks, &values);
+        let canvas = crate::canvas::heatmap(&title, "WAVE FREQUENCY (RAD/S)", &x_ticks, "AMPLITUDE (DEG)", &y_ticks, &values);
         let png = args.out.join(format!("envelope_{name}.png"));
         canvas.save_png(&png).map_err(|e| Error::output(&png, e))?;
         files.push(png);

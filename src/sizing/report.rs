@@ -2,7 +2,7 @@
 //! joint a chart of motor × ratio with the feasible region and the choice marked.
 
 use super::screening::{Candidate, JointSizing, SizeReport};
-use crate::diagnose::heatmap::{Canvas, ratio_color};
+use crate::canvas::{Canvas, ratio_color};
 
 /// A headroom factor for people: 2.4×, 37×, ∞.
 fn times(x: f64) -> String {

@@ -1,4 +1,5 @@
-//! PNG heatmaps with labels, drawn without any font files (a built-in 3×5 pixel font).
+//! PNG charts and heatmaps with labels, drawn without any font files (a built-in 3×5 pixel font):
+//! the envelope's heatmap (`diagnose`) and the sizing charts (`sizing`) both draw here.
 
 use std::path::Path;
 

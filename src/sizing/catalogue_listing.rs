@@ -1,7 +1,7 @@
 //! What `armscope catalogue` shows: every motor and reduction with its main numbers, where they were
 //! read, and what each entry lacks and what that means for sizing.
 
-use super::Catalogue;
+use crate::actuator::Catalogue;
 use serde::Serialize;
 use toml::Value;
 
