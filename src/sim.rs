@@ -165,6 +165,21 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
     if heat.any() {
         summary.winding = heat.summary();
     }
+    if let Some(motors) = &experiment.motors {
+        summary.drive_duty = motors
+            .joints
+            .iter()
+            .enumerate()
+            .map(|(j, d)| {
+                d.as_ref().map(|d| crate::summary::DriveDuty {
+                    rms_motor_torque: summary.rms_torque[j] / d.gear_ratio,
+                    continuous_torque: d.continuous_torque,
+                    cubic_mean_torque: summary.cubic_mean_torque[j],
+                    rated_average_torque: d.rated_average_torque,
+                })
+            })
+            .collect();
+    }
     summary.energy_balance = audit.map(|a| EnergyBalance { created: a.created, work: a.work });
     for r in recorders.iter_mut() {
         r.finish(&info, &summary)?;

@@ -36,6 +36,19 @@ pub struct EnergyBalance {
     pub work: f64,
 }
 
+/// A joint's drive against the vendors' duty ratings over a run: the motor's RMS torque at its shaft
+/// against its continuous rating, the cubic mean of the torque at the gearbox against its rated
+/// average torque (each None where the catalogue gives no rating).
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct DriveDuty {
+    /// RMS of u/N, the motor's torque at its shaft, N·m.
+    pub rms_motor_torque: f64,
+    pub continuous_torque: Option<f64>,
+    /// Cubic mean of |u|, the torque the motor puts through the gearbox, N·m.
+    pub cubic_mean_torque: f64,
+    pub rated_average_torque: Option<f64>,
+}
+
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Summary {
     pub status: RunStatus,
@@ -68,6 +81,14 @@ pub struct Summary {
     /// vendors' check against the continuous rating).
     #[serde(default)]
     pub rms_torque: Vec<f64>,
+    /// Per joint, the cubic mean of |τ| over the run's control steps, N·m (the gearbox makers'
+    /// average torque, Harmonic Drive's T_av).
+    #[serde(default)]
+    pub cubic_mean_torque: Vec<f64>,
+    /// Per joint with a motor, the vendors' duty checks against its catalogue ratings (empty
+    /// without motors).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub drive_duty: Vec<Option<DriveDuty>>,
     /// Per joint whose motor has thermal data: its winding over the run (empty when no motor has).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub winding: Vec<Option<crate::actuator::thermal::WindingSummary>>,
@@ -125,6 +146,7 @@ pub struct SummaryBuilder {
     peak_torque_in_window: Vec<f64>,
     peak_friction: Vec<f64>,
     sum_squared_torque: Vec<f64>,
+    sum_cubed_torque: Vec<f64>,
     stuck_steps: Vec<u64>,
     effort: Vec<f64>,
     lowest_limit: Vec<f64>,
@@ -157,6 +179,7 @@ impl SummaryBuilder {
             peak_torque_in_window: vec![0.0; n],
             peak_friction: Vec::new(),
             sum_squared_torque: vec![0.0; n],
+            sum_cubed_torque: vec![0.0; n],
             stuck_steps: Vec::new(),
             lowest_limit: effort.clone(),
             peak_share: vec![0.0; n],
@@ -210,6 +233,7 @@ impl SummaryBuilder {
                 self.chatter_steps[i] += s.chatter[i] as u64;
                 self.peak_torque[i] = self.peak_torque[i].max(s.u[i].abs());
                 self.sum_squared_torque[i] += s.u[i] * s.u[i];
+                self.sum_cubed_torque[i] += s.u[i].abs().powi(3);
                 if in_window {
                     self.peak_torque_in_window[i] = self.peak_torque_in_window[i].max(s.u[i].abs());
                 }
@@ -273,6 +297,8 @@ impl SummaryBuilder {
             peak_abs_torque: self.peak_torque.clone(),
             peak_abs_torque_after_settle: self.peak_torque_in_window.iter().map(|&p| (window_control_steps > 0).then_some(p)).collect(),
             rms_torque: self.sum_squared_torque.iter().map(|&s| if self.control_steps == 0 { 0.0 } else { (s / self.control_steps as f64).sqrt() }).collect(),
+            cubic_mean_torque: self.sum_cubed_torque.iter().map(|&s| if self.control_steps == 0 { 0.0 } else { (s / self.control_steps as f64).cbrt() }).collect(),
+            drive_duty: Vec::new(),
             winding: Vec::new(),
             peak_friction_torque: self.peak_friction.clone(),
             stuck_percent: share_of_control_steps(&self.stuck_steps),

@@ -212,7 +212,13 @@ fn a_motor_file_names_a_catalogue_reduction_at_one_of_its_ratios() {
     let j3 = set.joints[2].as_ref().unwrap();
     assert_eq!((j3.gear_ratio, j3.gear.breakaway_torque, j3.rated_torque), (51.0, 3.0, 14.8), "a one-ratio reduction needs no gear_ratio");
     assert!((j3.reflected_inertia() - (5.4e-6 + 1.19e-5) * 51.0 * 51.0).abs() < 1e-15, "rotor and the gear's input inertia through N²");
-    for (text, field) in [("reduction = \"NPS015\"\ngear_ratio = 6\n", "gear_ratio"), ("reduction = \"NPS015\"\n", "gear_ratio"), ("reduction = \"nope\"\n", "reduction"), ("reduction = \"NPS015\"\ngear_ratio = 5\nefficiency = 0.5\n", "efficiency")] {
+    // two stages from the motor out: a belt, then a planetary: ratios multiply, efficiencies too, the
+    // planetary's input turns at the motor's speed over the belt's ratio
+    let staged = write(dir.path(), "staged.toml", "[joints.J2]\nmotor = \"17HS19-2004S1\"\nreduction = [\"GT2-belt\", \"NPS015\"]\ngear_ratio = [2.8, 5]\n");
+    let d = load_motor_file(&staged, &model).unwrap().joints[1].take().unwrap();
+    assert!((d.gear_ratio - 14.0).abs() < 1e-12 && (d.gear.efficiency - 0.95 * 0.97).abs() < 1e-15 && d.reductions == ["GT2-belt", "NPS015"]);
+    assert!((d.max_motor_speed.unwrap() - 837.758 * 2.8).abs() < 1e-9 && d.rated_torque == 40.0);
+    for (text, field) in [("reduction = [\"GT2-belt\", \"NPS015\"]\ngear_ratio = 5\n", "gear_ratio"), ("reduction = \"NPS015\"\ngear_ratio = 6\n", "gear_ratio"), ("reduction = \"NPS015\"\n", "gear_ratio"), ("reduction = \"nope\"\n", "reduction"), ("reduction = \"NPS015\"\ngear_ratio = 5\nefficiency = 0.5\n", "efficiency")] {
         let bad = write(dir.path(), "bad.toml", &format!("[joints.J2]\nmotor = \"17HS4401\"\n{text}"));
         let e = load_motor_file(&bad, &model).unwrap_err().to_string();
         assert!(!e.contains('\n') && e.contains("bad.toml") && e.contains("joint 'J2'") && e.contains(field), "{text}: {e}");

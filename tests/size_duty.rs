@@ -85,4 +85,10 @@ fn a_one_hour_duty_rejects_a_motor_that_a_30_second_run_accepts() {
     let after = rejected["shortfall"]["reaches_limit_after"].as_f64().unwrap();
     assert!(after > 30.0 && after < 3600.0, "reaches 125 °C after {after} s: between the two duties");
     assert_eq!(chosen(&hour), "heat_sunk");
+    // the bill of materials gives the chosen motor's peak winding temperature in the full 30 s run:
+    // warmer than the 25 °C ambient, and well below the 125 °C limit
+    let row = &hour["bill_of_materials"][0];
+    assert_eq!(row["motor"], "heat_sunk");
+    let peak = row["peak_winding_temperature"].as_f64().expect("a thermal motor's peak temperature");
+    assert!(peak > 25.0 && peak < 125.0, "{peak}");
 }

@@ -115,3 +115,35 @@ fn a_partial_thermal_model_is_named() {
     assert!(line.contains("mine.toml") && line.contains("motor 'hot'") && line.contains("'thermal_time_constant_motor' is missing"), "{line}");
     assert!(!out.contains("panicked"));
 }
+
+/// The run's summary gives each motor's duty against its catalogue ratings: the RMS of u/N against
+/// the continuous rating (the STS3215-C018's 0.98 N·m), the cubic mean of |u| against the gearbox's
+/// rated average torque (the NPS015's 21 N·m at 5:1). Held still (`--static`) u is constant, so the
+/// cubic mean equals the RMS to rounding; in a wave it lies between the RMS and the peak (power means).
+#[test]
+fn the_summary_rates_each_drive_against_its_continuous_and_average_ratings() {
+    let dir = tempfile::tempdir().unwrap();
+    let motors = dir.path().join("duty.toml");
+    std::fs::write(&motors, "in_urdf = true\n[joints.J2]\nmotor = \"17HS19-2004S1\"\nreduction = \"NPS015\"\ngear_ratio = 5\n[joints.J5]\nmotor = \"STS3215-C018\"\n").unwrap();
+    let urdf = box_urdf();
+    for (label, motion) in [("static", vec!["--static"]), ("wave", vec![])] {
+        let summary_path = dir.path().join(format!("{label}.json"));
+        let args: Vec<&str> = ["run", "--quiet", "--urdf", urdf.to_str().unwrap(), "--motors", motors.to_str().unwrap(), "--drive", "pd", "--duration", "5", "--no-rrd", "--no-mcap", "--summary-json", summary_path.to_str().unwrap()].into_iter().chain(motion).collect();
+        let (code, out) = run(&args);
+        assert_eq!(code, 0, "{out}");
+        let root: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&summary_path).unwrap()).unwrap();
+        let s = &root["summary"];
+        let duty = &s["drive_duty"];
+        assert!(duty[0].is_null() && duty[2].is_null(), "joints without a motor have none");
+        let (j2, j5) = (&duty[1], &duty[4]);
+        assert_eq!((j2["rated_average_torque"].as_f64(), j2["continuous_torque"].as_f64()), (Some(21.0), None));
+        assert_eq!((j5["continuous_torque"].as_f64(), j5["rated_average_torque"].as_f64()), (Some(0.98), None));
+        let rms = s["rms_torque"][1].as_f64().unwrap();
+        assert!((j2["rms_motor_torque"].as_f64().unwrap() - rms / 5.0).abs() < 1e-12, "u/N at the motor's shaft");
+        let (cubic, peak) = (j2["cubic_mean_torque"].as_f64().unwrap(), s["peak_abs_torque"][1].as_f64().unwrap());
+        assert!(cubic >= rms - 1e-12 && cubic <= peak + 1e-12, "{label}: rms {rms} ≤ cubic {cubic} ≤ peak {peak}");
+        if label == "static" {
+            assert!((cubic / rms - 1.0).abs() < 1e-3, "held still: cubic mean {cubic} = RMS {rms}");
+        }
+    }
+}

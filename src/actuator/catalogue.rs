@@ -31,7 +31,8 @@
 //! catalogue = "my_motors.toml"   # optional, beside this file; the built-in catalogue otherwise
 //! [joints.J1]
 //! motor = "17HS4401"
-//! # reduction = "NPS015"         # a catalogue reduction, at gear_ratio (one of its ratios); or:
+//! # reduction = "NPS015"         # a catalogue reduction, at gear_ratio (one of its ratios), or
+//! #                              # stages: reduction = ["GT2-belt", "MG17-G5"], gear_ratio = [2.8, 5]; or:
 //! gear_ratio = 15                # the reduction after the motor (and after its own gearbox)
 //! efficiency = 0.9               # of that reduction, driving (the joint gets η·N·T)
 //! backdrive_efficiency = 0.85    # optional, when the load drives the motor (η when not given; ≤ 0: self-locking)
@@ -548,25 +549,39 @@ pub fn load_motor_file(path: &Path, model: &Model) -> Result<MotorSet, Error> {
         }
         let motor_name = fields.string("motor")?;
         let own = catalogue.drive_train(&motor_name).ok_or_else(|| fail(path, format!("{what}: no motor '{motor_name}' (known: {})", catalogue.names())))??;
-        if let Some(Value::String(reduction)) = t.get("reduction") {
-            // a catalogue reduction: its own losses and ratings, at one of its ratios
-            if let Some(k) = ["efficiency", "backdrive_efficiency", "breakaway_torque", "viscous", "rated_torque"].iter().find(|k| t.contains_key(**k)) {
-                return Err(fields.err(k, &format!("comes from the catalogue's reduction '{reduction}': leave it out, or give the reduction's numbers without 'reduction'")));
-            }
-            let r = catalogue.reduction(reduction).ok_or_else(|| fields.err("reduction", &format!("names no catalogue reduction '{reduction}' (known: {})", catalogue.reduction_names())))?;
-            let list = r.ratios.iter().map(|x| x.to_string()).collect::<Vec<_>>().join(", ");
-            let ratio = match fields.optional_positive("gear_ratio")? {
-                Some(x) => x,
-                None if r.ratios.len() == 1 => r.ratios[0],
-                None => return Err(fields.err("gear_ratio", &format!("is missing: '{reduction}' comes in {list}"))),
+        if let Some(value) = t.get("reduction") {
+            // catalogue reductions, one or a list of stages from the motor out: their own losses and
+            // ratings, each at one of its ratios
+            let names: Vec<String> = match value {
+                Value::String(name) => vec![name.clone()],
+                Value::Array(list) if !list.is_empty() && list.iter().all(Value::is_str) => list.iter().filter_map(Value::as_str).map(str::to_string).collect(),
+                _ => return Err(fields.err("reduction", "must be the name of a catalogue reduction, or a list of them (stages from the motor out)")),
             };
-            if r.efficiency.is_none() {
-                eprintln!("armscope: notice: {}: {what}: reduction '{reduction}' publishes no efficiency: simulated lossless", path.display());
+            if let Some(k) = ["efficiency", "backdrive_efficiency", "breakaway_torque", "viscous", "rated_torque"].iter().find(|k| t.contains_key(**k)) {
+                return Err(fields.err(k, &format!("comes from the catalogue's reduction '{}': leave it out, or give the reduction's numbers without 'reduction'", names.join("', '"))));
             }
-            set.joints[index] = Some(own.then_reduction(r, ratio).ok_or_else(|| fields.err("gear_ratio", &format!("{ratio} is not a ratio of '{reduction}' ({list})")))?);
+            let ratios: Vec<Option<f64>> = match t.get("gear_ratio") {
+                None => vec![None; names.len()],
+                Some(Value::Array(list)) if list.len() == names.len() => list.iter().map(|v| v.as_float().or(v.as_integer().map(|i| i as f64)).filter(|x| *x > 0.0).map(Some).ok_or_else(|| fields.err("gear_ratio", "must be positive numbers"))).collect::<Result<_, _>>()?,
+                Some(_) if names.len() == 1 => vec![Some(fields.positive("gear_ratio")?)],
+                Some(_) => return Err(fields.err("gear_ratio", &format!("must list one ratio per reduction ({})", names.len()))),
+            };
+            let mut drive = own;
+            for (reduction, ratio) in names.iter().zip(ratios) {
+                let r = catalogue.reduction(reduction).ok_or_else(|| fields.err("reduction", &format!("names no catalogue reduction '{reduction}' (known: {})", catalogue.reduction_names())))?;
+                let list = r.ratios.iter().map(|x| x.to_string()).collect::<Vec<_>>().join(", ");
+                let ratio = match ratio {
+                    Some(x) => x,
+                    None if r.ratios.len() == 1 => r.ratios[0],
+                    None => return Err(fields.err("gear_ratio", &format!("is missing: '{reduction}' comes in {list}"))),
+                };
+                if r.efficiency.is_none() {
+                    eprintln!("armscope: notice: {}: {what}: reduction '{reduction}' publishes no efficiency: simulated lossless", path.display());
+                }
+                drive = drive.then_reduction(r, ratio).ok_or_else(|| fields.err("gear_ratio", &format!("{ratio} is not a ratio of '{reduction}' ({list})")))?;
+            }
+            set.joints[index] = Some(drive);
             continue;
-        } else if t.contains_key("reduction") {
-            return Err(fields.err("reduction", "must be the name of a catalogue reduction"));
         }
         let ratio = fields.optional_positive("gear_ratio")?.unwrap_or(1.0);
         let gear = fields.gear("")?;

@@ -163,6 +163,13 @@ pub fn write_summary(out: &mut dyn Write, s: &Summary) -> std::io::Result<()> {
         writeln!(out, "{}   (t >= {} s: the motion's own)", row("  after settling", s.peak_abs_torque_after_settle.iter().map(|p| p.map_or("n/a".into(), |p| format!("{p:.3}"))).collect()), s.error_window_start)?;
     }
     writeln!(out, "{}", row("RMS |u| (N·m)", s.rms_torque.iter().map(|p| format!("{p:.3}")).collect()))?;
+    let share = |x: Option<f64>, of: f64| x.map_or("-".to_string(), |r| format!("{:.0}", 100.0 * of / r));
+    if s.drive_duty.iter().flatten().any(|d| d.continuous_torque.is_some()) {
+        writeln!(out, "{}   (the motor's RMS torque at its shaft, u/N, over its continuous rating)", row("RMS of cont. (%)", s.drive_duty.iter().map(|d| d.as_ref().map_or("-".into(), |d| share(d.continuous_torque, d.rms_motor_torque))).collect()))?;
+    }
+    if s.drive_duty.iter().flatten().any(|d| d.rated_average_torque.is_some()) {
+        writeln!(out, "{}   (the cubic mean of |u| through the gearbox over its rated average torque)", row("gear avg of rated (%)", s.drive_duty.iter().map(|d| d.as_ref().map_or("-".into(), |d| share(d.rated_average_torque, d.cubic_mean_torque))).collect()))?;
+    }
     if s.winding.iter().any(Option::is_some) {
         let cell = |f: &dyn Fn(&crate::actuator::thermal::WindingSummary) -> String| s.winding.iter().map(|w| w.as_ref().map_or("-".to_string(), f)).collect::<Vec<_>>();
         writeln!(out, "{}", row("winding peak (°C)", cell(&|w| format!("{:.1}", w.peak_temperature))))?;

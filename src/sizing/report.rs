@@ -1,7 +1,7 @@
 //! What `armscope size` shows: the console and Markdown table, the motor file of the choice, and per
 //! joint a chart of motor × ratio with the feasible region and the choice marked.
 
-use super::screening::{Candidate, JointSizing, SizeReport};
+use super::screening::{BillRow, Candidate, JointSizing, SizeReport};
 use crate::canvas::{Canvas, ratio_color};
 
 /// A headroom factor for people: 2.4×, 37×, ∞.
@@ -81,32 +81,58 @@ impl SizeReport {
         }
     }
 
+    /// The bill of materials: per joint with a choice, its parts and how hard the motion uses them.
+    pub fn bill_rows(&self) -> Vec<BillRow> {
+        self.joints
+            .iter()
+            .filter_map(|js| {
+                let c = js.candidate(js.chosen)?;
+                let passed = js.chosen.and_then(|i| js.simulated.iter().rev().find(|s| s.candidate == i && s.passed));
+                Some(BillRow {
+                    joint: js.joint.clone(),
+                    motor: c.motor.clone(),
+                    reduction: c.reduction.clone(),
+                    ratio: c.ratio,
+                    mass_kg: c.mass_kg,
+                    peak_use: passed.map(|s| s.peak_torque_share),
+                    rms_motor_torque: c.rms_motor_torque,
+                    rms_use: c.continuous_torque.map(|r| c.rms_motor_torque / r),
+                    peak_winding_temperature: passed.and_then(|s| s.peak_winding_temperature),
+                    inertia_ratio: c.inertia_ratio,
+                    binding: js.binding(c).to_string(),
+                })
+            })
+            .collect()
+    }
+
     /// The bill of materials in Markdown: per joint the motor, its reduction and ratio, the masses,
-    /// the use (peak and RMS), the binding check; the total; what to buy.
+    /// the use (peak and RMS), the peak winding temperature, the binding check; the total; what to buy.
     pub fn bill_of_materials(&self) -> String {
-        let mut md = String::from("## Bill of materials\n\n| joint | motor | reduction | ratio | mass (kg) | peak use (simulated) | RMS motor torque (N·m) | inertia ratio | binding check |\n|---|---|---|---|---|---|---|---|---|\n");
+        let mut md = String::from("## Bill of materials\n\n| joint | motor | reduction | ratio | mass (kg) | peak use (full run) | RMS motor torque (N·m) | RMS of continuous | peak winding (°C) | inertia ratio | binding check |\n|---|---|---|---|---|---|---|---|---|---|---|\n");
         let mut total = 0.0;
         let mut count: Vec<(String, usize)> = Vec::new();
-        for js in &self.joints {
-            let Some(c) = js.candidate(js.chosen) else { continue };
-            total += c.mass_kg;
-            for part in std::iter::once(&c.motor).chain(c.reduction.iter()) {
+        for (row, js) in self.bill_of_materials.iter().zip(self.joints.iter().filter(|js| js.chosen.is_some())) {
+            total += row.mass_kg;
+            for part in std::iter::once(&row.motor).chain(row.reduction.iter()) {
                 match count.iter_mut().find(|(p, _)| p == part) {
                     Some((_, n)) => *n += 1,
                     None => count.push((part.clone(), 1)),
                 }
             }
-            let peak = js.chosen.and_then(|i| js.simulated.iter().rev().find(|s| s.candidate == i && s.passed)).map_or("–".to_string(), |s| format!("{:.0} %", 100.0 * s.peak_torque_share));
-            let ratio = c.inertia_ratio.map_or("n/p".to_string(), |r| format!("{r:.1}:1{}", if js.inertia_ratio_above.is_some() { " ⚠" } else { "" }));
+            let percent = |x: Option<f64>| x.map_or("–".to_string(), |x| format!("{:.0} %", 100.0 * x));
+            let ratio = row.inertia_ratio.map_or("n/p".to_string(), |r| format!("{r:.1}:1{}", if js.inertia_ratio_above.is_some() { " ⚠" } else { "" }));
             md += &format!(
-                "| {} | {} | {} | {} | {:.3} | {peak} | {:.4} | {ratio} | {} |\n",
-                js.joint,
-                c.motor,
-                c.reduction.as_deref().unwrap_or(if c.ratio == 1.0 { "direct" } else { "ideal" }),
-                ratio_text(c.ratio),
-                c.mass_kg,
-                c.rms_motor_torque,
-                js.binding(c)
+                "| {} | {} | {} | {} | {:.3} | {} | {:.4} | {} | {} | {ratio} | {} |\n",
+                row.joint,
+                row.motor,
+                row.reduction.as_deref().unwrap_or(if row.ratio == 1.0 { "direct" } else { "ideal" }),
+                ratio_text(row.ratio),
+                row.mass_kg,
+                percent(row.peak_use),
+                row.rms_motor_torque,
+                percent(row.rms_use),
+                row.peak_winding_temperature.map_or("–".to_string(), |t| format!("{t:.1}")),
+                row.binding
             );
         }
         md += &format!("\nDrive trains: {total:.3} kg in all. To order: {}.\n", count.iter().map(|(p, n)| format!("{n} × {p}")).collect::<Vec<_>>().join(", "));

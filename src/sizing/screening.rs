@@ -200,6 +200,9 @@ pub struct Candidate {
     /// The load's inertia over the rotor's (and the reductions' input) at the joint, J_L/(J·N²);
     /// None when the rotor's inertia is not published.
     pub inertia_ratio: Option<f64>,
+    /// The motor's continuous rating, N·m, where the catalogue gives one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub continuous_torque: Option<f64>,
     /// The check its share comes from, where not the peak torque on the curve.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub binding: Option<String>,
@@ -222,6 +225,9 @@ pub struct SimulatedCheck {
     pub passed: bool,
     /// Why it did not pass (the run diverged, or lost steps, or used more than the margin allows).
     pub note: Option<String>,
+    /// The motor's peak winding temperature in the run, °C (motors with thermal data).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub peak_winding_temperature: Option<f64>,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -282,6 +288,29 @@ pub struct SizeReport {
     pub reductions: Vec<String>,
     /// Reductions tried whose mass is not published (counted as weightless).
     pub weightless_reductions: Vec<String>,
+    /// What to order, per joint ([`SizeReport::bill_rows`]).
+    pub bill_of_materials: Vec<BillRow>,
+}
+
+/// One joint's line of the bill of materials.
+#[derive(Clone, Debug, Serialize)]
+pub struct BillRow {
+    pub joint: String,
+    pub motor: String,
+    /// The reduction after the motor, if a catalogue one.
+    pub reduction: Option<String>,
+    pub ratio: f64,
+    pub mass_kg: f64,
+    /// The largest share of its torque at speed the full run used.
+    pub peak_use: Option<f64>,
+    /// The motor's RMS torque at its shaft, N·m, and its share of the continuous rating.
+    pub rms_motor_torque: f64,
+    pub rms_use: Option<f64>,
+    /// The motor's peak winding temperature in the full run, °C.
+    pub peak_winding_temperature: Option<f64>,
+    pub inertia_ratio: Option<f64>,
+    /// The check that binds it.
+    pub binding: String,
 }
 
 /// The commanded motion of every experiment, per joint: speed, acceleration and the torque without
@@ -551,7 +580,7 @@ pub fn size(request: &SizeRequest) -> Result<SizeReport, Error> {
                     let rms_motor_torque = rms_motor_torque(&drive, &motion, j);
                     let share = peak_share.max(duty_share);
                     let shortfall = peak_shortfall.or(duty_shortfall);
-                    candidates.push(Candidate { motor: motor.clone(), reduction: reduction.clone(), mass_kg, ratio, total_ratio: drive.gear_ratio, torque_at_rest: drive.torque_limit(0.0), share, torque_headroom, speed_headroom, shortfall, margin, rms_motor_torque, inertia_ratio, binding });
+                    candidates.push(Candidate { motor: motor.clone(), reduction: reduction.clone(), mass_kg, ratio, total_ratio: drive.gear_ratio, torque_at_rest: drive.torque_limit(0.0), share, torque_headroom, speed_headroom, shortfall, margin, rms_motor_torque, inertia_ratio, binding, continuous_torque: drive.continuous_torque });
                 }
             }
         }
@@ -711,7 +740,7 @@ pub fn size(request: &SizeRequest) -> Result<SizeReport, Error> {
         let set: Vec<Option<usize>> = joints.iter().map(|js| js.chosen).collect();
         motor_set(request, &joints, &set)?.joints.iter().flatten().map(|d| d.mass()).sum()
     };
-    Ok(SizeReport {
+    let mut report = SizeReport {
         model: model.name.clone(),
         motions: request.motions.iter().map(|(name, _)| name.clone()).collect(),
         payload_kg: request.payload_kg,
@@ -751,7 +780,10 @@ pub fn size(request: &SizeRequest) -> Result<SizeReport, Error> {
             Reductions::Catalogue(names) => names.iter().filter(|n| request.catalogue.reduction(n).is_some_and(|r| r.mass.is_none())).cloned().collect(),
             Reductions::Ideal(_) => Vec::new(),
         },
-    })
+        bill_of_materials: Vec::new(),
+    };
+    report.bill_of_materials = report.bill_rows();
+    Ok(report)
 }
 
 /// Each joint's candidate at its place `pick` in its ranking (None past the end, or with no candidates).
@@ -769,6 +801,7 @@ struct JointRun {
     /// Where it did worst, when the motion has several experiments: the first that lost steps, else
     /// the one with the largest torque share.
     worst_experiment: Option<String>,
+    peak_winding_temperature: Option<f64>,
 }
 
 fn check(candidate: usize, run: &JointRun, margin: f64) -> SimulatedCheck {
@@ -783,7 +816,7 @@ fn check(candidate: usize, run: &JointRun, margin: f64) -> SimulatedCheck {
     } else {
         None
     };
-    SimulatedCheck { candidate, lost_steps: run.lost_steps, peak_torque_share: run.peak_torque_share, passed: note.is_none(), note }
+    SimulatedCheck { candidate, lost_steps: run.lost_steps, peak_torque_share: run.peak_torque_share, passed: note.is_none(), note, peak_winding_temperature: run.peak_winding_temperature }
 }
 
 /// The motor set of per-joint candidates (None: the joint keeps its URDF effort).
@@ -822,6 +855,9 @@ fn simulate_set(request: &SizeRequest, joints: &[JointSizing], set: &[Option<usi
             }
             run.lost_steps += lost;
             run.peak_torque_share = run.peak_torque_share.max(share);
+            if let Some(Some(w)) = summary.winding.get(j) {
+                run.peak_winding_temperature = Some(run.peak_winding_temperature.unwrap_or(f64::NEG_INFINITY).max(w.peak_temperature));
+            }
         }
         if let crate::summary::RunStatus::Diverged { joint, message, .. } = &summary.status {
             if let Some(j) = request.model.joint_index(joint) {
