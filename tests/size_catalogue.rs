@@ -50,14 +50,6 @@ fn size_chooses_real_reductions_at_their_own_ratios() {
     assert!(set.joints.iter().flatten().any(|d| !d.reductions.is_empty()));
 }
 
-/// A 1 kg bob 0.153 m out along x from a horizontal axis: 1.50 N·m to hold level.
-const PENDULUM: &str = r#"<robot name="level_pendulum">
-  <link name="world"/>
-  <link name="arm"><inertial><origin xyz="0.153 0 0"/><mass value="1"/>
-    <inertia ixx="1e-4" iyy="1e-4" izz="1e-4" ixy="0" ixz="0" iyz="0"/></inertial></link>
-  <joint name="lift" type="revolute"><parent link="world"/><child link="arm"/><axis xyz="0 1 0"/>
-    <limit lower="-3" upper="3" effort="100" velocity="10"/></joint>
-</robot>"#;
 
 /// A bare motor (1 N·m, 100 rad/s) with two reductions of the same 10:1: one whose input may turn
 /// only 20 rad/s, one whose rated average torque (1 N·m) is below the 1.5 N·m the pendulum holds
@@ -79,7 +71,7 @@ fn candidate<'a>(report: &'a Value, reduction: &str) -> &'a Value {
 #[test]
 fn a_reduction_is_rejected_for_its_input_speed_and_for_its_average_torque() {
     let dir = tempfile::tempdir().unwrap();
-    std::fs::write(dir.path().join("pendulum.urdf"), PENDULUM).unwrap();
+    std::fs::write(dir.path().join("pendulum.urdf"), common::LEVEL_PENDULUM).unwrap();
     std::fs::write(dir.path().join("catalogue.toml"), catalogue()).unwrap();
     let (urdf, cat) = (dir.path().join("pendulum.urdf"), dir.path().join("catalogue.toml"));
     let common_args = ["--urdf", urdf.to_str().unwrap(), "--catalogue", cat.to_str().unwrap(), "--candidates", "bare", "--reductions", "slow,weak,strong", "--duration", "10", "--drive", "pd"];

@@ -2,23 +2,15 @@
 //! RMS torque over the motion against its continuous rating, and with thermal data the winding
 //! over the duty (`--duty HOURS`), beside the peak torque on the curve.
 
+mod common;
+
 use serde_json::Value;
 use std::path::Path;
-
-/// A 1 kg bob 0.153 m out along x from a horizontal axis: held level, its weight's torque is
-/// 1.50 N·m at q = 0, where the default start pose puts it.
-const PENDULUM: &str = r#"<robot name="level_pendulum">
-  <link name="world"/>
-  <link name="arm"><inertial><origin xyz="0.153 0 0"/><mass value="1"/>
-    <inertia ixx="1e-4" iyy="1e-4" izz="1e-4" ixy="0" ixz="0" iyz="0"/></inertial></link>
-  <joint name="lift" type="revolute"><parent link="world"/><child link="arm"/><axis xyz="0 1 0"/>
-    <limit lower="-3" upper="3" effort="100" velocity="10"/></joint>
-</robot>"#;
 
 /// `armscope size` on the level pendulum, a slow ±5° wave for `duration` s, with `catalogue` and
 /// the extra flags; its report.
 fn size(dir: &Path, catalogue: &str, duration: &str, extra: &[&str]) -> Value {
-    std::fs::write(dir.join("pendulum.urdf"), PENDULUM).unwrap();
+    std::fs::write(dir.join("pendulum.urdf"), common::LEVEL_PENDULUM).unwrap();
     std::fs::write(dir.join("catalogue.toml"), catalogue).unwrap();
     let out = dir.join(format!("out{}", extra.join("_")));
     // the file's own motors only (it adds to the built-in catalogue)

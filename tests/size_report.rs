@@ -2,20 +2,14 @@
 //! motor kind, the load-to-rotor inertia ratio with a notice above the guideline, the feasible drive
 //! with the lowest RMS motor torque, and a bill of materials.
 
+mod common;
+
 use serde_json::Value;
 use std::path::Path;
 
-/// A 1 kg bob 0.153 m out along x from a horizontal axis: M = 1e-4 + 0.153² kg·m² about it.
-const PENDULUM: &str = r#"<robot name="level_pendulum">
-  <link name="world"/>
-  <link name="arm"><inertial><origin xyz="0.153 0 0"/><mass value="1"/>
-    <inertia ixx="1e-4" iyy="1e-4" izz="1e-4" ixy="0" ixz="0" iyz="0"/></inertial></link>
-  <joint name="lift" type="revolute"><parent link="world"/><child link="arm"/><axis xyz="0 1 0"/>
-    <limit lower="-3" upper="3" effort="100" velocity="10"/></joint>
-</robot>"#;
 
 fn size(dir: &Path, label: &str, extra: &[&str]) -> (Value, String) {
-    std::fs::write(dir.join("pendulum.urdf"), PENDULUM).unwrap();
+    std::fs::write(dir.join("pendulum.urdf"), common::LEVEL_PENDULUM).unwrap();
     let out = dir.join(label);
     let args: Vec<String> = ["armscope", "size", "--urdf", dir.join("pendulum.urdf").to_str().unwrap(), "--freq", "1", "--amp-deg", "20", "--duration", "10", "--parts-in-urdf", "--out", out.to_str().unwrap()]
         .iter()

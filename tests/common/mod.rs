@@ -7,6 +7,16 @@ use std::path::{Path, PathBuf};
 pub mod random_tree;
 pub mod rrd;
 
+/// A 1 kg bob 0.153 m out along x from a horizontal axis (the sizing tests' load): held level its
+/// weight's torque is 1.50 N·m at q = 0, and M = 1e-4 + 0.153² kg·m² about the axis.
+pub const LEVEL_PENDULUM: &str = r#"<robot name="level_pendulum">
+  <link name="world"/>
+  <link name="arm"><inertial><origin xyz="0.153 0 0"/><mass value="1"/>
+    <inertia ixx="1e-4" iyy="1e-4" izz="1e-4" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <joint name="lift" type="revolute"><parent link="world"/><child link="arm"/><axis xyz="0 1 0"/>
+    <limit lower="-3" upper="3" effort="100" velocity="10"/></joint>
+</robot>"#;
+
 pub fn repo() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
