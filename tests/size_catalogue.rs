@@ -101,3 +101,28 @@ fn a_reduction_is_rejected_for_its_input_speed_and_for_its_average_torque() {
     let wave_speed = 60f64.to_radians() * 2.0;
     assert!(joint_speed >= wave_speed - 1e-3 && joint_speed < 1.5 * wave_speed, "top motor speed with the margin: {speed}");
 }
+
+/// `--stages 2`: beside one reduction, every reduction followed by a belt; each such candidate's
+/// first stage fits the motor, its second is a belt, its ratio is the product; the motor file of the
+/// choice lists the stages and loads.
+#[test]
+fn two_stage_trains_are_a_reduction_then_a_belt() {
+    let dir = tempfile::tempdir().unwrap();
+    let urdf = common::box_urdf();
+    let report = size(dir.path(), "two", &["--urdf", urdf.to_str().unwrap(), "--duration", "5", "--candidates", "17HS4401,17HS08-1004S", "--stages", "2", "--parts-in-urdf"]);
+    let catalogue = armscope::actuator::Catalogue::load(&common::repo().join("assets/motors/catalogue.toml")).unwrap();
+    let mut two = 0;
+    for joint in report["joints"].as_array().unwrap() {
+        for c in joint["candidates"].as_array().unwrap() {
+            let Some(stages) = c["stages"].as_array().filter(|s| s.len() == 2) else { continue };
+            two += 1;
+            let (first, belt) = (stages[0][0].as_str().unwrap(), stages[1][0].as_str().unwrap());
+            assert!(catalogue.fits(c["motor"].as_str().unwrap(), first) && catalogue.reduction(belt).unwrap().kind == "belt");
+            let product = stages[0][1].as_f64().unwrap() * stages[1][1].as_f64().unwrap();
+            assert!((c["ratio"].as_f64().unwrap() - product).abs() < 1e-9 * product);
+        }
+    }
+    assert!(two > 100, "{two} two-stage candidates");
+    let model = armscope::model::load_urdf(&urdf).unwrap();
+    armscope::actuator::load_motor_file(&dir.path().join("two/motors.toml"), &model).unwrap();
+}

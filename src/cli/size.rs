@@ -42,6 +42,10 @@ pub struct SizeArgs {
     /// published), each at its own ratios, beside a direct drive.
     #[arg(long, value_delimiter = ',', num_args = 1, conflicts_with = "ratios")]
     pub reductions: Option<Vec<String>>,
+    /// Catalogue stages per drive train: 1 (a reduction or none), or 2 (also every reduction
+    /// followed by a belt).
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u8).range(1..=2))]
+    pub stages: u8,
     /// Instead of the catalogue's reductions, ideal ones at these ratios (your own gearing): a range
     /// `1-50` (whole numbers), `1-50:0.5` (a step), a list `5,10,15`, or mixed; `JOINT=SPEC` for
     /// one joint (repeat the flag).
@@ -273,7 +277,7 @@ pub fn size(args: &SizeArgs) -> Result<i32, Error> {
     };
     let jobs = args.jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
     let started = std::time::Instant::now();
-    let request = SizeRequest { motions, model, payload_kg: args.payload, catalogue, motors, reductions, margin: args.margin, efficiency: args.efficiency, microsteps: args.microsteps, jobs, duty: args.duty.map(|hours| hours * 3600.0), carry_parts: !args.parts_in_urdf };
+    let request = SizeRequest { motions, model, payload_kg: args.payload, catalogue, motors, reductions, margin: args.margin, efficiency: args.efficiency, microsteps: args.microsteps, jobs, duty: args.duty.map(|hours| hours * 3600.0), carry_parts: !args.parts_in_urdf, max_stages: args.stages as usize };
     let report = size_joints(&request)?;
 
     std::fs::create_dir_all(&args.out).map_err(|e| Error::output(&args.out, e))?;

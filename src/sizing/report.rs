@@ -16,7 +16,7 @@ fn times(x: f64) -> String {
 }
 
 fn ratio_text(r: f64) -> String {
-    if r.fract() == 0.0 { format!("{r:.0}") } else { format!("{r}") }
+    if r.fract() == 0.0 { format!("{r:.0}") } else { format!("{r:.4}").trim_end_matches('0').to_string() }
 }
 
 impl Candidate {
@@ -113,10 +113,10 @@ impl SizeReport {
         let mut count: Vec<(String, usize)> = Vec::new();
         for (row, js) in self.bill_of_materials.iter().zip(self.joints.iter().filter(|js| js.chosen.is_some())) {
             total += row.mass_kg;
-            for part in std::iter::once(&row.motor).chain(row.reduction.iter()) {
+            for part in std::iter::once(row.motor.as_str()).chain(row.reduction.iter().flat_map(|r| r.split(" + "))) {
                 match count.iter_mut().find(|(p, _)| p == part) {
                     Some((_, n)) => *n += 1,
-                    None => count.push((part.clone(), 1)),
+                    None => count.push((part.to_string(), 1)),
                 }
             }
             let percent = |x: Option<f64>| x.map_or("–".to_string(), |x| format!("{:.0} %", 100.0 * x));
@@ -254,6 +254,14 @@ impl SizeReport {
         for js in &self.joints {
             let Some(c) = js.candidate(js.chosen) else { continue };
             toml += &match &c.reduction {
+                Some(_) if c.stages.len() > 1 => format!(
+                    "\n[joints.{}]\nmotor = {:?}\nreduction = [{}]\ngear_ratio = [{}]\nmicrosteps = {}\n",
+                    toml_key(&js.joint),
+                    c.motor,
+                    c.stages.iter().map(|(n, _)| format!("{n:?}")).collect::<Vec<_>>().join(", "),
+                    c.stages.iter().map(|(_, r)| r.to_string()).collect::<Vec<_>>().join(", "),
+                    self.microsteps
+                ),
                 Some(r) => format!("\n[joints.{}]\nmotor = {:?}\nreduction = {r:?}\ngear_ratio = {}\nmicrosteps = {}\n", toml_key(&js.joint), c.motor, c.ratio, self.microsteps),
                 None => format!("\n[joints.{}]\nmotor = {:?}\ngear_ratio = {}\nefficiency = {}\nmicrosteps = {}\n", toml_key(&js.joint), c.motor, c.ratio, if c.ratio == 1.0 { 1.0 } else { self.efficiency }, self.microsteps),
             };

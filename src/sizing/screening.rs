@@ -41,6 +41,8 @@ pub struct SizeRequest {
     pub motors: Vec<String>,
     /// The reductions to try after the motor (and after a gearmotor's own gearbox).
     pub reductions: Reductions,
+    /// Up to this many catalogue stages per drive train: 1, or 2 (a reduction, then a belt).
+    pub max_stages: usize,
     /// Headroom on torque and on speed: 0.3 asks for 30 % more than the motion needs. None: the
     /// vendors' margin for each motor kind ([`vendor_margin`]).
     pub margin: Option<f64>,
@@ -174,9 +176,13 @@ fn distinct(a: f64, b: f64) -> (String, String) {
 #[derive(Clone, Debug, Serialize)]
 pub struct Candidate {
     pub motor: String,
-    /// The catalogue reduction after the motor (None: a direct drive, or an ideal reduction).
+    /// The catalogue reduction after the motor (None: a direct drive, or an ideal reduction); for
+    /// two stages their names joined with " + ".
     #[serde(skip_serializing_if = "Option::is_none")]
     pub reduction: Option<String>,
+    /// The catalogue stages from the motor out with their ratios (empty: direct or ideal).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub stages: Vec<(String, f64)>,
     /// The motor's and the reduction's mass (a reduction without a published mass counts 0).
     pub mass_kg: f64,
     /// The ratio chosen after the motor.
@@ -361,28 +367,45 @@ fn commanded_motion(request: &SizeRequest, model: &Model) -> Result<Motion, Erro
     Ok(motion)
 }
 
-/// The drive train of `motor` behind the catalogue's `reduction` at `ratio`, or without one behind an
-/// ideal `ratio` at efficiency `efficiency` (1 for ratio 1).
-pub fn drive_train(catalogue: &Catalogue, motor: &str, reduction: Option<&str>, ratio: f64, efficiency: f64) -> Result<DriveTrain, Error> {
-    let own = catalogue.drive_train(motor).ok_or_else(|| Error::flag("--candidates", format!("no motor '{motor}' in {} (known: {})", catalogue.source.display(), catalogue.names())))??;
-    match reduction {
-        Some(name) => {
-            let r = catalogue.reduction(name).ok_or_else(|| Error::flag("--reductions", format!("no reduction '{name}' in {} (known: {})", catalogue.source.display(), catalogue.reduction_names())))?;
-            own.then_reduction(r, ratio).ok_or_else(|| Error::flag("--reductions", format!("'{name}' has no ratio {ratio}")))
-        }
-        None => Ok(own.followed_by(ratio, LossyGear::with_efficiency(if ratio == 1.0 { 1.0 } else { efficiency }), f64::INFINITY)),
+/// The drive train of `motor` behind the catalogue's `stages` (from the motor out, each at its
+/// ratio), or without any behind an ideal `ratio` at efficiency `efficiency` (1 for ratio 1).
+pub fn drive_train(catalogue: &Catalogue, motor: &str, stages: &[(String, f64)], ratio: f64, efficiency: f64) -> Result<DriveTrain, Error> {
+    let mut drive = catalogue.drive_train(motor).ok_or_else(|| Error::flag("--candidates", format!("no motor '{motor}' in {} (known: {})", catalogue.source.display(), catalogue.names())))??;
+    if stages.is_empty() {
+        return Ok(drive.followed_by(ratio, LossyGear::with_efficiency(if ratio == 1.0 { 1.0 } else { efficiency }), f64::INFINITY));
     }
+    for (name, ratio) in stages {
+        let r = catalogue.reduction(name).ok_or_else(|| Error::flag("--reductions", format!("no reduction '{name}' in {} (known: {})", catalogue.source.display(), catalogue.reduction_names())))?;
+        drive = drive.then_reduction(r, *ratio).ok_or_else(|| Error::flag("--reductions", format!("'{name}' has no ratio {ratio}")))?;
+    }
+    Ok(drive)
 }
 
-/// Per joint, the (reduction, ratio) pairs to try after each motor.
-fn options(request: &SizeRequest, j: usize) -> Vec<(Option<String>, f64)> {
+/// One way to follow a motor: catalogue stages (from the motor out), or an ideal ratio.
+#[derive(Clone, Debug)]
+struct DriveOption {
+    stages: Vec<(String, f64)>,
+    ratio: f64,
+}
+
+/// Per joint, the drive options to try after each motor: a direct drive and every reduction at each
+/// of its ratios, and with two stages every reduction followed by a belt at each of the belt's.
+fn options(request: &SizeRequest, j: usize) -> Vec<DriveOption> {
     match &request.reductions {
-        Reductions::Ideal(ratios) => ratios[j].iter().map(|&r| (None, r)).collect(),
+        Reductions::Ideal(ratios) => ratios[j].iter().map(|&ratio| DriveOption { stages: Vec::new(), ratio }).collect(),
         Reductions::Catalogue(names) => {
-            let mut out = vec![(None, 1.0)];
-            for name in names {
-                if let Some(r) = request.catalogue.reduction(name) {
-                    out.extend(r.ratios.iter().map(|&ratio| (Some(name.clone()), ratio)));
+            let mut out = vec![DriveOption { stages: Vec::new(), ratio: 1.0 }];
+            let reductions: Vec<&crate::actuator::Reduction> = names.iter().filter_map(|n| request.catalogue.reduction(n)).collect();
+            for r in &reductions {
+                out.extend(r.ratios.iter().map(|&ratio| DriveOption { stages: vec![(r.name.clone(), ratio)], ratio }));
+            }
+            if request.max_stages >= 2 {
+                for first in reductions.iter().filter(|r| r.kind != "belt") {
+                    for belt in reductions.iter().filter(|r| r.kind == "belt") {
+                        for &a in &first.ratios {
+                            out.extend(belt.ratios.iter().map(|&b| DriveOption { stages: vec![(first.name.clone(), a), (belt.name.clone(), b)], ratio: (a * b * 1e9).round() / 1e9 }));
+                        }
+                    }
                 }
             }
             out
@@ -558,13 +581,15 @@ pub fn size(request: &SizeRequest) -> Result<SizeReport, Error> {
             let options = options(request, j);
             for motor in &request.motors {
                 let motor_mass = request.catalogue.mass(motor).unwrap_or(f64::NAN);
-                for (reduction, ratio) in &options {
-                    if reduction.as_ref().is_some_and(|r| !request.catalogue.fits(motor, r)) {
+                for option in &options {
+                    // the first stage takes the motor's flange; a belt after it takes any output
+                    if option.stages.first().is_some_and(|(r, _)| !request.catalogue.fits(motor, r)) {
                         continue;
                     }
-                    let ratio = *ratio;
-                    let mass_kg = motor_mass + reduction.as_ref().and_then(|r| request.catalogue.reduction(r)?.mass).unwrap_or(0.0);
-                    let drive = drive_train(&request.catalogue, motor, reduction.as_deref(), ratio, request.efficiency)?;
+                    let ratio = option.ratio;
+                    let reduction = (!option.stages.is_empty()).then(|| option.stages.iter().map(|(n, _)| n.as_str()).collect::<Vec<_>>().join(" + "));
+                    let mass_kg = motor_mass + option.stages.iter().filter_map(|(r, _)| request.catalogue.reduction(r)?.mass).sum::<f64>();
+                    let drive = drive_train(&request.catalogue, motor, &option.stages, ratio, request.efficiency)?;
                     let margin = request.margin_for(motor);
                     let (peak_share, torque_headroom, speed_headroom, peak_shortfall) = rate(&drive, &motion, j, margin);
                     let (duty_share, duty_shortfall, duty_binding) = rate_duty(&drive, &motion, j, margin, duty);
@@ -580,7 +605,7 @@ pub fn size(request: &SizeRequest) -> Result<SizeReport, Error> {
                     let rms_motor_torque = rms_motor_torque(&drive, &motion, j);
                     let share = peak_share.max(duty_share);
                     let shortfall = peak_shortfall.or(duty_shortfall);
-                    candidates.push(Candidate { motor: motor.clone(), reduction: reduction.clone(), mass_kg, ratio, total_ratio: drive.gear_ratio, torque_at_rest: drive.torque_limit(0.0), share, torque_headroom, speed_headroom, shortfall, margin, rms_motor_torque, inertia_ratio, binding, continuous_torque: drive.continuous_torque });
+                    candidates.push(Candidate { motor: motor.clone(), reduction, stages: option.stages.clone(), mass_kg, ratio, total_ratio: drive.gear_ratio, torque_at_rest: drive.torque_limit(0.0), share, torque_headroom, speed_headroom, shortfall, margin, rms_motor_torque, inertia_ratio, binding, continuous_torque: drive.continuous_torque });
                 }
             }
         }
@@ -728,7 +753,7 @@ pub fn size(request: &SizeRequest) -> Result<SizeReport, Error> {
         if let Some(c) = js.chosen {
             let chosen = js.candidates[c].clone();
             js.lowest_rms = js.ranked.iter().copied().filter(|&x| js.candidates[x].motor == chosen.motor).min_by(|&a, &b| js.candidates[a].rms_motor_torque.total_cmp(&js.candidates[b].rms_motor_torque));
-            let drive = drive_train(&request.catalogue, &chosen.motor, chosen.reduction.as_deref(), chosen.ratio, request.efficiency)?;
+            let drive = drive_train(&request.catalogue, &chosen.motor, &chosen.stages, chosen.ratio, request.efficiency)?;
             js.optimal_ratio = optimal_ratio(js.rms_load_torque, js.rms_acceleration, drive.shaft_inertia(), drive.gear.efficiency);
             let (guideline, whom) = inertia_ratio_guideline(request.catalogue.kind(&chosen.motor), request.catalogue.frame(&chosen.motor), request.open_loop());
             if chosen.inertia_ratio.is_some_and(|r| r > guideline) {
@@ -829,7 +854,7 @@ pub fn motor_set(request: &SizeRequest, joints: &[JointSizing], set: &[Option<us
     for (j, choice) in set.iter().enumerate() {
         if let Some(c) = choice {
             let candidate = &joints[j].candidates[*c];
-            motors.joints[j] = Some(drive_train(&request.catalogue, &candidate.motor, candidate.reduction.as_deref(), candidate.ratio, request.efficiency)?);
+            motors.joints[j] = Some(drive_train(&request.catalogue, &candidate.motor, &candidate.stages, candidate.ratio, request.efficiency)?);
             motors.microsteps[j] = Some(request.microsteps);
         }
     }
