@@ -79,6 +79,14 @@ pub struct RunConfig {
     pub motors: Option<PathBuf>,
     /// Stepper joints open loop (default) or under the PD controller.
     pub drive: DriveMode,
+    /// Check every control step for self-collision (and with the floor, if any).
+    pub collisions: bool,
+    /// A floor at this height (world z, m), checked against every moving link; NaN: at the height of
+    /// the link the first joint hangs from (the base).
+    #[serde(skip)]
+    pub floor: Option<f64>,
+    /// An SRDF whose disabled pairs are not checked (default: the one beside the URDF).
+    pub srdf: Option<PathBuf>,
 }
 
 pub use crate::builtin::DEFAULT_URDF;
@@ -116,6 +124,9 @@ impl Default for RunConfig {
             q0: None,
             motors: None,
             drive: DriveMode::Stepper,
+            collisions: false,
+            floor: None,
+            srdf: None,
         }
     }
 }

@@ -37,6 +37,8 @@ pub struct Experiment {
     /// energized where the command starts; `start` is that pose plus the sag at which each stepper
     /// carries its share of the weight. Each run drives a copy.
     pub steppers: Option<OpenLoopSteppers>,
+    /// The collision checks (`--collisions`, `--floor`, `--srdf`): the shapes and active pairs.
+    pub collisions: Option<Arc<crate::collision::Collisions>>,
 }
 
 impl Experiment {
@@ -98,7 +100,25 @@ impl Experiment {
         weight_notices(&mut model, &start);
         let gains = gains(&config, &model, &start, trajectory.as_ref(), &plant)?;
         let steps = (config.duration / config.dt - 1e-9).ceil() as usize;
-        Ok(Self { config, model: Arc::new(model), gains, plant, trajectory, steps, start, motors, steppers })
+        let collisions = if config.collisions || config.floor.is_some() || config.srdf.is_some() {
+            let c = crate::collision::Collisions::new(&model, config.srdf.as_deref())?;
+            model.notices.extend(c.notices.iter().cloned());
+            if let Some(z) = config.floor.filter(|z| z.is_infinite()) {
+                return Err(Error::flag("--floor", format!("must be a height in m (got {z})")));
+            }
+            Some(Arc::new(c))
+        } else {
+            None
+        };
+        let mut config = config;
+        if config.floor.is_some_and(f64::is_nan) {
+            // at the base: the world height of the link the first joint hangs from
+            let base = model.frames.iter().find(|f| f.body.is_none() && model.frames.iter().any(|c| c.parent_frame.is_some_and(|p| std::ptr::eq(&model.frames[p], *f)) && c.body == Some(0)));
+            let z = base.map_or(0.0, |f| f.placement.translation.z);
+            model.notices.push(format!("--floor: at the base's height, z = {z} m (of '{}')", base.map_or("the world", |f| f.name.as_str())));
+            config.floor = Some(z);
+        }
+        Ok(Self { config, model: Arc::new(model), gains, plant, trajectory, steps, start, motors, steppers, collisions })
     }
 
     pub fn controller(&self) -> PdGravityController {

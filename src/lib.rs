@@ -8,6 +8,7 @@ pub mod allocator;
 pub mod batch;
 pub mod builtin;
 pub mod canvas;
+pub mod collision;
 pub mod cli;
 pub mod config;
 pub mod control;

@@ -55,6 +55,8 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
     // the motors' windings, where their thermal data is known
     let mut heat = crate::actuator::thermal::RunHeat::new(&experiment.motor_heat(), dt);
     let no_temperatures: Vec<f64> = Vec::new();
+    // the collision checks, every control step (flags only: the motion is not changed)
+    let mut collision_check = experiment.collisions.as_ref().map(|c| (crate::collision::CollisionData::new(&c.shapes, experiment.config.floor), crate::collision::StateCollisions::default(), crate::collision::RunLog::new(c.pairs.len(), experiment.config.floor)));
 
     for k in 0..=experiment.steps {
         let t = k as f64 * dt;
@@ -81,6 +83,10 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
             previous_saturated[i] = saturated[i];
         }
         body_poses(model, &cmd, &mut command_poses);
+        if let (Some(c), Some((cd, state, log))) = (experiment.collisions.as_ref(), collision_check.as_mut()) {
+            crate::collision::check_state(model, &c.shapes, &c.pairs, cd, |f| frame_pose(model, &data, f), COLLISION_BAND, state);
+            log.record(model, t, state);
+        }
         let interrupted = stop.is_some_and(|s| s.load(Ordering::Relaxed));
         let sample = Sample {
             k,
@@ -165,6 +171,7 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
     if heat.any() {
         summary.winding = heat.summary();
     }
+    summary.collisions = collision_check.map(|(_, _, log)| log.finish());
     if let Some(motors) = &experiment.motors {
         summary.drive_duty = motors
             .joints
@@ -186,6 +193,9 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
     }
     Ok(summary)
 }
+
+/// How close a pair must come to be measured exactly and reported (the near misses), m.
+const COLLISION_BAND: f64 = 0.05;
 
 /// Numerical energy audit of the discrete plant. Between control steps the arm's mechanical energy
 /// E = ½ q̇ᵀM(q)q̇ + potential may change only by the work of the torques, the damping and the

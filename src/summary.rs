@@ -89,6 +89,9 @@ pub struct Summary {
     /// without motors).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub drive_duty: Vec<Option<DriveDuty>>,
+    /// Self-collision and floor contacts, when the run checked them (`--collisions`, `--floor`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub collisions: Option<crate::collision::CollisionSummary>,
     /// Per joint whose motor has thermal data: its winding over the run (empty when no motor has).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub winding: Vec<Option<crate::actuator::thermal::WindingSummary>>,
@@ -299,6 +302,7 @@ impl SummaryBuilder {
             rms_torque: self.sum_squared_torque.iter().map(|&s| if self.control_steps == 0 { 0.0 } else { (s / self.control_steps as f64).sqrt() }).collect(),
             cubic_mean_torque: self.sum_cubed_torque.iter().map(|&s| if self.control_steps == 0 { 0.0 } else { (s / self.control_steps as f64).cbrt() }).collect(),
             drive_duty: Vec::new(),
+            collisions: None,
             winding: Vec::new(),
             peak_friction_torque: self.peak_friction.clone(),
             stuck_percent: share_of_control_steps(&self.stuck_steps),

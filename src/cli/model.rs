@@ -24,6 +24,13 @@ pub struct ModelArgs {
     /// library can check the model armscope simulates.
     #[arg(long, value_name = "FILE", requires = "motors")]
     pub urdf_out: Option<PathBuf>,
+    /// The collision checks' set-up: each link's shapes and the active pairs (with --states: per
+    /// state the pairs closer than 5 cm, negative inside, in the JSON).
+    #[arg(long)]
+    pub collisions: bool,
+    /// An SRDF whose <disable_collisions> pairs are not checked (default: the one beside the URDF).
+    #[arg(long, value_name = "FILE")]
+    pub srdf: Option<PathBuf>,
 }
 
 
@@ -45,10 +52,36 @@ pub fn model(args: &ModelArgs) -> Result<i32, Error> {
             eprintln!("armscope: wrote {}", out.display());
         }
     }
+    let collisions = if args.collisions || args.srdf.is_some() {
+        let c = crate::collision::Collisions::new(&model, args.srdf.as_deref())?;
+        for notice in &c.notices {
+            eprintln!("armscope: notice: {notice}");
+        }
+        Some(c)
+    } else {
+        None
+    };
     if let Some(path) = &args.states {
         let text = std::fs::read_to_string(path).map_err(|e| Error::flag("--states", format!("{}: {e}", path.display())))?;
         let states: Vec<crate::inspect::State> = serde_json::from_str(&text).map_err(|e| Error::flag("--states", format!("{}: {e}", path.display())))?;
-        println!("{}", crate::inspect::dynamics_at(&model, &states)?);
+        let mut out = crate::inspect::dynamics_at(&model, &states)?;
+        if let Some(c) = &collisions {
+            out["collision_pairs"] = serde_json::json!(c.pairs.iter().map(|&(a, b)| [&model.frames[a].name, &model.frames[b].name]).collect::<Vec<_>>());
+            for (s, json) in states.iter().zip(out["states"].as_array_mut().into_iter().flatten()) {
+                let q: Vec<f64> = model.joints.iter().map(|j| s.q.get(&j.name).copied().unwrap_or(0.0)).collect();
+                json["collisions"] = serde_json::json!(c.at(&model, &q, None, 0.05).into_iter().map(|(a, b, d)| serde_json::json!({"link1": a, "link2": b, "distance": d})).collect::<Vec<_>>());
+            }
+        }
+        println!("{out}");
+    } else if let Some(c) = &collisions {
+        let shapes = |f: usize| c.shapes.of_frame[f].len();
+        println!("{} links with collision shapes, {} active pairs (of {} link pairs with shapes):", (0..model.frames.len()).filter(|&f| shapes(f) > 0).count(), c.pairs.len(), {
+            let n = (0..model.frames.len()).filter(|&f| shapes(f) > 0).count();
+            n * n.saturating_sub(1) / 2
+        });
+        for &(a, b) in &c.pairs {
+            println!("  {} — {}", model.frames[a].name, model.frames[b].name);
+        }
     } else if args.json {
         println!("{}", serde_json::to_string_pretty(&crate::inspect::describe(&model)).unwrap_or_default());
     } else {

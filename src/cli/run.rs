@@ -82,6 +82,18 @@ pub struct RunArgs {
     pub q0: Option<String>,
     #[command(flatten)]
     pub motors: MotorArgs,
+    /// Check every control step for self-collision (the links' <collision> shapes; flags only, the
+    /// motion is not changed): first contact, each pair's steps in contact, closest approaches.
+    #[arg(long)]
+    pub collisions: bool,
+    /// Also check a floor, at this height (world z, m; without a value, at the height of the base:
+    /// the link the first joint hangs from). Implies --collisions.
+    #[arg(long, value_name = "Z", num_args = 0..=1, default_missing_value = "NaN", allow_negative_numbers = true)]
+    pub floor: Option<f64>,
+    /// An SRDF whose <disable_collisions> pairs are not checked (default: the one beside the URDF,
+    /// by name). Implies --collisions.
+    #[arg(long, value_name = "FILE")]
+    pub srdf: Option<PathBuf>,
 
     /// Write the tutorial's CSV (t, q, tool xyz every --print-every).
     #[arg(long, value_name = "PATH")]
@@ -210,6 +222,9 @@ impl RunArgs {
             q0: self.q0.clone(),
             motors: self.motors.motors.clone(),
             drive: self.motors.drive,
+            collisions: self.collisions,
+            floor: self.floor,
+            srdf: self.srdf.clone(),
         }
     }
 }

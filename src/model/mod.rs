@@ -71,6 +71,8 @@ pub struct Frame {
     /// Name of the URDF joint that attaches this link to its parent.
     pub parent_joint: Option<String>,
     pub visuals: Vec<Visual>,
+    /// Its `<collision>` shapes (the collision checks'; a mesh not found is left out, with a notice).
+    pub collisions: Vec<Visual>,
 }
 
 #[derive(Clone, Debug)]

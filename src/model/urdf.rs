@@ -172,6 +172,7 @@ fn build(text: &str, source: &Path, options: LoadOptions) -> Result<Model, K> {
             body_inertia[b] = body_inertia[b].combined(&link_inertia(ul).transformed(&placement));
         }
         let visuals = link_visuals(ul, &robot.materials, base_dir, &mut notices);
+        let collisions = link_collisions(ul, base_dir, &mut notices);
         frame_of_link[link] = Some(frames.len());
         frames.push(Frame {
             name: ul.name.clone(),
@@ -180,6 +181,7 @@ fn build(text: &str, source: &Path, options: LoadOptions) -> Result<Model, K> {
             parent_frame,
             parent_joint: via.map(|j| robot.joints[j].name.clone()),
             visuals,
+            collisions,
         });
         depth.push(d);
         for &j in child_joints[link].iter().rev() {
@@ -499,6 +501,25 @@ fn link_visuals(link: &urdf_rs::Link, materials: &[urdf_rs::Material], base_dir:
         visuals.extend(inertia_box(link));
     }
     visuals
+}
+
+/// A link's collision geometry (`<collision>`); a mesh that cannot be found is a notice, and the
+/// shape is left out of the collision checks.
+fn link_collisions(link: &urdf_rs::Link, base_dir: &Path, notices: &mut Vec<String>) -> Vec<Visual> {
+    link.collision
+        .iter()
+        .filter_map(|c| match geometry(&c.geometry, base_dir) {
+            Ok(geometry) => Some(Visual { origin: pose(&c.origin), geometry, rgba: None }),
+            Err(looked) => {
+                let filename = match &c.geometry {
+                    urdf_rs::Geometry::Mesh { filename, .. } => filename.as_str(),
+                    _ => "",
+                };
+                notices.push(format!("link '{}': collision mesh '{filename}' not found (looked for {looked}); left out of the collision checks", link.name));
+                None
+            }
+        })
+        .collect()
 }
 
 fn geometry(g: &urdf_rs::Geometry, base_dir: &Path) -> Result<Geometry, String> {

@@ -180,6 +180,20 @@ pub fn write_summary(out: &mut dyn Write, s: &Summary) -> std::io::Result<()> {
             writeln!(out, "  not thermally checked (no thermal data for their motors): {}", unchecked.join(", "))?;
         }
     }
+    if let Some(c) = &s.collisions {
+        let floor = c.floor.map_or(String::new(), |z| format!(" and the floor at z = {z} m"));
+        match &c.first_contact {
+            None => writeln!(out, "  collisions: none among {} link pairs{floor}", c.pairs_checked)?,
+            Some((t, a, b)) => writeln!(out, "  collisions: first at t = {t:.3} s, {a} with {b}; {} control steps in contact ({} link pairs{floor} checked)", c.steps_in_contact, c.pairs_checked)?,
+        }
+        for p in c.pairs.iter().take(8) {
+            let what = if p.steps_in_contact > 0 { format!("in contact {} steps, deepest {:.1} mm", p.steps_in_contact, -1e3 * p.closest) } else { format!("closest {:.1} mm", 1e3 * p.closest) };
+            writeln!(out, "    {} — {}: {what} at t = {:.3} s", p.link1, p.link2, p.closest_at)?;
+        }
+        if c.pairs.len() > 8 {
+            writeln!(out, "    … and {} more pairs closer than 5 cm (the summary JSON lists them)", c.pairs.len() - 8)?;
+        }
+    }
     if !s.stuck_percent.is_empty() {
         writeln!(out, "{}", row("peak friction (N·m)", s.peak_friction_torque.iter().map(|p| format!("{p:.3}")).collect()))?;
         writeln!(out, "{}", row("stuck (%)", s.stuck_percent.iter().map(|p| format!("{p:.1}")).collect()))?;

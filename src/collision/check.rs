@@ -1,0 +1,120 @@
+//! One state's collisions: per active pair the distance (negative: how deep the shapes overlap),
+//! the pairs in contact, and every pair closer than a threshold.
+
+use super::CollisionModel;
+use crate::model::Model;
+use crate::spatial::Pose;
+use parry3d_f64::math::{Pose as PPose, Vector};
+use parry3d_f64::shape::SharedShape;
+
+/// A pair of links (frame indices; `b` is `None` for the floor) and their distance, m (negative
+/// inside).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PairDistance {
+    pub a: usize,
+    pub b: Option<usize>,
+    pub distance: f64,
+}
+
+/// One state's result: the pairs in contact (distance ≤ 0) and every pair closer than the
+/// threshold (those in contact included), nearest first.
+#[derive(Clone, Debug, Default)]
+pub struct StateCollisions {
+    pub close: Vec<PairDistance>,
+}
+
+impl StateCollisions {
+    pub fn colliding(&self) -> impl Iterator<Item = &PairDistance> {
+        self.close.iter().filter(|p| p.distance <= 0.0)
+    }
+
+    /// The smallest distance among the pairs closer than the threshold (None: none that close).
+    pub fn min_distance(&self) -> Option<f64> {
+        self.close.first().map(|p| p.distance)
+    }
+}
+
+/// What a simulation keeps between checks: the shapes' world poses (no allocation per step).
+pub struct CollisionData {
+    poses: Vec<PPose>,
+    centres: Vec<nalgebra::Vector3<f64>>,
+    floor: Option<(f64, SharedShape)>,
+}
+
+impl CollisionData {
+    /// With a floor at height `floor` (world z), if any.
+    pub fn new(shapes: &CollisionModel, floor: Option<f64>) -> Self {
+        Self { poses: vec![PPose::identity(); shapes.shapes.len()], centres: vec![nalgebra::Vector3::zeros(); shapes.shapes.len()], floor: floor.map(|z| (z, SharedShape::halfspace(Vector::new(0.0, 0.0, 1.0)))) }
+    }
+}
+
+fn to_parry(p: &Pose) -> PPose {
+    let [x, y, z, w] = p.quaternion_xyzw();
+    PPose::from_parts(Vector::new(p.translation.x, p.translation.y, p.translation.z), parry3d_f64::math::Rot3::from_xyzw(x, y, z, w).normalize())
+}
+
+/// The signed distance of two placed shapes: parry's exact distance (GJK for two convex shapes —
+/// parry's own box–box shortcut projects twice and can miss the closest points by millimetres, which
+/// the check against coal caught — its composite-shape walk for meshes), and where they overlap its
+/// contact depth (negative).
+fn signed_distance(p1: &PPose, s1: &SharedShape, p2: &PPose, s2: &SharedShape) -> f64 {
+    let d = match (s1.as_support_map(), s2.as_support_map()) {
+        (Some(a), Some(b)) => parry3d_f64::query::details::distance_support_map_support_map(&p1.inv_mul(p2), a, b),
+        _ => parry3d_f64::query::distance(p1, s1.as_ref(), p2, s2.as_ref()).map_or(f64::INFINITY, |d| d.distance),
+    };
+    if d > 0.0 {
+        return d;
+    }
+    match parry3d_f64::query::contact(p1, s1.as_ref(), p2, s2.as_ref(), 0.0) {
+        Ok(Some(c)) => c.dist.min(0.0),
+        _ => 0.0,
+    }
+}
+
+/// The collisions of the state whose link poses `frame_pose` gives (world frame), over `pairs`, and
+/// with the floor for every link not fixed to the world; pairs farther than `threshold` are not
+/// measured past the broad phase.
+pub fn check_state(model: &Model, shapes: &CollisionModel, pairs: &[(usize, usize)], data: &mut CollisionData, frame_pose: impl Fn(usize) -> Pose, threshold: f64, out: &mut StateCollisions) {
+    out.close.clear();
+    for (i, s) in shapes.shapes.iter().enumerate() {
+        let pose = frame_pose(s.frame).compose(&s.origin);
+        data.centres[i] = pose.transform_point(&s.bounding_centre);
+        data.poses[i] = to_parry(&pose);
+    }
+    for &(a, b) in pairs {
+        let mut best = f64::INFINITY;
+        for &i in &shapes.of_frame[a] {
+            for &j in &shapes.of_frame[b] {
+                let (si, sj) = (&shapes.shapes[i], &shapes.shapes[j]);
+                let gap = (data.centres[i] - data.centres[j]).norm() - si.bounding_radius - sj.bounding_radius;
+                if gap > threshold.min(best) {
+                    continue;
+                }
+                best = best.min(signed_distance(&data.poses[i], &si.shape, &data.poses[j], &sj.shape));
+            }
+        }
+        if best < threshold {
+            out.close.push(PairDistance { a, b: Some(b), distance: best });
+        }
+    }
+    if let Some((z, plane)) = &data.floor {
+        let plane_pose = PPose::from_translation(Vector::new(0.0, 0.0, *z));
+        for (f, frame) in model.frames.iter().enumerate() {
+            if frame.body.is_none() || shapes.of_frame[f].is_empty() {
+                continue;
+            }
+            let mut best = f64::INFINITY;
+            for &i in &shapes.of_frame[f] {
+                let s = &shapes.shapes[i];
+                if data.centres[i].z - s.bounding_radius - z > threshold.min(best) {
+                    continue;
+                }
+                best = best.min(signed_distance(&plane_pose, plane, &data.poses[i], &s.shape));
+            }
+            if best < threshold {
+                out.close.push(PairDistance { a: f, b: None, distance: best });
+            }
+        }
+    }
+    out.close.sort_by(|x, y| x.distance.total_cmp(&y.distance));
+}

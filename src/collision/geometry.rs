@@ -1,0 +1,99 @@
+//! Each link's collision shapes, built once from the model's `<collision>` elements.
+
+use crate::model::{Geometry, Model};
+use parry3d_f64::math::Vector;
+use parry3d_f64::shape::SharedShape;
+use std::path::Path;
+
+/// One collision shape of a link: the link (a frame of the model), the shape's pose in the link's
+/// frame, the parry shape, and the radius of a sphere about its origin that bounds it (the broad
+/// phase).
+#[derive(Clone)]
+pub struct LinkShape {
+    pub frame: usize,
+    pub origin: crate::spatial::Pose,
+    pub shape: SharedShape,
+    pub bounding_radius: f64,
+    /// Where the bounding sphere's centre sits in the shape's frame.
+    pub bounding_centre: nalgebra::Vector3<f64>,
+}
+
+/// The collision shapes of a model, and the notices made building them.
+#[derive(Clone, Default)]
+pub struct CollisionModel {
+    pub shapes: Vec<LinkShape>,
+    /// Per frame, the indices of its shapes.
+    pub of_frame: Vec<Vec<usize>>,
+    /// The links left out of the checks, with why (a mesh format not read, a mesh that is empty).
+    pub left_out: Vec<String>,
+}
+
+fn parry_shape(geometry: &Geometry) -> Result<SharedShape, String> {
+    Ok(match geometry {
+        Geometry::Box { size } => SharedShape::cuboid(size[0] / 2.0, size[1] / 2.0, size[2] / 2.0),
+        // URDF's cylinders and capsules lie along z, parry's along y: turned in `shape_pose`
+        Geometry::Cylinder { radius, length } => SharedShape::cylinder(length / 2.0, *radius),
+        Geometry::Capsule { radius, length } => SharedShape::capsule_z(length / 2.0, *radius),
+        Geometry::Sphere { radius } => SharedShape::ball(*radius),
+        Geometry::Mesh { path, scale } => mesh(path, *scale)?,
+    })
+}
+
+/// An exact triangle mesh from an STL or OBJ file, scaled.
+fn mesh(path: &Path, scale: [f64; 3]) -> Result<SharedShape, String> {
+    let extension = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
+    let (vertices, indices): (Vec<[f64; 3]>, Vec<[u32; 3]>) = match extension.as_str() {
+        "stl" => {
+            let mut file = std::fs::File::open(path).map_err(|e| format!("{}: {e}", path.display()))?;
+            let m = stl_io::read_stl(&mut file).map_err(|e| format!("{}: {e}", path.display()))?;
+            (m.vertices.iter().map(|v| [v[0] as f64, v[1] as f64, v[2] as f64]).collect(), m.faces.iter().map(|f| f.vertices.map(|i| i as u32)).collect())
+        }
+        "obj" => {
+            let (models, _) = tobj::load_obj(path, &tobj::GPU_LOAD_OPTIONS).map_err(|e| format!("{}: {e}", path.display()))?;
+            let (mut vertices, mut indices) = (Vec::new(), Vec::new());
+            for m in models {
+                let base = vertices.len() as u32;
+                vertices.extend(m.mesh.positions.chunks(3).map(|p| [p[0] as f64, p[1] as f64, p[2] as f64]));
+                indices.extend(m.mesh.indices.chunks(3).map(|t| [base + t[0], base + t[1], base + t[2]]));
+            }
+            (vertices, indices)
+        }
+        other => return Err(format!("{}: a .{other} mesh is not read for collisions (STL and OBJ are)", path.display())),
+    };
+    let vertices: Vec<Vector> = vertices.iter().map(|v| Vector::new(v[0] * scale[0], v[1] * scale[1], v[2] * scale[2])).collect();
+    SharedShape::trimesh(vertices, indices).map_err(|e| format!("{}: {e:?}", path.display()))
+}
+
+/// URDF's cylinders lie along z; parry's along y: a quarter turn about x brings y onto z.
+fn shape_pose(geometry: &Geometry, origin: &crate::spatial::Pose) -> crate::spatial::Pose {
+    match geometry {
+        Geometry::Cylinder { .. } => origin.compose(&crate::spatial::Pose::new(crate::spatial::rotation_about_axis(&nalgebra::Vector3::x(), std::f64::consts::FRAC_PI_2), nalgebra::Vector3::zeros())),
+        _ => *origin,
+    }
+}
+
+impl CollisionModel {
+    /// The shapes of every link of `model` (a shape that cannot be read is left out, said once per link).
+    pub fn new(model: &Model) -> Self {
+        let mut out = CollisionModel { of_frame: vec![Vec::new(); model.frames.len()], ..Default::default() };
+        for (f, frame) in model.frames.iter().enumerate() {
+            for c in &frame.collisions {
+                match parry_shape(&c.geometry) {
+                    Ok(shape) => {
+                        let sphere = shape.compute_local_bounding_sphere();
+                        let centre = nalgebra::Vector3::new(sphere.center.x, sphere.center.y, sphere.center.z);
+                        out.of_frame[f].push(out.shapes.len());
+                        out.shapes.push(LinkShape { frame: f, origin: shape_pose(&c.geometry, &c.origin), shape, bounding_radius: sphere.radius, bounding_centre: centre });
+                    }
+                    Err(why) => out.left_out.push(format!("link '{}': {why}; left out of the collision checks", frame.name)),
+                }
+            }
+        }
+        out
+    }
+
+    /// Whether link (frame) `f` has any collision shape.
+    pub fn has_shapes(&self, f: usize) -> bool {
+        !self.of_frame[f].is_empty()
+    }
+}

@@ -1,0 +1,119 @@
+//! Collision checks (issue 23, the geometry and the distances): each link's `<collision>` shapes,
+//! the active pairs, and per state the distance of every pair closer than 5 cm (negative inside),
+//! against Pinocchio 4.1 + coal on the same shapes and pairs (tests/fixtures/collisions, made by its
+//! make_fixture.py; `.ci/collisions-vs-coal.py` does the same live on example-robot-data's robots).
+
+mod common;
+
+use armscope::collision::Collisions;
+use armscope::model::load_urdf;
+use serde_json::Value;
+
+/// At 40 random states of the box model (boxes) and of the SmallRobotArm mesh model (STL meshes):
+/// the same active pairs as the fixture's, and per pair the same answer as coal — the distance within
+/// 1e-6 m for boxes and 1e-5 m for meshes where both are apart and closer than 5 cm, in contact on
+/// both sides where coal finds contact, absent where coal measures more than 5 cm; pairs within 1 mm
+/// of touching may go either way.
+#[test]
+fn distances_are_coals_on_the_same_shapes_and_pairs() {
+    // (the mesh model's links never touch at these states: its contact cases are left to the CI check)
+    for (file, tolerance, min_contacts) in [("box_model.json", 1e-6, 1), ("smallrobotarm_meshes.json", 1e-5, 0)] {
+        let fixture: Value = serde_json::from_str(&std::fs::read_to_string(common::repo().join("tests/fixtures/collisions").join(file)).unwrap()).unwrap();
+        let model = load_urdf(&common::repo().join(fixture["urdf"].as_str().unwrap())).unwrap();
+        let c = Collisions::new(&model, None).unwrap();
+        let pairs: Vec<(String, String)> = c.pairs.iter().map(|&(a, b)| (model.frames[a].name.clone(), model.frames[b].name.clone())).collect();
+        let expected: Vec<(String, String)> = fixture["pairs"].as_array().unwrap().iter().map(|p| (p[0].as_str().unwrap().to_string(), p[1].as_str().unwrap().to_string())).collect();
+        assert_eq!(pairs, expected, "{file}: the active pairs");
+        let (mut compared, mut contacts) = (0, 0);
+        for state in fixture["states"].as_array().unwrap() {
+            let q: Vec<f64> = model.joints.iter().map(|j| state["q"][&j.name].as_f64().unwrap()).collect();
+            let ours = c.at(&model, &q, None, 0.05);
+            for ((a, b), coal) in expected.iter().zip(state["distances"].as_array().unwrap()) {
+                let coal = coal.as_f64().unwrap();
+                let mine = ours.iter().find(|(x, y, _)| x == a && y == b).map(|p| p.2);
+                if coal.abs() < 1e-3 || mine.is_some_and(|m| m.abs() < 1e-3) {
+                    continue;
+                }
+                match mine {
+                    None => assert!(coal > 0.05 - tolerance, "{file}: {a}–{b} at {q:?}: coal {coal}, armscope beyond 5 cm"),
+                    Some(m) if coal <= 0.0 => {
+                        assert!(m <= 0.0, "{file}: {a}–{b}: coal in contact ({coal}), armscope {m}");
+                        contacts += 1;
+                    }
+                    Some(m) => {
+                        assert!((m - coal).abs() <= tolerance, "{file}: {a}–{b}: coal {coal}, armscope {m}");
+                        compared += 1;
+                    }
+                }
+            }
+        }
+        assert!(compared >= 20 && contacts >= min_contacts, "{file}: {compared} distances and {contacts} contacts compared");
+    }
+}
+
+/// At the box model's zero pose (the arm level at 0.26 m, the carrier's box from 0.1 to 0.26 m), a
+/// floor at 0.2 m: the upper arm's box (0.23–0.29 m) is 0.03 m above it, the carrier's 0.1 m into it;
+/// the base, welded to the world, is not checked against it.
+#[test]
+fn a_floor_is_a_half_space_at_its_height() {
+    let model = load_urdf(&common::box_urdf()).unwrap();
+    let c = Collisions::new(&model, None).unwrap();
+    let close = c.at(&model, &[0.0; 6], Some(0.2), 0.05);
+    let floor = |link: &str| close.iter().find(|(a, b, _)| a == link && b == "floor").map(|p| p.2);
+    assert!((floor("upper_arm_link").unwrap() - 0.03).abs() < 1e-9, "{close:?}");
+    assert!((floor("carrier_link").unwrap() + 0.1).abs() < 1e-6, "{close:?}");
+    assert_eq!(floor("base_link"), None);
+}
+
+/// An SRDF's <disable_collisions> pairs are not checked, in either order; a malformed one gets one
+/// line naming the file and the line.
+#[test]
+fn an_srdf_disables_pairs_and_a_bad_one_is_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = load_urdf(&common::box_urdf()).unwrap();
+    let all = Collisions::new(&model, None).unwrap().pairs.len();
+    let srdf = dir.path().join("arm.srdf");
+    std::fs::write(&srdf, r#"<robot name="a"><disable_collisions link1="tool_link" link2="base_link" reason="Never"/><disable_collisions link1="nowhere" link2="base_link"/></robot>"#).unwrap();
+    let c = Collisions::new(&model, Some(&srdf)).unwrap();
+    assert_eq!(c.pairs.len(), all - 1);
+    assert!(!c.pairs.iter().any(|&(a, b)| [&model.frames[a].name, &model.frames[b].name] == ["base_link", "tool_link"]));
+    assert!(c.notices.iter().any(|n| n.contains("nowhere")), "an unknown link is said");
+    std::fs::write(&srdf, "<robot>\n<disable_collisions link1=\"tool_link\"/>\n</robot>").unwrap();
+    let e = Collisions::new(&model, Some(&srdf)).err().unwrap().to_string();
+    assert!(!e.contains('\n') && e.contains("arm.srdf") && e.contains("line 2") && e.contains("link2"), "{e}");
+}
+
+/// `run --floor Z`: the box model's default wave takes its tool below the base. With a floor at
+/// −0.2 m the run's first contact is the tool with the floor, at the first control step where the
+/// lowest corner of the tool's box (0.04 × 0.18 × 0.03 m about (0.02, 0, 0) in its link frame), put
+/// where the trace's joint angles place it, is at or below the floor — an independent reading of the
+/// same state — and the summary's deepest overlap is that corner's deepest.
+#[test]
+fn a_run_flags_the_floor_when_the_tool_reaches_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let (trace, summary) = (dir.path().join("trace.csv"), dir.path().join("summary.json"));
+    let code = common::armscope(&["run", "--quiet", "--floor", "-0.2", "--duration", "3", "--trace", trace.to_str().unwrap(), "--summary-json", summary.to_str().unwrap()]);
+    assert_eq!(code, 0);
+    let s: Value = serde_json::from_str(&std::fs::read_to_string(&summary).unwrap()).unwrap();
+    let c = &s["summary"]["collisions"];
+    let first = &c["first_contact"];
+    assert_eq!((first[1].as_str(), first[2].as_str()), (Some("tool_link"), Some("floor")), "{c}");
+    let model = load_urdf(&common::box_urdf()).unwrap();
+    let tool = model.frame_index("tool_link").unwrap();
+    let table = common::read_csv(&trace);
+    let mut data = armscope::dynamics::Data::new(&model);
+    let (mut first_below, mut deepest) = (None, 0.0f64);
+    for row in &table.rows {
+        let q: Vec<f64> = (1..=6).map(|i| row[table.col(&format!("q{i}"))]).collect();
+        armscope::dynamics::forward_kinematics(&model, &mut data, &q);
+        let pose = armscope::dynamics::frame_pose(&model, &data, tool);
+        let lowest = [-1.0, 1.0].iter().flat_map(|&x| [-1.0, 1.0].iter().flat_map(move |&y| [-1.0, 1.0].map(move |z| nalgebra::Vector3::new(0.02 + 0.02 * x, 0.09 * y, 0.015 * z)))).map(|p| pose.transform_point(&p).z).fold(f64::INFINITY, f64::min);
+        if lowest <= -0.2 && first_below.is_none() {
+            first_below = Some(row[table.col("t")]);
+        }
+        deepest = deepest.max(-0.2 - lowest);
+    }
+    assert_eq!(first[0].as_f64(), first_below, "the first contact is the first step the tool's lowest corner reaches the floor");
+    let tool_floor = c["pairs"].as_array().unwrap().iter().find(|p| p["link1"] == "tool_link" && p["link2"] == "floor").unwrap();
+    assert!((-tool_floor["closest"].as_f64().unwrap() - deepest).abs() < 1e-9, "deepest {deepest} vs {tool_floor}");
+}
