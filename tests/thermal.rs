@@ -147,3 +147,33 @@ fn the_summary_rates_each_drive_against_its_continuous_and_average_ratings() {
         }
     }
 }
+
+/// An open-loop stepper's driver sets its current whatever the load: a stepper with thermal data (a
+/// user's catalogue; none is published for the built-in ones) heats the same on the loaded shoulder
+/// (J2) as on the unloaded wrist roll (J6), and settles at the closed form with I the set current:
+/// T_amb + (R_th1 + R_th2)·I²·R(T), R per phase (the two microstepping phases' currents square to I²).
+#[test]
+fn a_stepper_heats_by_its_set_current_whatever_the_load() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = ThermalData { winding_to_housing: 2.0, housing_to_ambient: 6.0, winding_time_constant: 3.0, motor_time_constant: 20.0, resistance_25: 1.5, max_winding_temperature: 130.0 };
+    std::fs::write(
+        dir.path().join("mine.toml"),
+        format!(
+            "[hot_stepper]\nkind = \"stepper\"\nholding_torque = 0.4\nrotor_inertia = 5.4e-6\nstep_angle = 1.8\ncurrent = 1.7\ninductance = 2.8e-3\nsupply_voltage = 24\nterminal_resistance = {}\nthermal_resistance_winding_housing = {}\nthermal_resistance_housing_ambient = {}\nthermal_time_constant_winding = {}\nthermal_time_constant_motor = {}\nmax_winding_temperature = {}\n",
+            data.resistance_25, data.winding_to_housing, data.housing_to_ambient, data.winding_time_constant, data.motor_time_constant, data.max_winding_temperature
+        ),
+    )
+    .unwrap();
+    let motors = dir.path().join("motors.toml");
+    std::fs::write(&motors, "catalogue = \"mine.toml\"\nin_urdf = true\n[joints.J2]\nmotor = \"hot_stepper\"\ngear_ratio = 50\n[joints.J6]\nmotor = \"hot_stepper\"\ngear_ratio = 5\n").unwrap();
+    let summary_path = dir.path().join("s.json");
+    let (code, out) = run(&["run", "--quiet", "--urdf", box_urdf().to_str().unwrap(), "--motors", motors.to_str().unwrap(), "--drive", "pd", "--static", "--duration", "600", "--no-rrd", "--no-mcap", "--summary-json", summary_path.to_str().unwrap()]);
+    assert_eq!(code, 0, "{out}");
+    let root: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&summary_path).unwrap()).unwrap();
+    let w = &root["summary"]["winding"];
+    let (j2, j6) = (w[1]["peak_temperature"].as_f64().unwrap(), w[5]["peak_temperature"].as_f64().unwrap());
+    assert_eq!(j2, j6, "the same set current, the same heat, loaded or not");
+    let steady = data.steady_winding_temperature(1.7, AMBIENT_TEMPERATURE).unwrap();
+    // 600 s is 30 motor time constants (the coupled nodes and R(T) slow the rise beyond τ_s)
+    assert!((j2 - steady).abs() < 0.01, "{j2} vs the closed form {steady}");
+}

@@ -364,7 +364,8 @@ impl Fields<'_> {
         Ok(LossyGear { efficiency, backdrive_efficiency, breakaway_torque: self.non_negative(&format!("{prefix}breakaway_torque"))?, viscous: self.non_negative(&format!("{prefix}viscous"))? })
     }
 
-    /// The motor's thermal data: all of torque_constant, terminal_resistance (Ω at 25 °C),
+    /// The motor's thermal data: all of torque_constant (a stepper: its driver's `current`
+    /// instead), terminal_resistance (Ω at 25 °C, per phase for a stepper),
     /// thermal_resistance_winding_housing, thermal_resistance_housing_ambient (K/W),
     /// thermal_time_constant_winding, thermal_time_constant_motor (s) and max_winding_temperature
     /// (°C), or none of them (the motor is then not thermally checked).
@@ -383,8 +384,11 @@ impl Fields<'_> {
         if given.iter().all(|f| *f == "torque_constant") {
             return Ok(None);
         }
-        if let Some(missing) = FIELDS.iter().find(|f| !given.contains(f)) {
-            return Err(self.err(missing, &format!("is missing: a thermal model needs all of {}", FIELDS.join(", "))));
+        // an open-loop stepper's current is its driver's setting (`current`), not its torque's
+        let stepper = self.table.get("kind").and_then(Value::as_str) == Some("stepper");
+        let needed: Vec<&str> = if stepper { FIELDS[1..].iter().copied().chain(["current"]).collect() } else { FIELDS.to_vec() };
+        if let Some(missing) = needed.iter().find(|f| !self.table.contains_key(**f)) {
+            return Err(self.err(missing, &format!("is missing: a thermal model needs all of {}", needed.join(", "))));
         }
         let thermal = super::thermal::ThermalData {
             resistance_25: self.positive("terminal_resistance")?,
@@ -394,7 +398,12 @@ impl Fields<'_> {
             motor_time_constant: self.positive("thermal_time_constant_motor")?,
             max_winding_temperature: self.positive("max_winding_temperature")?,
         };
-        Ok(Some(super::thermal::WindingHeat { thermal, torque_constant: self.positive("torque_constant")? }))
+        if stepper {
+            // K_t only for the RMS torque's current where given; the losses follow the set current
+            let torque_constant = self.optional_positive("torque_constant")?.unwrap_or(f64::INFINITY);
+            return Ok(Some(super::thermal::WindingHeat { thermal, torque_constant, set_current: Some(self.positive("current")?) }));
+        }
+        Ok(Some(super::thermal::WindingHeat { thermal, torque_constant: self.positive("torque_constant")?, set_current: None }))
     }
 
     /// Where a joint's parts sit: `in_urdf = true` (or the file's), else `mount_link` with

@@ -76,8 +76,12 @@ impl ThermalData {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct WindingHeat {
     pub thermal: ThermalData,
-    /// N·m/A.
+    /// N·m/A (the current from the torque: I = τ/K_t).
     pub torque_constant: f64,
+    /// An open-loop stepper's driver current, A: it flows whatever the load (the two phases' sine
+    /// and cosine currents of a microstepping driver square to I² together, so the losses are
+    /// I²·R(T) with R per phase); None for a motor whose current follows its torque.
+    pub set_current: Option<f64>,
 }
 
 /// The ambient temperature of every run, °C (the datasheets' reference).
@@ -102,7 +106,7 @@ pub struct WindingSummary {
 /// Every joint's motor heat over a run: per joint with thermal data, its winding and housing.
 #[derive(Clone, Debug)]
 pub struct RunHeat {
-    motors: Vec<Option<(MotorHeat, f64)>>,
+    motors: Vec<Option<(MotorHeat, f64, Option<f64>)>>,
     /// Winding temperature per joint, °C (NaN for joints without thermal data).
     pub winding_temperature: Vec<f64>,
     peak: Vec<f64>,
@@ -113,7 +117,7 @@ pub struct RunHeat {
 impl RunHeat {
     /// Per joint: its motor's heat data and gear ratio N (the joint torque u is N·τ_motor).
     pub fn new(heat: &[Option<(WindingHeat, f64)>], dt: f64) -> Self {
-        let motors: Vec<_> = heat.iter().map(|h| h.map(|(w, ratio)| (MotorHeat::new(w.thermal, AMBIENT_TEMPERATURE, dt), w.torque_constant * ratio))).collect();
+        let motors: Vec<_> = heat.iter().map(|h| h.map(|(w, ratio)| (MotorHeat::new(w.thermal, AMBIENT_TEMPERATURE, dt), w.torque_constant * ratio, w.set_current))).collect();
         let winding_temperature = winding_temperature_of(&motors);
         let n = heat.len();
         Self { peak: winding_temperature_of(&motors), motors, winding_temperature, sum_squared_current: vec![0.0; n], steps: 0 }
@@ -128,8 +132,8 @@ impl RunHeat {
     pub fn step(&mut self, u: &[f64]) {
         self.steps += 1;
         for (i, motor) in self.motors.iter_mut().enumerate() {
-            let Some((heat, newton_metres_per_amp)) = motor else { continue };
-            let current = u[i].abs() / *newton_metres_per_amp;
+            let Some((heat, newton_metres_per_amp, set_current)) = motor else { continue };
+            let current = set_current.unwrap_or(u[i].abs() / *newton_metres_per_amp);
             self.sum_squared_current[i] += current * current;
             heat.step(current);
             self.winding_temperature[i] = heat.winding_temperature();
@@ -143,7 +147,7 @@ impl RunHeat {
             .iter()
             .enumerate()
             .map(|(i, motor)| {
-                let (heat, _) = motor.as_ref()?;
+                let (heat, _, _) = motor.as_ref()?;
                 let rms_current = (self.sum_squared_current[i] / self.steps.max(1) as f64).sqrt();
                 Some(WindingSummary {
                     peak_temperature: self.peak[i],
@@ -157,8 +161,8 @@ impl RunHeat {
     }
 }
 
-fn winding_temperature_of(motors: &[Option<(MotorHeat, f64)>]) -> Vec<f64> {
-    motors.iter().map(|m| m.as_ref().map_or(f64::NAN, |(m, _)| m.winding_temperature())).collect()
+fn winding_temperature_of(motors: &[Option<(MotorHeat, f64, Option<f64>)>]) -> Vec<f64> {
+    motors.iter().map(|m| m.as_ref().map_or(f64::NAN, |(m, _, _)| m.winding_temperature())).collect()
 }
 
 /// One motor's winding and housing temperatures over a run.

@@ -502,7 +502,8 @@ fn rate_duty(drive: &DriveTrain, motion: &Motion, j: usize, margin: f64, duty: f
         }
     }
     if let Some(heat) = drive.heat {
-        let current = need / heat.torque_constant;
+        // a stepper's driver current flows whatever the load (the margin is on torque, not on it)
+        let current = heat.set_current.unwrap_or(need / heat.torque_constant);
         let winding = crate::actuator::thermal::MotorHeat::new(heat.thermal, crate::actuator::thermal::AMBIENT_TEMPERATURE, 1.0);
         let thermal_share = match winding.time_to_limit(current) {
             Some(after) => {
