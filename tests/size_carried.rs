@@ -8,7 +8,7 @@ use serde_json::Value;
 use std::path::Path;
 
 fn size(out: &Path, urdf: &Path, extra: &[&str]) -> Value {
-    let args: Vec<String> = ["armscope", "size", "--urdf", urdf.to_str().unwrap(), "--payload", "0.2", "--out", out.to_str().unwrap()].iter().chain(extra).map(|s| s.to_string()).collect();
+    let args: Vec<String> = ["armscope", "size", "--urdf", urdf.to_str().unwrap(), "--out", out.to_str().unwrap()].iter().chain(extra).map(|s| s.to_string()).collect();
     assert_eq!(armscope::cli::main_with_args(args), 0, "a verified set");
     serde_json::from_str(&std::fs::read_to_string(out.join("size.json")).unwrap()).unwrap()
 }
@@ -18,7 +18,7 @@ fn chosen(report: &Value, j: usize) -> &Value {
     &joint["candidates"][joint["chosen"].as_u64().expect("a choice") as usize]
 }
 
-/// The SmallRobotArm mesh model, its default wave with 0.2 kg, from the whole catalogue: with the
+/// The SmallRobotArm mesh model, its default wave, from the whole catalogue: with the
 /// parts carried the shoulder (J2) needs more than without — its chosen drive has less torque to
 /// spare on the same motion — and the report's arm weighs its URDF plus the chosen parts. Writing
 /// the chosen parts into the URDF (`model --motors --urdf-out`) and sizing that with
