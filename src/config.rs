@@ -87,6 +87,8 @@ pub struct RunConfig {
     pub floor: Option<f64>,
     /// An SRDF whose disabled pairs are not checked (default: the one beside the URDF).
     pub srdf: Option<PathBuf>,
+    /// End the run at the first collision.
+    pub stop_on_collision: bool,
 }
 
 pub use crate::builtin::DEFAULT_URDF;
@@ -127,6 +129,7 @@ impl Default for RunConfig {
             collisions: false,
             floor: None,
             srdf: None,
+            stop_on_collision: false,
         }
     }
 }

@@ -83,15 +83,19 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
             previous_saturated[i] = saturated[i];
         }
         body_poses(model, &cmd, &mut command_poses);
+        let mut collided = None;
         if let (Some(c), Some((cd, state, log))) = (experiment.collisions.as_ref(), collision_check.as_mut()) {
             crate::collision::check_state(model, &c.shapes, &c.pairs, cd, |f| frame_pose(model, &data, f), COLLISION_BAND, state);
             log.record(model, t, state);
+            if experiment.config.stop_on_collision {
+                collided = state.colliding().next().map(|p| RunStatus::Collided { time: t, link1: model.frames[p.a].name.clone(), link2: p.b.map_or("floor".to_string(), |b| model.frames[b].name.clone()) });
+            }
         }
         let interrupted = stop.is_some_and(|s| s.load(Ordering::Relaxed));
         let sample = Sample {
             k,
             t,
-            is_final: k == experiment.steps || interrupted,
+            is_final: k == experiment.steps || interrupted || collided.is_some(),
             q: &q,
             v: &v,
             cmd: &cmd,
@@ -118,6 +122,8 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
         if sample.is_final {
             if interrupted {
                 status = RunStatus::Interrupted { time: t };
+            } else if let Some(c) = collided {
+                status = c;
             }
             break;
         }

@@ -11,6 +11,9 @@ pub enum RunStatus {
     Interrupted { time: f64 },
     /// The state became non-finite or absurd.
     Diverged { joint: String, time: f64, message: String },
+    /// Stopped at the first collision (`--stop-on-collision`): its time and the two links ("floor"
+    /// for the floor).
+    Collided { time: f64, link1: String, link2: String },
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]

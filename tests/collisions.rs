@@ -117,3 +117,20 @@ fn a_run_flags_the_floor_when_the_tool_reaches_it() {
     let tool_floor = c["pairs"].as_array().unwrap().iter().find(|p| p["link1"] == "tool_link" && p["link2"] == "floor").unwrap();
     assert!((-tool_floor["closest"].as_f64().unwrap() - deepest).abs() < 1e-9, "deepest {deepest} vs {tool_floor}");
 }
+
+/// `--stop-on-collision` ends the run at the first contact, exit code 4: the trace's last step is the
+/// first contact's time, which a run without the flag reports too; the summary says why it stopped.
+#[test]
+fn stop_on_collision_ends_the_run_at_the_first_contact() {
+    let dir = tempfile::tempdir().unwrap();
+    let (full, stopped, trace) = (dir.path().join("full.json"), dir.path().join("stopped.json"), dir.path().join("trace.csv"));
+    assert_eq!(common::armscope(&["run", "--quiet", "--floor", "-0.2", "--duration", "2", "--summary-json", full.to_str().unwrap()]), 0);
+    assert_eq!(common::armscope(&["run", "--quiet", "--floor", "-0.2", "--duration", "2", "--stop-on-collision", "--trace", trace.to_str().unwrap(), "--summary-json", stopped.to_str().unwrap()]), 4);
+    let read = |p: &std::path::Path| -> Value { serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap() };
+    let first = read(&full)["summary"]["collisions"]["first_contact"][0].as_f64().unwrap();
+    let status = &read(&stopped)["summary"]["status"];
+    assert_eq!((status["state"].as_str(), status["time"].as_f64()), (Some("collided"), Some(first)), "{status}");
+    assert_eq!((status["link1"].as_str(), status["link2"].as_str()), (Some("tool_link"), Some("floor")));
+    let t = common::read_csv(&trace).column("t");
+    assert_eq!(t.last().copied(), Some(first), "the trace ends at the contact");
+}

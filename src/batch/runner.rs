@@ -90,6 +90,7 @@ fn run_timed(e: &PlannedExperiment, dir: &Path, stop: Option<&AtomicBool>, serie
                 RunStatus::Completed => ("completed", None),
                 RunStatus::Interrupted { .. } => ("interrupted", None),
                 RunStatus::Diverged { message, .. } => ("diverged", Some(message.clone())),
+                RunStatus::Collided { time, link1, link2 } => ("collided", Some(format!("stopped at the first collision, t = {time:.3} s: {link1} with {link2}"))),
             };
             ExperimentOutcome { index: e.index, name: e.name.clone(), args: e.args.clone(), status: status.into(), summary: Some(summary), error, wall_time: 0.0 }
         }

@@ -94,6 +94,9 @@ pub struct RunArgs {
     /// by name). Implies --collisions.
     #[arg(long, value_name = "FILE")]
     pub srdf: Option<PathBuf>,
+    /// End the run at the first collision (whole files up to there; exit code 4). Implies --collisions.
+    #[arg(long)]
+    pub stop_on_collision: bool,
 
     /// Write the tutorial's CSV (t, q, tool xyz every --print-every).
     #[arg(long, value_name = "PATH")]
@@ -222,7 +225,8 @@ impl RunArgs {
             q0: self.q0.clone(),
             motors: self.motors.motors.clone(),
             drive: self.motors.drive,
-            collisions: self.collisions,
+            collisions: self.collisions || self.stop_on_collision,
+            stop_on_collision: self.stop_on_collision,
             floor: self.floor,
             srdf: self.srdf.clone(),
         }
@@ -284,6 +288,7 @@ pub fn run(args: &RunArgs) -> Result<i32, Error> {
     match summary.status {
         RunStatus::Diverged { message, .. } => Err(Error::Diverged(message)),
         RunStatus::Interrupted { .. } => Ok(130),
+        RunStatus::Collided { .. } => Ok(4),
         RunStatus::Completed => Ok(0),
     }
 }

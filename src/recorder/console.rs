@@ -137,6 +137,7 @@ pub fn write_summary(out: &mut dyn Write, s: &Summary) -> std::io::Result<()> {
         RunStatus::Completed => {}
         RunStatus::Interrupted { time } => writeln!(out, "INTERRUPTED at t = {time:.3} s: the summary covers the run up to there")?,
         RunStatus::Diverged { message, .. } => writeln!(out, "DIVERGED: {message}")?,
+        RunStatus::Collided { time, link1, link2 } => writeln!(out, "STOPPED at the first collision, t = {time:.3} s: {link1} with {link2} (--stop-on-collision); the summary covers the run up to there")?,
     }
     let speed = if s.wall_time > 0.0 { s.simulated_time / s.wall_time } else { f64::INFINITY };
     writeln!(
