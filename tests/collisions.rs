@@ -134,3 +134,24 @@ fn stop_on_collision_ends_the_run_at_the_first_contact() {
     let t = common::read_csv(&trace).column("t");
     assert_eq!(t.last().copied(), Some(first), "the trace ends at the contact");
 }
+
+/// `armscope trajectory` checks the IK path before writing it: the trajectory lab's circle on the box
+/// model touches nothing; with a floor at 0.2 m (inside the carrier's box, 0.1–0.26 m) every point is
+/// in contact, from t = 0, and the notice names the pair.
+#[test]
+fn the_trajectory_lab_checks_its_path() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = |extra: &[&str]| {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_armscope"))
+            .args(["trajectory", "circle", "--urdf", common::box_urdf().to_str().unwrap(), "--out", dir.path().join("circle").to_str().unwrap()])
+            .args(extra)
+            .output()
+            .unwrap();
+        assert!(out.status.success());
+        String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr)
+    };
+    let clear = run(&[]);
+    assert!(clear.contains("collisions: none (15 link pairs)"), "{clear}");
+    let floored = run(&["--floor", "0.2"]);
+    assert!(floored.contains("the path collides: first at t = 0.000 s, carrier_link with floor; 1001 of 1001 points in contact"), "{floored}");
+}

@@ -27,6 +27,12 @@ pub struct TrajectoryArgs {
     /// Output prefix: writes PREFIX.csv and PREFIX.npy (default: recordings/trajectory_SHAPE).
     #[arg(long, value_name = "PREFIX")]
     pub out: Option<PathBuf>,
+    /// Also check the path for a floor at this height (world z, m; self-collision is always checked).
+    #[arg(long, value_name = "Z", allow_negative_numbers = true)]
+    pub floor: Option<f64>,
+    /// An SRDF whose disabled pairs are not checked (default: the one beside the URDF).
+    #[arg(long, value_name = "FILE")]
+    pub srdf: Option<PathBuf>,
 }
 
 
@@ -67,6 +73,34 @@ pub fn trajectory(args: &TrajectoryArgs) -> Result<i32, Error> {
         text += "\n";
         flat.push(*t);
         flat.extend_from_slice(q);
+    }
+    // the path checked for collisions before it is written: each sample's pairs in contact
+    let collisions = crate::collision::Collisions::new(&model, args.srdf.as_deref())?;
+    for notice in &collisions.notices {
+        eprintln!("armscope: notice: {notice}");
+    }
+    let mut first: Option<(f64, String, String, f64)> = None;
+    let mut in_contact = 0;
+    let mut closest: Option<(f64, String, String, f64)> = None;
+    for (t, q) in times.iter().zip(&positions) {
+        let close = collisions.at(&model, q, args.floor, 0.05);
+        if let Some((a, b, d)) = close.first() {
+            if closest.as_ref().is_none_or(|c| *d < c.3) {
+                closest = Some((*t, a.clone(), b.clone(), *d));
+            }
+            if *d <= 0.0 {
+                in_contact += 1;
+                if first.is_none() {
+                    first = Some((*t, a.clone(), b.clone(), *d));
+                }
+            }
+        }
+    }
+    let floor = args.floor.map_or(String::new(), |z| format!(" and the floor at z = {z} m"));
+    match (&first, &closest) {
+        (Some((t, a, b, _)), _) => eprintln!("armscope: notice: the path collides: first at t = {t:.3} s, {a} with {b}; {in_contact} of {} points in contact ({} link pairs{floor} checked)", times.len(), collisions.pairs.len()),
+        (None, Some((t, a, b, d))) => println!("collisions: none ({} link pairs{floor}); closest {a} — {b}, {:.1} mm at t = {t:.3} s", collisions.pairs.len(), 1e3 * d),
+        (None, None) => println!("collisions: none ({} link pairs{floor}), none closer than 5 cm", collisions.pairs.len()),
     }
     std::fs::write(&csv, text).map_err(|e| Error::output(&csv, e))?;
     std::fs::write(&npy, crate::npy::write_f64(times.len(), n + 1, &flat)).map_err(|e| Error::output(&npy, e))?;
