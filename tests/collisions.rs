@@ -155,3 +155,30 @@ fn the_trajectory_lab_checks_its_path() {
     let floored = run(&["--floor", "0.2"]);
     assert!(floored.contains("the path collides: first at t = 0.000 s, carrier_link with floor; 1001 of 1001 points in contact"), "{floored}");
 }
+
+/// `model --srdf-out` writes what MoveIt's setup assistant computes: on the SmallRobotArm mesh model
+/// over 2000 random states, the active pairs never (or always) in contact, and the adjacent ones. A pair
+/// it calls "Never" is apart at every one of coal's fixture states too; loading the written SRDF
+/// leaves exactly the other active pairs.
+#[test]
+fn model_writes_the_srdf_of_pairs_that_never_touch() {
+    let dir = tempfile::tempdir().unwrap();
+    let urdf = common::repo().join("assets/smallrobotarm/smallrobotarm.urdf");
+    let srdf = dir.path().join("arm.srdf");
+    assert_eq!(common::armscope(&["model", "--urdf", urdf.to_str().unwrap(), "--srdf-out", srdf.to_str().unwrap(), "--samples", "2000"]), 0);
+    let text = std::fs::read_to_string(&srdf).unwrap();
+    let disabled = armscope::collision::srdf::disabled_pairs(&srdf).unwrap();
+    let never: Vec<&(String, String)> = disabled.iter().filter(|(a, b)| text.contains(&format!("link1=\"{a}\" link2=\"{b}\" reason=\"Never\""))).collect();
+    assert!(!never.is_empty(), "{text}");
+    let fixture: Value = serde_json::from_str(&std::fs::read_to_string(common::repo().join("tests/fixtures/collisions/smallrobotarm_meshes.json")).unwrap()).unwrap();
+    let pairs: Vec<(String, String)> = fixture["pairs"].as_array().unwrap().iter().map(|p| (p[0].as_str().unwrap().to_string(), p[1].as_str().unwrap().to_string())).collect();
+    for (a, b) in &never {
+        let i = pairs.iter().position(|(x, y)| x == a && y == b).expect("a Never pair is an active one");
+        assert!(fixture["states"].as_array().unwrap().iter().all(|s| s["distances"][i].as_f64().unwrap() > 0.0), "{a}–{b} touches at a fixture state");
+    }
+    let model = load_urdf(&urdf).unwrap();
+    let all = Collisions::new(&model, None).unwrap().pairs.len();
+    let kept = Collisions::new(&model, Some(&srdf)).unwrap().pairs.len();
+    let never_or_always = text.matches("reason=\"Never\"").count() + text.matches("reason=\"Always\"").count();
+    assert_eq!(kept, all - never_or_always);
+}

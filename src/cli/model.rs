@@ -31,6 +31,13 @@ pub struct ModelArgs {
     /// An SRDF whose <disable_collisions> pairs are not checked (default: the one beside the URDF).
     #[arg(long, value_name = "FILE")]
     pub srdf: Option<PathBuf>,
+    /// Write an SRDF of the active pairs that never (or always) touch over --samples random states,
+    /// and the adjacent ones, as MoveIt's setup assistant does (implies --collisions).
+    #[arg(long, value_name = "FILE")]
+    pub srdf_out: Option<PathBuf>,
+    /// Random states for --srdf-out.
+    #[arg(long, default_value_t = 10000)]
+    pub samples: usize,
 }
 
 
@@ -52,7 +59,7 @@ pub fn model(args: &ModelArgs) -> Result<i32, Error> {
             eprintln!("armscope: wrote {}", out.display());
         }
     }
-    let collisions = if args.collisions || args.srdf.is_some() {
+    let collisions = if args.collisions || args.srdf.is_some() || args.srdf_out.is_some() {
         let c = crate::collision::Collisions::new(&model, args.srdf.as_deref())?;
         for notice in &c.notices {
             eprintln!("armscope: notice: {notice}");
@@ -61,6 +68,12 @@ pub fn model(args: &ModelArgs) -> Result<i32, Error> {
     } else {
         None
     };
+    if let (Some(out), Some(c)) = (&args.srdf_out, &collisions) {
+        let text = crate::collision::srdf::sampled(&model, c, args.samples);
+        std::fs::write(out, &text).map_err(|e| Error::output(out, e))?;
+        eprintln!("armscope: wrote {}: {} of {} active pairs never or always in contact over {} states", out.display(), text.matches("reason=\"Never\"").count() + text.matches("reason=\"Always\"").count(), c.pairs.len(), args.samples);
+        return Ok(0);
+    }
     if let Some(path) = &args.states {
         let text = std::fs::read_to_string(path).map_err(|e| Error::flag("--states", format!("{}: {e}", path.display())))?;
         let states: Vec<crate::inspect::State> = serde_json::from_str(&text).map_err(|e| Error::flag("--states", format!("{}: {e}", path.display())))?;

@@ -28,3 +28,56 @@ pub fn beside(urdf: &Path) -> Option<std::path::PathBuf> {
     let name = Path::new(stem).with_extension("srdf");
     [dir.join(&name), dir.join("..").join("srdf").join(&name)].into_iter().find(|p| p.is_file())
 }
+
+/// What MoveIt's setup assistant computes for a robot without an SRDF: the active pairs that never
+/// touch over `samples` random states within the joint limits (reason "Never"), that always do
+/// (reason "Always"), and the adjacent ones (reason "Adjacent"), as an SRDF. Deterministic: the
+/// states come from a fixed seed.
+pub fn sampled(model: &crate::model::Model, collisions: &super::Collisions, samples: usize) -> String {
+    let mut seed = 0x9e37_79b9_7f4a_7c15_u64;
+    let mut uniform = || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let mut contacts = vec![0usize; collisions.pairs.len()];
+    let mut data = crate::dynamics::Data::new(model);
+    let mut cd = super::CollisionData::new(&collisions.shapes, None);
+    let mut state = super::StateCollisions::default();
+    for _ in 0..samples {
+        let q: Vec<f64> = model.joints.iter().map(|j| {
+            let (lo, hi) = (j.lower.max(-std::f64::consts::PI), j.upper.min(std::f64::consts::PI));
+            lo + (hi - lo) * uniform()
+        }).collect();
+        crate::dynamics::forward_kinematics(model, &mut data, &q);
+        // (a band of 1 nm: touching counts as contact, and nothing farther is measured)
+        super::check_state(model, &collisions.shapes, &collisions.pairs, &mut cd, |f| crate::dynamics::frame_pose(model, &data, f), 1e-9, &mut state);
+        for p in state.colliding() {
+            if let Some(i) = p.b.and_then(|b| collisions.pairs.iter().position(|&x| x == (p.a, b))) {
+                contacts[i] += 1;
+            }
+        }
+    }
+    let mut out = format!("<?xml version=\"1.0\"?>\n<!-- Written by armscope model (srdf-out): {samples} random states within the limits -->\n<robot name=\"{}\">\n", model.name);
+    for (&(a, b), &n) in collisions.pairs.iter().zip(&contacts) {
+        let reason = match n {
+            0 => "Never",
+            n if n == samples => "Always",
+            _ => continue,
+        };
+        out += &format!("  <disable_collisions link1=\"{}\" link2=\"{}\" reason=\"{reason}\"/>\n", model.frames[a].name, model.frames[b].name);
+    }
+    // the pairs the checks skip as adjacent, said as MoveIt says them
+    let shapes = &collisions.shapes;
+    let parent = |b: Option<usize>| b.and_then(|b| model.bodies[b].parent);
+    for a in 0..model.frames.len() {
+        for b in a + 1..model.frames.len() {
+            let (fa, fb) = (&model.frames[a], &model.frames[b]);
+            if shapes.has_shapes(a) && shapes.has_shapes(b) && fa.body != fb.body && (parent(fa.body) == fb.body && fa.body.is_some() || parent(fb.body) == fa.body && fb.body.is_some()) {
+                out += &format!("  <disable_collisions link1=\"{}\" link2=\"{}\" reason=\"Adjacent\"/>\n", fa.name, fb.name);
+            }
+        }
+    }
+    out + "</robot>\n"
+}
