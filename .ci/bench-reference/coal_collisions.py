@@ -1,3 +1,9 @@
+#!/usr/bin/env python3
+"""Pinocchio 4.1 + coal doing armscope's collision checks: the same active pairs (from the fixtures in
+tests/fixtures/collisions) on the box model and the SmallRobotArm mesh model, 64 random states within the
+limits, µs per state for computeDistances (every pair's exact distance) and computeCollisions (yes/no).
+Beside `cargo bench --bench collisions`. Run from the repository root with the corpus check's venv:
+    python .ci/bench-reference/coal_collisions.py"""
 import json, time, sys, numpy as np, pinocchio as pin
 for name, urdf in [("box", "assets/smallrobot_arm.urdf"), ("mesh", "assets/smallrobotarm/smallrobotarm.urdf")]:
     fx = json.load(open(f"tests/fixtures/collisions/{'box_model' if name=='box' else 'smallrobotarm_meshes'}.json"))
