@@ -207,9 +207,12 @@ impl SizeReport {
             let reduction = c.reduction.clone().unwrap_or_else(|| if c.ratio == 1.0 { "direct".into() } else { "ideal".into() });
             md += &format!("| {} | {} | {reduction} | {}{edge} | {:.3} | {:.2} | {} | {} | {sim} | {runner} |\n", js.joint, c.motor, ratio_text(c.ratio), c.mass_kg, c.torque_at_rest, times(c.torque_headroom), times(c.speed_headroom));
         }
+        if let Some((experiment, t, a, b)) = &self.collision {
+            md += &format!("\n**The motion collides**: {a} with {b} at t = {t:.2} s of '{experiment}' (its commanded path, checked every 10 ms): no valid sizing until the motion is changed.\n");
+        }
         md += &format!(
             "\n{} ({} simulation rounds, {} simulations).\n\nWhy not the nearest rejected candidates:\n\n",
-            if self.verified { "The chosen set passed its full simulation, every joint at once" } else { "**The chosen set did not pass its full simulation**" },
+            if self.verified { "The chosen set passed its full simulation, every joint at once" } else if self.collision.is_some() { "The set was simulated, but the motion collides" } else { "**The chosen set did not pass its full simulation**" },
             self.rounds,
             self.simulations
         );

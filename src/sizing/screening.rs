@@ -276,8 +276,13 @@ pub struct SizeReport {
     pub joints: Vec<JointSizing>,
     /// Simulation rounds until the chosen set passed together.
     pub rounds: usize,
-    /// The chosen set passed its full simulation on every motion.
+    /// The chosen set passed its full simulation on every motion (and the motion is free of
+    /// self-collision: a colliding motion is no valid sizing).
     pub verified: bool,
+    /// Where the commanded motion first brings two links into contact (experiment, time, links),
+    /// checked every 10 ms of the command; None: it never does.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub collision: Option<(String, f64, String, String)>,
     pub simulations: usize,
     /// The duty the thermal check used, s.
     pub duty_seconds: f64,
@@ -365,6 +370,25 @@ fn commanded_motion(request: &SizeRequest, model: &Model) -> Result<Motion, Erro
         });
     }
     Ok(motion)
+}
+
+/// The first self-collision along the commanded motions, checked every 10 ms of the command (the
+/// full runs follow it within their tracking error): (experiment, time, link, link).
+fn commanded_collision(request: &SizeRequest, model: &Model) -> Result<Option<(String, f64, String, String)>, Error> {
+    let collisions = crate::collision::Collisions::new(model, None)?;
+    for (name, config) in &request.motions {
+        let experiment = Experiment::with_model(RunConfig { motors: None, ..config.clone() }, model.clone())?;
+        let (mut q, mut qd) = (vec![0.0; model.dof()], vec![0.0; model.dof()]);
+        let steps = (config.duration / 0.01).ceil() as usize;
+        for k in 0..=steps {
+            let t = (k as f64 * 0.01).min(config.duration);
+            experiment.trajectory.sample(t, &mut q, &mut qd);
+            if let Some((a, b, _)) = collisions.at(model, &q, None, 1e-9).into_iter().find(|p| p.2 <= 0.0) {
+                return Ok(Some((name.clone(), t, a, b)));
+            }
+        }
+    }
+    Ok(None)
 }
 
 /// The drive train of `motor` behind the catalogue's `stages` (from the motor out, each at its
@@ -563,6 +587,7 @@ pub fn size(request: &SizeRequest) -> Result<SizeReport, Error> {
     // chosen beyond it (a motor sits on or before its own joint, so joint j carries those of k > j)
     let mut joints: Vec<JointSizing> = (0..n).map(|j| JointSizing { joint: model.joints[j].name.clone(), candidates: Vec::new(), ranked: Vec::new(), chosen: None, runner_up: None, simulated: Vec::new(), nearest_rejected: Vec::new(), rms_load_torque: 0.0, rms_acceleration: 0.0, lowest_rms: None, optimal_ratio: None, inertia_ratio_above: None }).collect();
     let mut motion = commanded_motion(request, model)?;
+    let collision = commanded_collision(request, model)?;
     let mut carried_so_far = 0.0;
     for j in (0..n).rev() {
         if request.carry_parts && model.is_actuated(j) {
@@ -786,7 +811,8 @@ pub fn size(request: &SizeRequest) -> Result<SizeReport, Error> {
         motors: request.motors.clone(),
         joints,
         rounds,
-        verified,
+        verified: verified && collision.is_none(),
+        collision,
         simulations,
         duty_seconds: duty,
         duty_unchecked: request
