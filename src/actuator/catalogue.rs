@@ -65,8 +65,17 @@ pub struct Catalogue {
     pub source: PathBuf,
 }
 
-/// The motor kinds.
-pub const MOTOR_KINDS: [&str; 3] = ["stepper", "servo", "dc"];
+/// A motor's thermal model, all or none (the torque constant first: it also serves alone, for the
+/// RMS current).
+const THERMAL_FIELDS: [&str; 7] = [
+    "torque_constant",
+    "terminal_resistance",
+    "thermal_resistance_winding_housing",
+    "thermal_resistance_housing_ambient",
+    "thermal_time_constant_winding",
+    "thermal_time_constant_motor",
+    "max_winding_temperature",
+];
 
 fn fail(file: &Path, message: String) -> Error {
     Error::flag("--motors", format!("{}: {message}", file.display()))
@@ -134,8 +143,7 @@ impl Catalogue {
 
     /// Whether reduction `reduction` can follow motor `motor` (see [`Reduction::fits`]).
     pub fn fits(&self, motor: &str, reduction: &str) -> bool {
-        let (Some(t), Some(r)) = (self.entries.get(motor), self.reductions.get(reduction)) else { return false };
-        r.fits(t.get("kind").and_then(Value::as_str).unwrap_or(""), t.get("frame").and_then(Value::as_str))
+        self.entries.contains_key(motor) && self.reductions.get(reduction).is_some_and(|r| r.fits(self.kind(motor), self.frame(motor)))
     }
 
     /// Where the entry's numbers come from (None: the user's own).
@@ -171,26 +179,7 @@ fn drive_train_from(source: &Path, name: &str, t: &toml::Table) -> Result<DriveT
     let (gear_ratio, rated) = (fields.optional_positive("gearbox_ratio")?.unwrap_or(1.0), fields.optional_positive("gearbox_rated_torque")?.unwrap_or(f64::INFINITY));
     let gear = fields.gear("gearbox_")?;
     let heat = fields.heat()?;
-    let common = [
-        "kind",
-        "gearbox_ratio",
-        "gearbox_efficiency",
-        "gearbox_backdrive_efficiency",
-        "gearbox_breakaway_torque",
-        "gearbox_viscous",
-        "gearbox_rated_torque",
-        "rotor_inertia",
-        "source",
-        "torque_constant",
-        "terminal_resistance",
-        "thermal_resistance_winding_housing",
-        "thermal_resistance_housing_ambient",
-        "thermal_time_constant_winding",
-        "thermal_time_constant_motor",
-        "max_winding_temperature",
-        "sources",
-        "length",
-    ];
+    let common = [&["kind", "gearbox_ratio", "gearbox_efficiency", "gearbox_backdrive_efficiency", "gearbox_breakaway_torque", "gearbox_viscous", "gearbox_rated_torque", "rotor_inertia", "source", "sources", "length"][..], &THERMAL_FIELDS[..]].concat();
     fields.sources()?;
     let motor: Box<dyn Motor> = match kind.as_str() {
         "stepper" => {
@@ -370,23 +359,14 @@ impl Fields<'_> {
     /// thermal_time_constant_winding, thermal_time_constant_motor (s) and max_winding_temperature
     /// (°C), or none of them (the motor is then not thermally checked).
     fn heat(&self) -> Result<Option<super::thermal::WindingHeat>, Error> {
-        const FIELDS: [&str; 7] = [
-            "torque_constant",
-            "terminal_resistance",
-            "thermal_resistance_winding_housing",
-            "thermal_resistance_housing_ambient",
-            "thermal_time_constant_winding",
-            "thermal_time_constant_motor",
-            "max_winding_temperature",
-        ];
-        let given: Vec<&str> = FIELDS.iter().copied().filter(|f| self.table.contains_key(*f)).collect();
+        let given: Vec<&str> = THERMAL_FIELDS.iter().copied().filter(|f| self.table.contains_key(*f)).collect();
         // the torque constant alone is no thermal model (it also serves the RMS current)
         if given.iter().all(|f| *f == "torque_constant") {
             return Ok(None);
         }
         // an open-loop stepper's current is its driver's setting (`current`), not its torque's
         let stepper = self.table.get("kind").and_then(Value::as_str) == Some("stepper");
-        let needed: Vec<&str> = if stepper { FIELDS[1..].iter().copied().chain(["current"]).collect() } else { FIELDS.to_vec() };
+        let needed: Vec<&str> = if stepper { THERMAL_FIELDS[1..].iter().copied().chain(["current"]).collect() } else { THERMAL_FIELDS.to_vec() };
         if let Some(missing) = needed.iter().find(|f| !self.table.contains_key(**f)) {
             return Err(self.err(missing, &format!("is missing: a thermal model needs all of {}", needed.join(", "))));
         }
