@@ -55,13 +55,7 @@ impl JointSizing {
         if simulated > c.share {
             return "peak torque in the full run";
         }
-        match c.binding.as_deref() {
-            Some("gearbox average torque") => "gearbox average torque",
-            Some("RMS torque") => "RMS torque",
-            Some("winding temperature over the duty") => "winding temperature over the duty",
-            Some("reduction input speed") => "reduction input speed",
-            _ => "peak torque on the curve",
-        }
+        c.binding.unwrap_or("peak torque on the curve")
     }
 
     fn candidate(&self, c: Option<usize>) -> Option<&Candidate> {

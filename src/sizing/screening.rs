@@ -211,7 +211,7 @@ pub struct Candidate {
     pub continuous_torque: Option<f64>,
     /// The check its share comes from, where not the peak torque on the curve.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub binding: Option<String>,
+    pub binding: Option<&'static str>,
 }
 
 impl Candidate {
@@ -495,7 +495,7 @@ fn rate(drive: &DriveTrain, motion: &Motion, j: usize, margin: f64) -> (f64, f64
 /// against its continuous rating, and with thermal data, the winding at that RMS current (through
 /// K_t) against its limit over `duty` seconds from ambient. Returns the larger share (≤ 1 passes)
 /// and why it fails.
-fn rate_duty(drive: &DriveTrain, motion: &Motion, j: usize, margin: f64, duty: f64) -> (f64, Option<Shortfall>, &'static str) {
+fn rate_duty(drive: &DriveTrain, motion: &Motion, j: usize, margin: f64, duty: f64, rms_motor_torque: f64) -> (f64, Option<Shortfall>, &'static str) {
     let reflected = drive.reflected_inertia();
     let samples = motion.t.len().max(1) as f64;
     // the gearbox makers' average torque: the cubic mean at the output (Harmonic Drive's T_av)
@@ -509,15 +509,7 @@ fn rate_duty(drive: &DriveTrain, motion: &Motion, j: usize, margin: f64, duty: f
     if drive.continuous_torque.is_none() && drive.heat.is_none() {
         return (gearbox_share, gearbox_shortfall, AVERAGE);
     }
-    let mean_square: f64 = (0..motion.t.len())
-        .map(|i| {
-            let torque = motion.torque[j][i] + reflected * motion.acceleration[j][i];
-            // at the motor's shaft: through the gear's losses, over the ratio
-            (drive.gear.motor_torque_for(torque, motion.speed[j][i]) / drive.gear_ratio).powi(2)
-        })
-        .sum::<f64>()
-        / samples;
-    let need = (1.0 + margin) * mean_square.sqrt();
+    let need = (1.0 + margin) * rms_motor_torque;
     let (mut share, mut shortfall, mut binding) = (0.0f64, None, "RMS torque");
     if let Some(continuous) = drive.continuous_torque {
         share = need / continuous;
@@ -552,7 +544,8 @@ fn rate_duty(drive: &DriveTrain, motion: &Motion, j: usize, margin: f64, duty: f
     (share, shortfall.or(gearbox_shortfall), binding)
 }
 
-/// The motor's RMS torque at its shaft over joint `j`'s motion, without margin.
+/// The motor's RMS torque at its shaft over joint `j`'s motion — through the gear's losses, over the
+/// ratio — without margin.
 fn rms_motor_torque(drive: &DriveTrain, motion: &Motion, j: usize) -> f64 {
     let reflected = drive.reflected_inertia();
     let samples = motion.t.len().max(1) as f64;
@@ -605,6 +598,7 @@ pub fn size(request: &SizeRequest) -> Result<SizeReport, Error> {
         let mut candidates = Vec::new();
         if model.is_actuated(j) {
             let options = options(request, j);
+            let top_speed = motion.speed[j].iter().fold(0.0f64, |a, v| a.max(v.abs()));
             for motor in &request.motors {
                 let motor_mass = request.catalogue.mass(motor).unwrap_or(f64::NAN);
                 for option in &options {
@@ -618,17 +612,17 @@ pub fn size(request: &SizeRequest) -> Result<SizeReport, Error> {
                     let drive = drive_train(&request.catalogue, motor, &option.stages, ratio, request.efficiency)?;
                     let margin = request.margin_for(motor);
                     let (peak_share, torque_headroom, speed_headroom, peak_shortfall) = rate(&drive, &motion, j, margin);
-                    let (duty_share, duty_shortfall, duty_binding) = rate_duty(&drive, &motion, j, margin, duty);
+                    let rms_motor_torque = rms_motor_torque(&drive, &motion, j);
+                    let (duty_share, duty_shortfall, duty_binding) = rate_duty(&drive, &motion, j, margin, duty, rms_motor_torque);
                     let binding = if duty_share > peak_share {
-                        Some(duty_binding.to_string())
-                    } else if matches!(peak_shortfall, Some(Shortfall::InputSpeed { .. })) || drive.max_motor_speed.is_some_and(|w| (1.0 + margin) * drive.gear_ratio * motion.speed[j].iter().fold(0.0f64, |a, v| a.max(v.abs())) >= peak_share * w) {
-                        Some("reduction input speed".to_string())
+                        Some(duty_binding)
+                    } else if matches!(peak_shortfall, Some(Shortfall::InputSpeed { .. })) || drive.max_motor_speed.is_some_and(|w| (1.0 + margin) * drive.gear_ratio * top_speed >= peak_share * w) {
+                        Some("reduction input speed")
                     } else {
                         None
                     };
                     let reflected = drive.reflected_inertia();
                     let inertia_ratio = (reflected > 0.0).then(|| motion.load_inertia[j] / reflected);
-                    let rms_motor_torque = rms_motor_torque(&drive, &motion, j);
                     let share = peak_share.max(duty_share);
                     let shortfall = peak_shortfall.or(duty_shortfall);
                     candidates.push(Candidate { motor: motor.clone(), reduction, stages: option.stages.clone(), mass_kg, ratio, total_ratio: drive.gear_ratio, torque_at_rest: drive.torque_limit(0.0), share, torque_headroom, speed_headroom, shortfall, margin, rms_motor_torque, inertia_ratio, binding, continuous_torque: drive.continuous_torque });
