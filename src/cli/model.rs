@@ -80,9 +80,11 @@ pub fn model(args: &ModelArgs) -> Result<i32, Error> {
         let mut out = crate::inspect::dynamics_at(&model, &states)?;
         if let Some(c) = &collisions {
             out["collision_pairs"] = serde_json::json!(c.pairs.iter().map(|&(a, b)| [&model.frames[a].name, &model.frames[b].name]).collect::<Vec<_>>());
+            let mut checker = c.checker(&model, None);
             for (s, json) in states.iter().zip(out["states"].as_array_mut().into_iter().flatten()) {
                 let q: Vec<f64> = model.joints.iter().map(|j| s.q.get(&j.name).copied().unwrap_or(0.0)).collect();
-                json["collisions"] = serde_json::json!(c.at(&model, &q, None, 0.05).into_iter().map(|(a, b, d)| serde_json::json!({"link1": a, "link2": b, "distance": d})).collect::<Vec<_>>());
+                checker.check(&q, 0.05);
+                json["collisions"] = serde_json::json!(checker.named().into_iter().map(|(a, b, d)| serde_json::json!({"link1": a, "link2": b, "distance": d})).collect::<Vec<_>>());
             }
         }
         println!("{out}");

@@ -82,8 +82,10 @@ pub fn trajectory(args: &TrajectoryArgs) -> Result<i32, Error> {
     let mut first: Option<(f64, String, String, f64)> = None;
     let mut in_contact = 0;
     let mut closest: Option<(f64, String, String, f64)> = None;
+    let mut checker = collisions.checker(&model, args.floor);
     for (t, q) in times.iter().zip(&positions) {
-        let close = collisions.at(&model, q, args.floor, 0.05);
+        checker.check(q, 0.05);
+        let close = checker.named();
         if let Some((a, b, d)) = close.first() {
             if closest.as_ref().is_none_or(|c| *d < c.3) {
                 closest = Some((*t, a.clone(), b.clone(), *d));

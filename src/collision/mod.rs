@@ -50,14 +50,42 @@ impl Collisions {
         Ok(Self { shapes, pairs, notices })
     }
 
+    /// A checker of states of `model` one after another, with a floor at `floor` if any (its
+    /// workspaces made once).
+    pub fn checker<'a>(&'a self, model: &'a Model, floor: Option<f64>) -> Checker<'a> {
+        Checker { model, collisions: self, data: crate::dynamics::Data::new(model), shapes: CollisionData::new(&self.shapes, floor), state: StateCollisions::default() }
+    }
+
     /// The pairs closer than `threshold` (m) at joint positions `q`, with a floor at `floor` if any:
     /// (link, link or "floor", distance), nearest first.
     pub fn at(&self, model: &Model, q: &[f64], floor: Option<f64>, threshold: f64) -> Vec<(String, String, f64)> {
-        let mut data = crate::dynamics::Data::new(model);
-        crate::dynamics::forward_kinematics(model, &mut data, q);
-        let mut cd = CollisionData::new(&self.shapes, floor);
-        let mut out = StateCollisions::default();
-        check_state(model, &self.shapes, &self.pairs, &mut cd, |f| crate::dynamics::frame_pose(model, &data, f), threshold, &mut out);
-        out.close.iter().map(|p| (model.frames[p.a].name.clone(), p.b.map_or("floor".to_string(), |b| model.frames[b].name.clone()), p.distance)).collect()
+        let mut checker = self.checker(model, floor);
+        checker.check(q, threshold);
+        checker.named()
+    }
+}
+
+/// Checks joint positions one after another (a path, sampled states) for their collisions.
+pub struct Checker<'a> {
+    model: &'a Model,
+    collisions: &'a Collisions,
+    data: crate::dynamics::Data,
+    shapes: CollisionData,
+    state: StateCollisions,
+}
+
+impl Checker<'_> {
+    /// The pairs closer than `threshold` (m) at joint positions `q`, nearest first.
+    pub fn check(&mut self, q: &[f64], threshold: f64) -> &StateCollisions {
+        let (model, data) = (self.model, &mut self.data);
+        crate::dynamics::forward_kinematics(model, data, q);
+        check_state(model, &self.collisions.shapes, &self.collisions.pairs, &mut self.shapes, |f| crate::dynamics::frame_pose(model, data, f), threshold, &mut self.state);
+        &self.state
+    }
+
+    /// The last check's pairs by name: (link, link or "floor", distance), nearest first.
+    pub fn named(&self) -> Vec<(String, String, f64)> {
+        let frames = &self.model.frames;
+        self.state.close.iter().map(|p| (frames[p.a].name.clone(), p.b.map_or("floor".to_string(), |b| frames[b].name.clone()), p.distance)).collect()
     }
 }

@@ -42,18 +42,14 @@ pub fn sampled(model: &crate::model::Model, collisions: &super::Collisions, samp
         (seed >> 11) as f64 / (1u64 << 53) as f64
     };
     let mut contacts = vec![0usize; collisions.pairs.len()];
-    let mut data = crate::dynamics::Data::new(model);
-    let mut cd = super::CollisionData::new(&collisions.shapes, None);
-    let mut state = super::StateCollisions::default();
+    let mut checker = collisions.checker(model, None);
     for _ in 0..samples {
         let q: Vec<f64> = model.joints.iter().map(|j| {
             let (lo, hi) = (j.lower.max(-std::f64::consts::PI), j.upper.min(std::f64::consts::PI));
             lo + (hi - lo) * uniform()
         }).collect();
-        crate::dynamics::forward_kinematics(model, &mut data, &q);
         // (a band of 1 nm: touching counts as contact, and nothing farther is measured)
-        super::check_state(model, &collisions.shapes, &collisions.pairs, &mut cd, |f| crate::dynamics::frame_pose(model, &data, f), 1e-9, &mut state);
-        for p in state.colliding() {
+        for p in checker.check(&q, 1e-9).colliding() {
             if let Some(i) = p.b.and_then(|b| collisions.pairs.iter().position(|&x| x == (p.a, b))) {
                 contacts[i] += 1;
             }
@@ -70,11 +66,10 @@ pub fn sampled(model: &crate::model::Model, collisions: &super::Collisions, samp
     }
     // the pairs the checks skip as adjacent, said as MoveIt says them
     let shapes = &collisions.shapes;
-    let parent = |b: Option<usize>| b.and_then(|b| model.bodies[b].parent);
     for a in 0..model.frames.len() {
         for b in a + 1..model.frames.len() {
             let (fa, fb) = (&model.frames[a], &model.frames[b]);
-            if shapes.has_shapes(a) && shapes.has_shapes(b) && fa.body != fb.body && (parent(fa.body) == fb.body && fa.body.is_some() || parent(fb.body) == fa.body && fb.body.is_some()) {
+            if shapes.has_shapes(a) && shapes.has_shapes(b) && super::pairs::joined(model, fa.body, fb.body) {
                 out += &format!("  <disable_collisions link1=\"{}\" link2=\"{}\" reason=\"Adjacent\"/>\n", fa.name, fb.name);
             }
         }

@@ -376,6 +376,7 @@ fn commanded_motion(request: &SizeRequest, model: &Model) -> Result<Motion, Erro
 /// full runs follow it within their tracking error): (experiment, time, link, link).
 fn commanded_collision(request: &SizeRequest, model: &Model) -> Result<Option<(String, f64, String, String)>, Error> {
     let collisions = crate::collision::Collisions::new(model, None)?;
+    let mut checker = collisions.checker(model, None);
     for (name, config) in &request.motions {
         let experiment = Experiment::with_model(RunConfig { motors: None, ..config.clone() }, model.clone())?;
         let (mut q, mut qd) = (vec![0.0; model.dof()], vec![0.0; model.dof()]);
@@ -383,7 +384,8 @@ fn commanded_collision(request: &SizeRequest, model: &Model) -> Result<Option<(S
         for k in 0..=steps {
             let t = (k as f64 * 0.01).min(config.duration);
             experiment.trajectory.sample(t, &mut q, &mut qd);
-            if let Some((a, b, _)) = collisions.at(model, &q, None, 1e-9).into_iter().find(|p| p.2 <= 0.0) {
+            if checker.check(&q, 1e-9).colliding().next().is_some() {
+                let (a, b, _) = checker.named().swap_remove(0);
                 return Ok(Some((name.clone(), t, a, b)));
             }
         }
