@@ -113,7 +113,7 @@ impl Experiment {
         let mut config = config;
         if config.floor.is_some_and(f64::is_nan) {
             // at the base: the world height of the link the first joint hangs from
-            let base = model.frames.iter().find(|f| f.body.is_none() && model.frames.iter().any(|c| c.parent_frame.is_some_and(|p| std::ptr::eq(&model.frames[p], *f)) && c.body == Some(0)));
+            let base = (!model.bodies.is_empty()).then(|| model.parent_link(0)).flatten().map(|f| &model.frames[f]);
             let z = base.map_or(0.0, |f| f.placement.translation.z);
             model.notices.push(format!("--floor: at the base's height, z = {z} m (of '{}')", base.map_or("the world", |f| f.name.as_str())));
             config.floor = Some(z);

@@ -56,14 +56,12 @@ pub fn placed_parts(model: &Model, motors: &MotorSet) -> Result<Vec<PlacedPart>,
         if mount == Mount::InUrdf {
             continue;
         }
-        let body = &model.bodies[body_of(model, joint)];
+        let b = body_of(model, joint);
+        let body = &model.bodies[b];
         for part in &drive.parts {
             let placed = match &mount {
                 Mount::AtJoint => {
-                    // the joint frame in the parent body's frame; the parent link is the frame of the
-                    // body the joint hangs from whose placement composes with the joint's
-                    let parent_frame = model.frames.iter().position(|f| f.name == body.child_link).and_then(|f| model.frames[f].parent_frame);
-                    let (link, link_in_body) = match parent_frame {
+                    let (link, link_in_body) = match model.parent_link(b) {
                         Some(f) => (model.frames[f].name.clone(), model.frames[f].placement),
                         None => (String::new(), Pose::identity()),
                     };

@@ -191,6 +191,11 @@ impl Model {
         self.frames.iter().position(|f| f.name == name)
     }
 
+    /// The frame of the link body `body`'s joint hangs from (its URDF parent link).
+    pub fn parent_link(&self, body: usize) -> Option<usize> {
+        self.frame_index(&self.bodies[body].child_link).and_then(|f| self.frames[f].parent_frame)
+    }
+
     /// Give the model its motors (sorted by joint) and the reflected inertias they bring to M's
     /// diagonal: the one place `armature` is derived from `actuators`.
     pub fn set_actuators(&mut self, mut actuators: Vec<Actuator>) {
