@@ -12,12 +12,7 @@ import pinocchio as pin
 
 armscope = os.path.abspath(sys.argv[1])
 repo = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-def find_robots():
-    for p in sys.path:
-        d = os.path.join(p, "cmeel.prefix", "share", "example-robot-data", "robots")
-        if os.path.isdir(d):
-            return d
-    sys.exit("collisions-vs-coal: example-robot-data not found")
+from example_robots import robots_dir as find_robots
 robots_dir = find_robots()
 def erd(rel):
     p = os.path.join(robots_dir, rel)

@@ -12,6 +12,7 @@ joint after the 2 s settling.
 Run by .ci/run in a venv with pin and example-robot-data installed:
     corpus-check.py ARMSCOPE_BINARY [--tolerance 1e-9]
 """
+from example_robots import robots_dir
 import argparse
 import json
 import os
@@ -43,15 +44,6 @@ ROBOTS = {
 }
 # robots armscope does not load yet, with a word of the reason its error gives
 KNOWN_UNSUPPORTED = {}
-
-
-def robots_dir():
-    import cmeel  # noqa: F401  (example-robot-data is a cmeel package)
-    for p in sys.path:
-        d = os.path.join(p, "cmeel.prefix", "share", "example-robot-data", "robots")
-        if os.path.isdir(d):
-            return d
-    sys.exit("example-robot-data not found")
 
 
 def independent_joints(model, fallback):
