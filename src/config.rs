@@ -87,6 +87,8 @@ pub struct RunConfig {
     pub floor: Option<f64>,
     /// An SRDF whose disabled pairs are not checked (default: the one beside the URDF).
     pub srdf: Option<PathBuf>,
+    /// A scene file: fixed objects in the world, a floor, the payload's shape (`collision::scene`).
+    pub scene: Option<PathBuf>,
     /// End the run at the first collision.
     pub stop_on_collision: bool,
 }
@@ -129,6 +131,7 @@ impl Default for RunConfig {
             collisions: false,
             floor: None,
             srdf: None,
+            scene: None,
             stop_on_collision: false,
         }
     }

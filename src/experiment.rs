@@ -100,17 +100,10 @@ impl Experiment {
         weight_notices(&mut model, &start);
         let gains = gains(&config, &model, &start, trajectory.as_ref(), &plant)?;
         let steps = (config.duration / config.dt - 1e-9).ceil() as usize;
-        let collisions = if config.collisions || config.floor.is_some() || config.srdf.is_some() {
-            let c = crate::collision::Collisions::new(&model, config.srdf.as_deref())?;
-            model.notices.extend(c.notices.iter().cloned());
-            if let Some(z) = config.floor.filter(|z| z.is_infinite()) {
-                return Err(Error::flag("--floor", format!("must be a height in m (got {z})")));
-            }
-            Some(Arc::new(c))
-        } else {
-            None
-        };
         let mut config = config;
+        if let Some(z) = config.floor.filter(|z| z.is_infinite()) {
+            return Err(Error::flag("--floor", format!("must be a height in m (got {z})")));
+        }
         if config.floor.is_some_and(f64::is_nan) {
             // at the base: the world height of the link the first joint hangs from
             let base = (!model.bodies.is_empty()).then(|| model.parent_link(0)).flatten().map(|f| &model.frames[f]);
@@ -118,6 +111,15 @@ impl Experiment {
             model.notices.push(format!("--floor: at the base's height, z = {z} m (of '{}')", base.map_or("the world", |f| f.name.as_str())));
             config.floor = Some(z);
         }
+        let collisions = if config.collisions || config.floor.is_some() || config.srdf.is_some() || config.scene.is_some() {
+            let (scene, notice) = crate::collision::Scene::from_flags(config.scene.as_deref(), config.floor)?;
+            model.notices.extend(notice);
+            let c = crate::collision::Collisions::new(&model, config.srdf.as_deref(), &scene)?;
+            model.notices.extend(c.notices.iter().cloned());
+            Some(Arc::new(c))
+        } else {
+            None
+        };
         Ok(Self { config, model: Arc::new(model), gains, plant, trajectory, steps, start, motors, steppers, collisions })
     }
 

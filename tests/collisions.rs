@@ -20,14 +20,14 @@ fn distances_are_coals_on_the_same_shapes_and_pairs() {
     for (file, tolerance, min_contacts) in [("box_model.json", 1e-6, 1), ("smallrobotarm_meshes.json", 1e-5, 0)] {
         let fixture: Value = serde_json::from_str(&std::fs::read_to_string(common::repo().join("tests/fixtures/collisions").join(file)).unwrap()).unwrap();
         let model = load_urdf(&common::repo().join(fixture["urdf"].as_str().unwrap())).unwrap();
-        let c = Collisions::new(&model, None).unwrap();
+        let c = Collisions::new(&model, None, &Default::default()).unwrap();
         let pairs: Vec<(String, String)> = c.pairs.iter().map(|&(a, b)| (model.frames[a].name.clone(), model.frames[b].name.clone())).collect();
         let expected: Vec<(String, String)> = fixture["pairs"].as_array().unwrap().iter().map(|p| (p[0].as_str().unwrap().to_string(), p[1].as_str().unwrap().to_string())).collect();
         assert_eq!(pairs, expected, "{file}: the active pairs");
         let (mut compared, mut contacts) = (0, 0);
         for state in fixture["states"].as_array().unwrap() {
             let q: Vec<f64> = model.joints.iter().map(|j| state["q"][&j.name].as_f64().unwrap()).collect();
-            let ours = c.at(&model, &q, None, 0.05);
+            let ours = c.at(&model, &q, 0.05);
             for ((a, b), coal) in expected.iter().zip(state["distances"].as_array().unwrap()) {
                 let coal = coal.as_f64().unwrap();
                 let mine = ours.iter().find(|(x, y, _)| x == a && y == b).map(|p| p.2);
@@ -57,8 +57,9 @@ fn distances_are_coals_on_the_same_shapes_and_pairs() {
 #[test]
 fn a_floor_is_a_half_space_at_its_height() {
     let model = load_urdf(&common::box_urdf()).unwrap();
-    let c = Collisions::new(&model, None).unwrap();
-    let close = c.at(&model, &[0.0; 6], Some(0.2), 0.05);
+    let scene = armscope::collision::Scene { floor: Some(0.2), ..Default::default() };
+    let c = Collisions::new(&model, None, &scene).unwrap();
+    let close = c.at(&model, &[0.0; 6], 0.05);
     let floor = |link: &str| close.iter().find(|(a, b, _)| a == link && b == "floor").map(|p| p.2);
     assert!((floor("upper_arm_link").unwrap() - 0.03).abs() < 1e-9, "{close:?}");
     assert!((floor("carrier_link").unwrap() + 0.1).abs() < 1e-6, "{close:?}");
@@ -71,15 +72,15 @@ fn a_floor_is_a_half_space_at_its_height() {
 fn an_srdf_disables_pairs_and_a_bad_one_is_named() {
     let dir = tempfile::tempdir().unwrap();
     let model = load_urdf(&common::box_urdf()).unwrap();
-    let all = Collisions::new(&model, None).unwrap().pairs.len();
+    let all = Collisions::new(&model, None, &Default::default()).unwrap().pairs.len();
     let srdf = dir.path().join("arm.srdf");
     std::fs::write(&srdf, r#"<robot name="a"><disable_collisions link1="tool_link" link2="base_link" reason="Never"/><disable_collisions link1="nowhere" link2="base_link"/></robot>"#).unwrap();
-    let c = Collisions::new(&model, Some(&srdf)).unwrap();
+    let c = Collisions::new(&model, Some(&srdf), &Default::default()).unwrap();
     assert_eq!(c.pairs.len(), all - 1);
     assert!(!c.pairs.iter().any(|&(a, b)| [&model.frames[a].name, &model.frames[b].name] == ["base_link", "tool_link"]));
     assert!(c.notices.iter().any(|n| n.contains("nowhere")), "an unknown link is said");
     std::fs::write(&srdf, "<robot>\n<disable_collisions link1=\"tool_link\"/>\n</robot>").unwrap();
-    let e = Collisions::new(&model, Some(&srdf)).err().unwrap().to_string();
+    let e = Collisions::new(&model, Some(&srdf), &Default::default()).err().unwrap().to_string();
     assert!(!e.contains('\n') && e.contains("arm.srdf") && e.contains("line 2") && e.contains("link2"), "{e}");
 }
 
@@ -116,6 +117,53 @@ fn a_run_flags_the_floor_when_the_tool_reaches_it() {
     assert_eq!(first[0].as_f64(), first_below, "the first contact is the first step the tool's lowest corner reaches the floor");
     let tool_floor = c["pairs"].as_array().unwrap().iter().find(|p| p["link1"] == "tool_link" && p["link2"] == "floor").unwrap();
     assert!((-tool_floor["closest"].as_f64().unwrap() - deepest).abs() < 1e-9, "deepest {deepest} vs {tool_floor}");
+}
+
+/// A scene file's table and payload: the box model's default wave dips its tool through a table top
+/// at z = −0.15 m (a slab 2 × 2 × 0.3 m, wider than the arm's reach) while it carries a ball of 4 cm
+/// radius 0.1 m out along the tool's x axis. The run's first contact is the tool (ball included) with
+/// the table, at the first control step where the lowest point of the tool's box or of the ball, put
+/// where the trace's joint angles place them, reaches the table top — an independent reading of the
+/// same states; without the ball the contact comes later.
+#[test]
+fn a_scene_table_is_flagged_when_the_payload_dips_into_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("scene.toml");
+    std::fs::write(&scene, "[[object]]\nname = \"table\"\nshape = \"box\"\nsize = [2.0, 2.0, 0.3]\nxyz = [0.0, 0.0, -0.3]\n\n[payload]\nshape = \"sphere\"\nradius = 0.04\nxyz = [0.1, 0.0, 0.0]\n").unwrap();
+    let bare = dir.path().join("bare.toml");
+    std::fs::write(&bare, "[[object]]\nname = \"table\"\nshape = \"box\"\nsize = [2.0, 2.0, 0.3]\nxyz = [0.0, 0.0, -0.3]\n").unwrap();
+    let run = |scene: &std::path::Path, name: &str| {
+        let (trace, summary) = (dir.path().join(format!("{name}.csv")), dir.path().join(format!("{name}.json")));
+        assert_eq!(common::armscope(&["run", "--quiet", "--scene", scene.to_str().unwrap(), "--duration", "3", "--trace", trace.to_str().unwrap(), "--summary-json", summary.to_str().unwrap()]), 0);
+        let s: Value = serde_json::from_str(&std::fs::read_to_string(&summary).unwrap()).unwrap();
+        (common::read_csv(&trace), s["summary"]["collisions"].clone())
+    };
+    let (table, c) = run(&scene, "ball");
+    let first = &c["first_contact"];
+    assert_eq!((first[1].as_str(), first[2].as_str()), (Some("tool_link"), Some("table")), "{c}");
+    assert_eq!(c["scene_objects"][0], "table");
+    let model = load_urdf(&common::box_urdf()).unwrap();
+    let tool = model.frame_index("tool_link").unwrap();
+    let mut data = armscope::dynamics::Data::new(&model);
+    let (mut first_box, mut first_any) = (None, None);
+    for row in &table.rows {
+        let q: Vec<f64> = (1..=6).map(|i| row[table.col(&format!("q{i}"))]).collect();
+        armscope::dynamics::forward_kinematics(&model, &mut data, &q);
+        let pose = armscope::dynamics::frame_pose(&model, &data, tool);
+        let box_lowest = [-1.0, 1.0].iter().flat_map(|&x| [-1.0, 1.0].iter().flat_map(move |&y| [-1.0, 1.0].map(move |z| nalgebra::Vector3::new(0.02 + 0.02 * x, 0.09 * y, 0.015 * z)))).map(|p| pose.transform_point(&p).z).fold(f64::INFINITY, f64::min);
+        let ball_lowest = pose.transform_point(&nalgebra::Vector3::new(0.1, 0.0, 0.0)).z - 0.04;
+        let t = row[table.col("t")];
+        if box_lowest <= -0.15 && first_box.is_none() {
+            first_box = Some(t);
+        }
+        if box_lowest.min(ball_lowest) <= -0.15 && first_any.is_none() {
+            first_any = Some(t);
+        }
+    }
+    assert_eq!(first[0].as_f64(), first_any, "the first contact is the first step the tool or its ball reaches the table top");
+    let (_, without) = run(&bare, "bare");
+    assert_eq!(without["first_contact"][0].as_f64(), first_box, "without the ball: the tool's box");
+    assert!(first_any < first_box, "the ball reaches the table first: {first_any:?} vs {first_box:?}");
 }
 
 /// `--stop-on-collision` ends the run at the first contact, exit code 4: the trace's last step is the
@@ -185,8 +233,8 @@ fn model_writes_the_srdf_of_pairs_that_never_touch() {
     let committed = armscope::collision::srdf::disabled_pairs(&common::repo().join("assets/smallrobotarm/smallrobotarm.srdf")).unwrap();
     assert!(never.iter().all(|p| committed.contains(p)), "2000 samples find no Never pair the committed 10000-sample SRDF lacks");
     let model = load_urdf(&urdf).unwrap();
-    let all = Collisions::new(&model, Some(&empty)).unwrap().pairs.len();
-    let kept = Collisions::new(&model, Some(&srdf)).unwrap().pairs.len();
+    let all = Collisions::new(&model, Some(&empty), &Default::default()).unwrap().pairs.len();
+    let kept = Collisions::new(&model, Some(&srdf), &Default::default()).unwrap().pairs.len();
     let never_or_always = text.matches("reason=\"Never\"").count() + text.matches("reason=\"Always\"").count();
     assert_eq!(kept, all - never_or_always);
 }
@@ -209,4 +257,25 @@ fn size_refuses_a_motion_that_collides() {
     assert!(c[2].is_string() && c[3].is_string() && c[1].as_f64().unwrap() >= 0.0, "{c}");
     let (code, tutorial) = size("30", "tutorial");
     assert_eq!((code, tutorial["collision"].is_null()), (0, true));
+}
+
+/// A bad scene file stops `run` and `trajectory` before anything is written: exit 2 and one line
+/// naming the file, the object and the field.
+#[test]
+fn a_bad_scene_file_is_one_line_naming_file_and_field() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("scene.toml");
+    std::fs::write(&scene, "[[object]]\nname = \"wall\"\nshape = \"box\"\nsize = [0.1, 2.0]\n").unwrap();
+    for args in [vec!["run", "--no-rrd", "--no-mcap", "--quiet", "--duration", "0.1"], vec!["trajectory", "circle", "--out"]] {
+        let mut args: Vec<String> = args.into_iter().map(String::from).collect();
+        if args[0] == "trajectory" {
+            args.push(dir.path().join("c").display().to_string());
+        }
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_armscope")).args(&args).args(["--scene", scene.to_str().unwrap()]).output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{err}");
+        let line = err.lines().find(|l| l.contains("error")).unwrap_or_default();
+        assert!(line.contains("scene.toml") && line.contains("object 'wall'") && line.contains("field 'size'"), "{err}");
+        assert!(!dir.path().join("c.csv").exists(), "nothing written");
+    }
 }

@@ -35,6 +35,10 @@ pub struct ModelArgs {
     /// and the adjacent ones, as MoveIt's setup assistant does (implies --collisions).
     #[arg(long, value_name = "FILE")]
     pub srdf_out: Option<PathBuf>,
+    /// A scene file (TOML: fixed objects, a floor, the payload's shape) checked with --collisions
+    /// --states too (see `armscope run --scene`).
+    #[arg(long, value_name = "FILE")]
+    pub scene: Option<PathBuf>,
     /// Random states for --srdf-out.
     #[arg(long, default_value_t = 10000)]
     pub samples: usize,
@@ -59,8 +63,9 @@ pub fn model(args: &ModelArgs) -> Result<i32, Error> {
             eprintln!("armscope: wrote {}", out.display());
         }
     }
-    let collisions = if args.collisions || args.srdf.is_some() || args.srdf_out.is_some() {
-        let c = crate::collision::Collisions::new(&model, args.srdf.as_deref())?;
+    let collisions = if args.collisions || args.srdf.is_some() || args.srdf_out.is_some() || args.scene.is_some() {
+        let (scene, _) = crate::collision::Scene::from_flags(args.scene.as_deref(), None)?;
+        let c = crate::collision::Collisions::new(&model, args.srdf.as_deref(), &scene)?;
         for notice in &c.notices {
             eprintln!("armscope: notice: {notice}");
         }
@@ -80,7 +85,7 @@ pub fn model(args: &ModelArgs) -> Result<i32, Error> {
         let mut out = crate::inspect::dynamics_at(&model, &states)?;
         if let Some(c) = &collisions {
             out["collision_pairs"] = serde_json::json!(c.pairs.iter().map(|&(a, b)| [&model.frames[a].name, &model.frames[b].name]).collect::<Vec<_>>());
-            let mut checker = c.checker(&model, None);
+            let mut checker = c.checker(&model);
             for (s, json) in states.iter().zip(out["states"].as_array_mut().into_iter().flatten()) {
                 let q: Vec<f64> = model.joints.iter().map(|j| s.q.get(&j.name).copied().unwrap_or(0.0)).collect();
                 checker.check(&q, 0.05);

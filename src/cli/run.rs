@@ -94,6 +94,10 @@ pub struct RunArgs {
     /// by name). Implies --collisions.
     #[arg(long, value_name = "FILE")]
     pub srdf: Option<PathBuf>,
+    /// A scene file (TOML): fixed boxes, cylinders, spheres, capsules and meshes in the world frame,
+    /// a floor, the payload's shape at the tool. Implies --collisions.
+    #[arg(long, value_name = "FILE")]
+    pub scene: Option<PathBuf>,
     /// End the run at the first collision (whole files up to there; exit code 4). Implies --collisions.
     #[arg(long)]
     pub stop_on_collision: bool,
@@ -229,6 +233,7 @@ impl RunArgs {
             stop_on_collision: self.stop_on_collision,
             floor: self.floor,
             srdf: self.srdf.clone(),
+            scene: self.scene.clone(),
         }
     }
 }

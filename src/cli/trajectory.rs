@@ -33,6 +33,10 @@ pub struct TrajectoryArgs {
     /// An SRDF whose disabled pairs are not checked (default: the one beside the URDF).
     #[arg(long, value_name = "FILE")]
     pub srdf: Option<PathBuf>,
+    /// Also check the path against a scene file's objects, floor and payload shape (TOML; see
+    /// `armscope run --scene`).
+    #[arg(long, value_name = "FILE")]
+    pub scene: Option<PathBuf>,
 }
 
 
@@ -75,14 +79,15 @@ pub fn trajectory(args: &TrajectoryArgs) -> Result<i32, Error> {
         flat.extend_from_slice(q);
     }
     // the path checked for collisions before it is written: each sample's pairs in contact
-    let collisions = crate::collision::Collisions::new(&model, args.srdf.as_deref())?;
-    for notice in &collisions.notices {
+    let (scene, floor_notice) = crate::collision::Scene::from_flags(args.scene.as_deref(), args.floor)?;
+    let collisions = crate::collision::Collisions::new(&model, args.srdf.as_deref(), &scene)?;
+    for notice in floor_notice.iter().chain(&collisions.notices) {
         eprintln!("armscope: notice: {notice}");
     }
     let mut first: Option<(f64, String, String, f64)> = None;
     let mut in_contact = 0;
     let mut closest: Option<(f64, String, String, f64)> = None;
-    let mut checker = collisions.checker(&model, args.floor);
+    let mut checker = collisions.checker(&model);
     for (t, q) in times.iter().zip(&positions) {
         checker.check(q, 0.05);
         let close = checker.named();
@@ -98,11 +103,11 @@ pub fn trajectory(args: &TrajectoryArgs) -> Result<i32, Error> {
             }
         }
     }
-    let floor = args.floor.map_or(String::new(), |z| format!(" and the floor at z = {z} m"));
+    let checked = collisions.describe();
     match (&first, &closest) {
-        (Some((t, a, b, _)), _) => eprintln!("armscope: notice: the path collides: first at t = {t:.3} s, {a} with {b}; {in_contact} of {} points in contact ({} link pairs{floor} checked)", times.len(), collisions.pairs.len()),
-        (None, Some((t, a, b, d))) => println!("collisions: none ({} link pairs{floor}); closest {a} — {b}, {:.1} mm at t = {t:.3} s", collisions.pairs.len(), 1e3 * d),
-        (None, None) => println!("collisions: none ({} link pairs{floor}), none closer than 5 cm", collisions.pairs.len()),
+        (Some((t, a, b, _)), _) => eprintln!("armscope: notice: the path collides: first at t = {t:.3} s, {a} with {b}; {in_contact} of {} points in contact ({checked} checked)", times.len()),
+        (None, Some((t, a, b, d))) => println!("collisions: none ({checked}); closest {a} — {b}, {:.1} mm at t = {t:.3} s", 1e3 * d),
+        (None, None) => println!("collisions: none ({checked}), none closer than 5 cm"),
     }
     std::fs::write(&csv, text).map_err(|e| Error::output(&csv, e))?;
     std::fs::write(&npy, crate::npy::write_f64(times.len(), n + 1, &flat)).map_err(|e| Error::output(&npy, e))?;

@@ -7,12 +7,19 @@ use crate::spatial::Pose;
 use parry3d_f64::math::{Pose as PPose, Vector};
 use parry3d_f64::shape::SharedShape;
 
-/// A pair of links (frame indices; `b` is `None` for the floor) and their distance, m (negative
-/// inside).
+/// What a link is checked against: another link (a frame index) or a fixed shape of the world (an
+/// index into [`super::Collisions::world`]: the floor, a scene's objects).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Against {
+    Link(usize),
+    World(usize),
+}
+
+/// A link (frame index), what it is checked against, and their distance, m (negative inside).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PairDistance {
     pub a: usize,
-    pub b: Option<usize>,
+    pub b: Against,
     pub distance: f64,
 }
 
@@ -38,13 +45,47 @@ impl StateCollisions {
 pub struct CollisionData {
     poses: Vec<PPose>,
     centres: Vec<nalgebra::Vector3<f64>>,
-    floor: Option<(f64, SharedShape)>,
 }
 
 impl CollisionData {
-    /// With a floor at height `floor` (world z), if any.
-    pub fn new(shapes: &CollisionModel, floor: Option<f64>) -> Self {
-        Self { poses: vec![PPose::identity(); shapes.shapes.len()], centres: vec![nalgebra::Vector3::zeros(); shapes.shapes.len()], floor: floor.map(|z| (z, SharedShape::halfspace(Vector::new(0.0, 0.0, 1.0)))) }
+    pub fn new(shapes: &CollisionModel) -> Self {
+        Self { poses: vec![PPose::identity(); shapes.shapes.len()], centres: vec![nalgebra::Vector3::zeros(); shapes.shapes.len()] }
+    }
+}
+
+/// A fixed shape of the world: the floor (a half-space) or a scene's object.
+pub struct WorldShape {
+    pub name: String,
+    pub shape: SharedShape,
+    pub pose: PPose,
+    /// The broad phase: a bounding sphere, or for the floor the height of its plane.
+    pub bound: WorldBound,
+}
+
+pub enum WorldBound {
+    Sphere { centre: nalgebra::Vector3<f64>, radius: f64 },
+    Below(f64),
+}
+
+impl WorldShape {
+    /// A floor at height `z` (world z, m).
+    pub fn floor(z: f64) -> Self {
+        Self { name: "floor".into(), shape: SharedShape::halfspace(Vector::new(0.0, 0.0, 1.0)), pose: PPose::from_translation(Vector::new(0.0, 0.0, z)), bound: WorldBound::Below(z) }
+    }
+
+    /// `shape` placed at `pose` in the world (`pose` already turned for parry's axis conventions).
+    pub fn fixed(name: &str, shape: SharedShape, pose: &Pose) -> Self {
+        let sphere = shape.compute_local_bounding_sphere();
+        let centre = pose.transform_point(&nalgebra::Vector3::new(sphere.center.x, sphere.center.y, sphere.center.z));
+        Self { name: name.to_string(), shape, pose: to_parry(pose), bound: WorldBound::Sphere { centre, radius: sphere.radius } }
+    }
+
+    /// How far a sphere at `centre` of `radius` is from this shape's bound at least.
+    fn gap(&self, centre: &nalgebra::Vector3<f64>, radius: f64) -> f64 {
+        match &self.bound {
+            WorldBound::Sphere { centre: c, radius: r } => (centre - c).norm() - radius - r,
+            WorldBound::Below(z) => centre.z - radius - z,
+        }
     }
 }
 
@@ -72,9 +113,10 @@ fn signed_distance(p1: &PPose, s1: &SharedShape, p2: &PPose, s2: &SharedShape) -
 }
 
 /// The collisions of the state whose link poses `frame_pose` gives (world frame), over `pairs`, and
-/// with the floor for every link not fixed to the world; pairs farther than `threshold` are not
-/// measured past the broad phase.
-pub fn check_state(model: &Model, shapes: &CollisionModel, pairs: &[(usize, usize)], data: &mut CollisionData, frame_pose: impl Fn(usize) -> Pose, threshold: f64, out: &mut StateCollisions) {
+/// with each of the `world`'s shapes for every link not fixed to the world; pairs farther than
+/// `threshold` are not measured past the broad phase.
+#[allow(clippy::too_many_arguments)]
+pub fn check_state(model: &Model, shapes: &CollisionModel, pairs: &[(usize, usize)], world: &[WorldShape], data: &mut CollisionData, frame_pose: impl Fn(usize) -> Pose, threshold: f64, out: &mut StateCollisions) {
     out.close.clear();
     for (i, s) in shapes.shapes.iter().enumerate() {
         let pose = frame_pose(s.frame).compose(&s.origin);
@@ -94,11 +136,10 @@ pub fn check_state(model: &Model, shapes: &CollisionModel, pairs: &[(usize, usiz
             }
         }
         if best < threshold {
-            out.close.push(PairDistance { a, b: Some(b), distance: best });
+            out.close.push(PairDistance { a, b: Against::Link(b), distance: best });
         }
     }
-    if let Some((z, plane)) = &data.floor {
-        let plane_pose = PPose::from_translation(Vector::new(0.0, 0.0, *z));
+    for (w, fixed) in world.iter().enumerate() {
         for (f, frame) in model.frames.iter().enumerate() {
             if frame.body.is_none() || shapes.of_frame[f].is_empty() {
                 continue;
@@ -106,13 +147,13 @@ pub fn check_state(model: &Model, shapes: &CollisionModel, pairs: &[(usize, usiz
             let mut best = f64::INFINITY;
             for &i in &shapes.of_frame[f] {
                 let s = &shapes.shapes[i];
-                if data.centres[i].z - s.bounding_radius - z > threshold.min(best) {
+                if fixed.gap(&data.centres[i], s.bounding_radius) > threshold.min(best) {
                     continue;
                 }
-                best = best.min(signed_distance(&plane_pose, plane, &data.poses[i], &s.shape));
+                best = best.min(signed_distance(&fixed.pose, &fixed.shape, &data.poses[i], &s.shape));
             }
             if best < threshold {
-                out.close.push(PairDistance { a: f, b: None, distance: best });
+                out.close.push(PairDistance { a: f, b: Against::World(w), distance: best });
             }
         }
     }

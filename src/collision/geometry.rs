@@ -28,7 +28,7 @@ pub struct CollisionModel {
     pub left_out: Vec<String>,
 }
 
-fn parry_shape(geometry: &Geometry) -> Result<SharedShape, String> {
+pub(crate) fn parry_shape(geometry: &Geometry) -> Result<SharedShape, String> {
     Ok(match geometry {
         Geometry::Box { size } => SharedShape::cuboid(size[0] / 2.0, size[1] / 2.0, size[2] / 2.0),
         // URDF's cylinders and capsules lie along z, parry's along y: turned in `shape_pose`
@@ -65,7 +65,7 @@ fn mesh(path: &Path, scale: [f64; 3]) -> Result<SharedShape, String> {
 }
 
 /// URDF's cylinders lie along z; parry's along y: a quarter turn about x brings y onto z.
-fn shape_pose(geometry: &Geometry, origin: &crate::spatial::Pose) -> crate::spatial::Pose {
+pub(crate) fn shape_pose(geometry: &Geometry, origin: &crate::spatial::Pose) -> crate::spatial::Pose {
     match geometry {
         Geometry::Cylinder { .. } => origin.compose(&crate::spatial::Pose::new(crate::spatial::rotation_about_axis(&nalgebra::Vector3::x(), std::f64::consts::FRAC_PI_2), nalgebra::Vector3::zeros())),
         _ => *origin,
@@ -78,18 +78,22 @@ impl CollisionModel {
         let mut out = CollisionModel { of_frame: vec![Vec::new(); model.frames.len()], ..Default::default() };
         for (f, frame) in model.frames.iter().enumerate() {
             for c in &frame.collisions {
-                match parry_shape(&c.geometry) {
-                    Ok(shape) => {
-                        let sphere = shape.compute_local_bounding_sphere();
-                        let centre = nalgebra::Vector3::new(sphere.center.x, sphere.center.y, sphere.center.z);
-                        out.of_frame[f].push(out.shapes.len());
-                        out.shapes.push(LinkShape { frame: f, origin: shape_pose(&c.geometry, &c.origin), shape, bounding_radius: sphere.radius, bounding_centre: centre });
-                    }
-                    Err(why) => out.left_out.push(format!("link '{}': {why}; left out of the collision checks", frame.name)),
+                if let Err(why) = out.add(f, &c.geometry, &c.origin) {
+                    out.left_out.push(format!("link '{}': {why}; left out of the collision checks", frame.name));
                 }
             }
         }
         out
+    }
+
+    /// One more shape on link (frame) `f`, at `origin` in the link's frame (the payload the tool holds).
+    pub fn add(&mut self, f: usize, geometry: &Geometry, origin: &crate::spatial::Pose) -> Result<(), String> {
+        let shape = parry_shape(geometry)?;
+        let sphere = shape.compute_local_bounding_sphere();
+        let centre = nalgebra::Vector3::new(sphere.center.x, sphere.center.y, sphere.center.z);
+        self.of_frame[f].push(self.shapes.len());
+        self.shapes.push(LinkShape { frame: f, origin: shape_pose(geometry, origin), shape, bounding_radius: sphere.radius, bounding_centre: centre });
+        Ok(())
     }
 
     /// Whether link (frame) `f` has any collision shape.

@@ -12,29 +12,45 @@ pub mod check;
 pub mod geometry;
 pub mod pairs;
 pub mod run_log;
+pub mod scene;
 pub mod srdf;
 
-pub use check::{CollisionData, PairDistance, StateCollisions, check_state};
+pub use check::{Against, CollisionData, PairDistance, StateCollisions, WorldShape, check_state};
+pub use scene::Scene;
 pub use geometry::{CollisionModel, LinkShape};
 pub use pairs::active_pairs;
 pub use run_log::{CollisionSummary, PairRecord, RunLog};
 
 use crate::model::Model;
 
-/// A model's collision set-up for `armscope model` and the runs: its shapes, the active pairs, and
-/// the notices made (links left out, SRDF names that are no link).
+/// A model's collision set-up for `armscope model` and the runs: its shapes, the active pairs, the
+/// world's fixed shapes (floor, scene), and the notices made (links left out, SRDF names that are no
+/// link, where the payload's shape went).
 pub struct Collisions {
     pub shapes: CollisionModel,
     pub pairs: Vec<(usize, usize)>,
+    /// Checked against every moving link: the floor first, if any, then the scene's objects.
+    pub world: Vec<WorldShape>,
     pub notices: Vec<String>,
 }
 
 impl Collisions {
-    /// The shapes of `model` and its active pairs, less those `srdf` disables (an SRDF file; when
-    /// None, the one beside the URDF by name, if any, with a notice).
-    pub fn new(model: &Model, srdf: Option<&std::path::Path>) -> Result<Self, crate::error::Error> {
-        let shapes = CollisionModel::new(model);
+    /// The shapes of `model` (with the `scene`'s payload on the tool) and its active pairs, less
+    /// those `srdf` disables (an SRDF file; when None, the one beside the URDF by name, if any, with
+    /// a notice); the scene's floor and objects.
+    pub fn new(model: &Model, srdf: Option<&std::path::Path>, scene: &Scene) -> Result<Self, crate::error::Error> {
+        let mut shapes = CollisionModel::new(model);
         let mut notices = shapes.left_out.clone();
+        let scene_name = || scene.source.as_ref().map_or("the scene".to_string(), |p| p.display().to_string());
+        if let Some((geometry, origin)) = &scene.payload {
+            shapes.add(model.tool_frame, geometry, origin).map_err(|e| crate::error::Error::flag("--scene", format!("{}: payload: {e}", scene_name())))?;
+            notices.push(format!("{}: the payload's shape is checked as part of link '{}' (the tool)", scene_name(), model.frames[model.tool_frame].name));
+        }
+        let mut world: Vec<WorldShape> = scene.floor.map(WorldShape::floor).into_iter().collect();
+        for o in &scene.objects {
+            let shape = geometry::parry_shape(&o.geometry).map_err(|e| crate::error::Error::flag("--scene", format!("{}: object '{}': {e}", scene_name(), o.name)))?;
+            world.push(WorldShape::fixed(&o.name, shape, &geometry::shape_pose(&o.geometry, &o.pose)));
+        }
         let found = match srdf {
             Some(p) => Some(p.to_path_buf()),
             None => srdf::beside(&model.source).inspect(|p| notices.push(format!("collision pairs: the SRDF beside the URDF, {}, disables its pairs (--srdf chooses another)", p.display()))),
@@ -47,19 +63,46 @@ impl Collisions {
         if !unknown.is_empty() {
             notices.push(format!("SRDF {}: names links the URDF does not have, ignored: {}", found.as_ref().map_or(String::new(), |p| p.display().to_string()), unknown.join(", ")));
         }
-        Ok(Self { shapes, pairs, notices })
+        Ok(Self { shapes, pairs, world, notices })
     }
 
-    /// A checker of states of `model` one after another, with a floor at `floor` if any (its
-    /// workspaces made once).
-    pub fn checker<'a>(&'a self, model: &'a Model, floor: Option<f64>) -> Checker<'a> {
-        Checker { model, collisions: self, data: crate::dynamics::Data::new(model), shapes: CollisionData::new(&self.shapes, floor), state: StateCollisions::default() }
+    /// The name of what a link is checked against: a link's, or the world shape's ("floor", a
+    /// scene object's).
+    pub fn name<'a>(&'a self, model: &'a Model, b: Against) -> &'a str {
+        match b {
+            Against::Link(f) => &model.frames[f].name,
+            Against::World(w) => &self.world[w].name,
+        }
     }
 
-    /// The pairs closer than `threshold` (m) at joint positions `q`, with a floor at `floor` if any:
-    /// (link, link or "floor", distance), nearest first.
-    pub fn at(&self, model: &Model, q: &[f64], floor: Option<f64>, threshold: f64) -> Vec<(String, String, f64)> {
-        let mut checker = self.checker(model, floor);
+    /// What the checks cover, for a line of text: "15 link pairs, the floor at z = 0 m and 2 scene objects".
+    pub fn describe(&self) -> String {
+        let mut parts = vec![format!("{} link pairs", self.pairs.len())];
+        if let Some(WorldShape { bound: check::WorldBound::Below(z), .. }) = self.world.first() {
+            parts.push(format!("the floor at z = {z} m"));
+        }
+        let objects = self.world.iter().filter(|w| matches!(w.bound, check::WorldBound::Sphere { .. })).count();
+        if objects > 0 {
+            parts.push(format!("{objects} scene object{}", if objects == 1 { "" } else { "s" }));
+        }
+        match parts.len() {
+            1 => parts.remove(0),
+            _ => {
+                let last = parts.pop().unwrap_or_default();
+                format!("{} and {last}", parts.join(", "))
+            }
+        }
+    }
+
+    /// A checker of states of `model` one after another (its workspaces made once).
+    pub fn checker<'a>(&'a self, model: &'a Model) -> Checker<'a> {
+        Checker { model, collisions: self, data: crate::dynamics::Data::new(model), shapes: CollisionData::new(&self.shapes), state: StateCollisions::default() }
+    }
+
+    /// The pairs closer than `threshold` (m) at joint positions `q`: (link, link or world shape,
+    /// distance), nearest first.
+    pub fn at(&self, model: &Model, q: &[f64], threshold: f64) -> Vec<(String, String, f64)> {
+        let mut checker = self.checker(model);
         checker.check(q, threshold);
         checker.named()
     }
@@ -79,13 +122,12 @@ impl Checker<'_> {
     pub fn check(&mut self, q: &[f64], threshold: f64) -> &StateCollisions {
         let (model, data) = (self.model, &mut self.data);
         crate::dynamics::forward_kinematics(model, data, q);
-        check_state(model, &self.collisions.shapes, &self.collisions.pairs, &mut self.shapes, |f| crate::dynamics::frame_pose(model, data, f), threshold, &mut self.state);
+        check_state(model, &self.collisions.shapes, &self.collisions.pairs, &self.collisions.world, &mut self.shapes, |f| crate::dynamics::frame_pose(model, data, f), threshold, &mut self.state);
         &self.state
     }
 
-    /// The last check's pairs by name: (link, link or "floor", distance), nearest first.
+    /// The last check's pairs by name: (link, link or world shape, distance), nearest first.
     pub fn named(&self) -> Vec<(String, String, f64)> {
-        let frames = &self.model.frames;
-        self.state.close.iter().map(|p| (frames[p.a].name.clone(), p.b.map_or("floor".to_string(), |b| frames[b].name.clone()), p.distance)).collect()
+        self.state.close.iter().map(|p| (self.model.frames[p.a].name.clone(), self.collisions.name(self.model, p.b).to_string(), p.distance)).collect()
     }
 }

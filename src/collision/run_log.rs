@@ -1,7 +1,7 @@
 //! A run's collisions, step by step into a summary: when the arm first touched something, each pair's
 //! steps in contact and its closest approach.
 
-use super::StateCollisions;
+use super::{Against, Collisions, StateCollisions};
 use crate::model::Model;
 use serde::{Deserialize, Serialize};
 
@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct PairRecord {
     pub link1: String,
-    /// The other link, or "floor".
+    /// The other link, or the world's shape ("floor", a scene object's name).
     pub link2: String,
     /// Control steps the pair was in contact (distance ≤ 0).
     pub steps_in_contact: u64,
@@ -25,6 +25,12 @@ pub struct CollisionSummary {
     /// Link pairs checked (the floor's not counted).
     pub pairs_checked: usize,
     pub floor: Option<f64>,
+    /// The scene's objects checked against every moving link (`--scene`).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub scene_objects: Vec<String>,
+    /// What was checked, in words ("15 link pairs and the floor at z = 0 m").
+    #[serde(default)]
+    pub checked: String,
     /// The first control step in contact: its time and the pair.
     pub first_contact: Option<(f64, String, String)>,
     /// Control steps with any pair in contact.
@@ -37,21 +43,26 @@ pub struct CollisionSummary {
 pub struct RunLog {
     summary: CollisionSummary,
     /// Per (a, b) key: the index into `summary.pairs`.
-    index: std::collections::HashMap<(usize, Option<usize>), usize>,
+    index: std::collections::HashMap<(usize, Against), usize>,
 }
 
 impl RunLog {
-    pub fn new(pairs_checked: usize, floor: Option<f64>) -> Self {
-        Self { summary: CollisionSummary { pairs_checked, floor, ..Default::default() }, index: Default::default() }
+    pub fn new(collisions: &Collisions) -> Self {
+        let floor = collisions.world.iter().find_map(|w| match w.bound {
+            super::check::WorldBound::Below(z) => Some(z),
+            _ => None,
+        });
+        let scene_objects = collisions.world.iter().filter(|w| matches!(w.bound, super::check::WorldBound::Sphere { .. })).map(|w| w.name.clone()).collect();
+        Self { summary: CollisionSummary { pairs_checked: collisions.pairs.len(), floor, scene_objects, checked: collisions.describe(), ..Default::default() }, index: Default::default() }
     }
 
-    pub fn record(&mut self, model: &Model, t: f64, state: &StateCollisions) {
+    pub fn record(&mut self, model: &Model, collisions: &Collisions, t: f64, state: &StateCollisions) {
         let mut any = false;
         for p in &state.close {
             let n = self.summary.pairs.len();
             let i = *self.index.entry((p.a, p.b)).or_insert(n);
             if i == n {
-                let link2 = p.b.map_or("floor".to_string(), |b| model.frames[b].name.clone());
+                let link2 = collisions.name(model, p.b).to_string();
                 self.summary.pairs.push(PairRecord { link1: model.frames[p.a].name.clone(), link2, steps_in_contact: 0, closest: f64::INFINITY, closest_at: t });
             }
             let r = &mut self.summary.pairs[i];

@@ -42,7 +42,7 @@ pub fn sampled(model: &crate::model::Model, collisions: &super::Collisions, samp
         (seed >> 11) as f64 / (1u64 << 53) as f64
     };
     let mut contacts = vec![0usize; collisions.pairs.len()];
-    let mut checker = collisions.checker(model, None);
+    let mut checker = collisions.checker(model);
     for _ in 0..samples {
         let q: Vec<f64> = model.joints.iter().map(|j| {
             let (lo, hi) = (j.lower.max(-std::f64::consts::PI), j.upper.min(std::f64::consts::PI));
@@ -50,7 +50,7 @@ pub fn sampled(model: &crate::model::Model, collisions: &super::Collisions, samp
         }).collect();
         // (a band of 1 nm: touching counts as contact, and nothing farther is measured)
         for p in checker.check(&q, 1e-9).colliding() {
-            if let Some(i) = p.b.and_then(|b| collisions.pairs.iter().position(|&x| x == (p.a, b))) {
+            if let super::Against::Link(b) = p.b && let Some(i) = collisions.pairs.iter().position(|&x| x == (p.a, b)) {
                 contacts[i] += 1;
             }
         }

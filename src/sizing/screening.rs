@@ -375,10 +375,18 @@ fn commanded_motion(request: &SizeRequest, model: &Model) -> Result<Motion, Erro
 /// The first self-collision along the commanded motions, checked every 10 ms of the command (the
 /// full runs follow it within their tracking error): (experiment, time, link, link).
 fn commanded_collision(request: &SizeRequest, model: &Model) -> Result<Option<(String, f64, String, String)>, Error> {
-    let collisions = crate::collision::Collisions::new(model, None)?;
-    let mut checker = collisions.checker(model, None);
+    let mut own = None;
     for (name, config) in &request.motions {
         let experiment = Experiment::with_model(RunConfig { motors: None, ..config.clone() }, model.clone())?;
+        // the motion's own checks (its --scene, --floor, --srdf), else self-collision
+        let collisions = match &experiment.collisions {
+            Some(c) => c.clone(),
+            None => match &own {
+                Some(c) => std::sync::Arc::clone(c),
+                None => own.insert(std::sync::Arc::new(crate::collision::Collisions::new(model, None, &crate::collision::Scene::default())?)).clone(),
+            },
+        };
+        let mut checker = collisions.checker(model);
         let (mut q, mut qd) = (vec![0.0; model.dof()], vec![0.0; model.dof()]);
         let steps = (config.duration / 0.01).ceil() as usize;
         for k in 0..=steps {

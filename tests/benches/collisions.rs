@@ -15,7 +15,7 @@ fn checks(c: &mut Criterion) {
     let mut group = c.benchmark_group("collision_check");
     for (name, urdf) in [("box_model", "assets/smallrobot_arm.urdf"), ("smallrobotarm_meshes", "assets/smallrobotarm/smallrobotarm.urdf")] {
         let model = armscope::model::load_urdf(&root.join(urdf)).unwrap();
-        let collisions = Collisions::new(&model, None).unwrap();
+        let collisions = Collisions::new(&model, None, &Default::default()).unwrap();
         let mut seed = 0x2545_f491_4f6c_dd1d_u64;
         let mut uniform = || {
             seed ^= seed << 13;
@@ -25,14 +25,14 @@ fn checks(c: &mut Criterion) {
         };
         let states: Vec<Vec<f64>> = (0..64).map(|_| model.joints.iter().map(|j| j.lower.max(-3.14) + (j.upper.min(3.14) - j.lower.max(-3.14)) * uniform()).collect()).collect();
         let mut data = Data::new(&model);
-        let mut cd = CollisionData::new(&collisions.shapes, None);
+        let mut cd = CollisionData::new(&collisions.shapes);
         let mut out = StateCollisions::default();
         let mut k = 0;
         group.bench_function(name, |b| {
             b.iter(|| {
                 k = (k + 1) % states.len();
                 forward_kinematics(&model, &mut data, &states[k]);
-                check_state(&model, &collisions.shapes, &collisions.pairs, &mut cd, |f| frame_pose(&model, &data, f), 0.05, &mut out);
+                check_state(&model, &collisions.shapes, &collisions.pairs, &collisions.world, &mut cd, |f| frame_pose(&model, &data, f), 0.05, &mut out);
                 black_box(out.close.len())
             })
         });
