@@ -41,6 +41,9 @@ pub struct Sample<'a> {
     /// Per joint, its motor's winding temperature, °C (NaN where the motor has no thermal data;
     /// empty when no motor of the run has).
     pub winding_temperature: &'a [f64],
+    /// With collision checks: the pairs closer than 5 cm at this state, nearest first (distance ≤ 0:
+    /// in contact); empty without checks.
+    pub collisions: &'a [crate::collision::PairDistance],
     pub tool_position: Vector3<f64>,
     /// Where the command puts the tool (forward kinematics of cmd).
     pub tool_target: Vector3<f64>,

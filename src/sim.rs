@@ -111,6 +111,7 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
             friction: &friction,
             stuck: &stuck,
             winding_temperature: if heat.any() { &heat.winding_temperature } else { &no_temperatures },
+            collisions: collision_check.as_ref().map_or(&[], |(_, state, _)| state.close.as_slice()),
             tool_position: frame_pose(model, &data, model.tool_frame).translation,
             tool_target: frame_pose_in(model, &command_poses, model.tool_frame).translation,
             body_pose: &data.body_pose,

@@ -216,3 +216,30 @@ fn the_batch_comparison_from_memory_equals_the_one_from_the_mcap_files() {
     assert_eq!(compared, finished.len() * 6 * 3, "every run, joint and series");
     assert_eq!(batch.blueprints, 1);
 }
+
+/// Experiments that check collisions (`floor`, `scene` in the manifest) get counted in the tables:
+/// the CSV's control steps in contact and first contact equal a single run's summary with the same
+/// flags; an experiment that does not check says so (empty cells, "not checked").
+#[test]
+fn batch_tables_count_collisions() {
+    let dir = tempfile::tempdir().unwrap();
+    let manifest = dir.path().join("m.toml");
+    std::fs::write(&manifest, "name = \"contacts\"\n[[experiment]]\nname = \"unchecked\"\nduration = 2\n[[experiment]]\nname = \"floor\"\nfloor = -0.2\nduration = 2\n").unwrap();
+    let out = dir.path().join("out");
+    assert_eq!(armscope(&["batch", manifest.to_str().unwrap(), "--out", out.to_str().unwrap(), "--no-compare"]), 0);
+    let single = dir.path().join("single.json");
+    assert_eq!(armscope(&["run", "--quiet", "--floor", "-0.2", "--duration", "2", "--summary-json", single.to_str().unwrap()]), 0);
+    let c = &read_json(&single)["summary"]["collisions"];
+    let csv = std::fs::read_to_string(out.join("summary.csv")).unwrap();
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let cell = |name: &str, column: &str| -> String {
+        let i = header.iter().position(|h| *h == column).unwrap_or_else(|| panic!("no column {column}"));
+        csv.lines().find(|l| l.starts_with(&format!("{name},"))).unwrap().split(',').nth(i).unwrap().to_string()
+    };
+    assert_eq!(cell("floor", "collision_steps"), c["steps_in_contact"].to_string());
+    assert_eq!(cell("floor", "first_contact_s").parse::<f64>().unwrap(), c["first_contact"][0].as_f64().unwrap());
+    assert_eq!(cell("floor", "first_contact_pair"), "tool_link–floor");
+    assert_eq!(cell("unchecked", "collision_steps"), "");
+    let md = std::fs::read_to_string(out.join("summary.md")).unwrap();
+    assert!(md.contains("| collisions |") && md.contains("not checked") && md.contains("tool_link–floor"), "{md}");
+}

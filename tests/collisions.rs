@@ -279,3 +279,80 @@ fn a_bad_scene_file_is_one_line_naming_file_and_field() {
         assert!(!dir.path().join("c.csv").exists(), "nothing written");
     }
 }
+
+/// The recordings show the checks (the table scene of the test above, 3 s): in the `.rrd` a
+/// `collisions/in_contact` row per step whose steps with contact, sum of pairs and first contact
+/// are the summary's; the tool's and the table's shapes red from the first contact on (their
+/// own colour before); a `collisions/events` log. In the `.mcap`, decoded through the schema it
+/// carries, a `/collisions` message per step equal to the `.rrd`'s rows, `/collisions/contacts`
+/// updates each replacing the whole set (first at the first contact: the tool and the table), and
+/// the table drawn with the robot's geometry.
+#[test]
+fn recordings_show_what_is_in_contact_and_when() {
+    use prost::Message as _;
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("scene.toml");
+    std::fs::write(&scene, "[[object]]\nname = \"table\"\nshape = \"box\"\nsize = [2.0, 2.0, 0.3]\nxyz = [0.0, 0.0, -0.3]\n\n[payload]\nshape = \"sphere\"\nradius = 0.04\nxyz = [0.1, 0.0, 0.0]\n").unwrap();
+    let (rrd, mcap, summary) = (dir.path().join("c.rrd"), dir.path().join("c.mcap"), dir.path().join("c.json"));
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_armscope"))
+        .args(["run", "--quiet", "--duration", "3", "--scene", scene.to_str().unwrap(), "--rrd", rrd.to_str().unwrap(), "--mcap", mcap.to_str().unwrap(), "--summary-json", summary.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let s: Value = serde_json::from_str(&std::fs::read_to_string(&summary).unwrap()).unwrap();
+    let c = &s["summary"]["collisions"];
+    let first = c["first_contact"][0].as_f64().unwrap();
+    let steps_in_contact = c["steps_in_contact"].as_u64().unwrap();
+    let pair_steps: u64 = c["pairs"].as_array().unwrap().iter().map(|p| p["steps_in_contact"].as_u64().unwrap()).sum();
+    let steps = 3001;
+
+    let rrd = common::rrd::Rrd::open(&rrd);
+    assert!(rrd.verify_errors.is_empty(), "{:?}", rrd.verify_errors);
+    let count = rrd.series("/collisions/in_contact");
+    assert_eq!(count.len(), steps, "a row per step");
+    assert_eq!(count.iter().filter(|r| r.1[0] > 0.0).count() as u64, steps_in_contact);
+    assert_eq!(count.iter().map(|r| r.1[0]).sum::<f64>() as u64, pair_steps);
+    // (the .rrd keeps times in whole nanoseconds)
+    let at = |t: f64| (t - first).abs() < 1e-9;
+    assert!(at(count.iter().find(|r| r.1[0] > 0.0).unwrap().0), "the first step with a contact is the summary's");
+    let min = rrd.series("/collisions/min_distance");
+    assert!(min.iter().find(|r| at(r.0)).unwrap().1[0] <= 0.0);
+    let red = f64::from(0xEB1E1EFFu32);
+    for (entity, component) in [("/world/robot/tool_link/visual_0", "Boxes3D:colors"), ("/world/robot/tool_link/payload", "Ellipsoids3D:colors"), ("/world/scene/table", "Boxes3D:colors")] {
+        let colours = rrd.component(entity, component);
+        assert_eq!(colours[0].0, 0.0, "{entity}: its own colour from the start");
+        assert_ne!(colours[0].1[0], red, "{entity}");
+        let at_first = colours.iter().rev().find(|r| r.0 <= first + 1e-9).unwrap();
+        assert_eq!(at_first.1[0], red, "{entity}: red at the first contact, t = {first}");
+        assert!(colours.windows(2).all(|w| w[0].1 != w[1].1), "{entity}: logged at the changes only");
+    }
+    assert!(rrd.entities().contains_key("/collisions/events"));
+
+    let bytes = std::fs::read(&mcap).unwrap();
+    let (mut states, mut times, mut contacts, mut geometry) = (Vec::new(), Vec::new(), Vec::new(), None);
+    for m in mcap::MessageStream::new(&bytes).unwrap().map(|m| m.unwrap()) {
+        match m.channel.topic.as_str() {
+            "/collisions" => {
+                times.push(m.log_time);
+                let schema = m.channel.schema.clone().unwrap();
+                let pool = prost_reflect::DescriptorPool::decode(&schema.data[..]).unwrap();
+                states.push(prost_reflect::DynamicMessage::decode(pool.get_message_by_name(&schema.name).unwrap(), &m.data[..]).unwrap());
+            }
+            "/collisions/contacts" => contacts.push((m.log_time, foxglove::messages::SceneUpdate::decode(&m.data[..]).unwrap())),
+            "/robot/geometry" if geometry.is_none() => geometry = Some(foxglove::messages::SceneUpdate::decode(&m.data[..]).unwrap()),
+            _ => {}
+        }
+    }
+    assert_eq!(states.len(), steps);
+    for (state, row) in states.iter().zip(&count) {
+        assert!((state.get_field_by_name("time").unwrap().as_f64().unwrap() - row.0).abs() < 1e-9);
+        assert_eq!(state.get_field_by_name("in_contact").unwrap().as_u32(), Some(row.1[0] as u32));
+    }
+    let (first_time, first_update) = &contacts[0];
+    let k = count.iter().position(|r| at(r.0)).unwrap();
+    assert_eq!(*first_time, times[k], "the first contacts update at the first contact's step");
+    assert_eq!(first_update.deletions[0].r#type, foxglove::messages::scene_entity_deletion::Type::All as i32, "each update replaces the set");
+    let ids: Vec<&str> = first_update.entities.iter().map(|e| e.id.as_str()).collect();
+    assert!(ids.contains(&"contact-tool_link") && ids.contains(&"contact-scene-table"), "{ids:?}");
+    assert!(geometry.unwrap().entities.iter().any(|e| e.id == "scene-table" && e.cubes.len() == 1), "the table drawn");
+}

@@ -29,16 +29,35 @@ fn per_joint(s: &Summary, f: impl Fn(usize) -> String) -> String {
     (0..s.joints.len()).map(f).collect::<Vec<_>>().join(" ")
 }
 
+/// Whether any experiment of the batch checked collisions (its tables then count them).
+fn checks_collisions(summary: &BatchSummary) -> bool {
+    summary.experiments.iter().any(|e| e.summary.as_ref().is_some_and(|s| s.collisions.is_some()))
+}
+
+/// A run's collisions in a table cell: control steps in contact, and the first contact.
+fn collision_cell(s: &Summary) -> String {
+    match &s.collisions {
+        None => "not checked".into(),
+        Some(c) => match &c.first_contact {
+            None => "none".into(),
+            Some((t, a, b)) => format!("{} steps, first {t:.3} s {a}–{b}", c.steps_in_contact),
+        },
+    }
+}
+
 pub fn markdown(summary: &BatchSummary) -> String {
-    let mut md = format!("# batch `{}`\n\nMax and RMS tracking error over every step with t ≥ the settle time (2 s), saturation % and chatter % of control steps, full steps lost (stepper mode), per joint J1..Jn.\n\n", summary.batch);
-    md += "| experiment | status | max err (rad) | RMS err (rad) | saturation % | chatter % | lost steps | tool x / y / z range (m) | wall time incl. recording (s) |\n|---|---|---|---|---|---|---|---|---|\n";
+    let collisions = checks_collisions(summary);
+    let mut md = format!("# batch `{}`\n\nMax and RMS tracking error over every step with t ≥ the settle time (2 s), saturation % and chatter % of control steps, full steps lost (stepper mode), per joint J1..Jn{}.\n\n", summary.batch, if collisions { "; collisions: control steps with any pair in contact, and the first contact" } else { "" });
+    let (head, rule, extra) = if collisions { (" collisions |", "---|", 1) } else { ("", "", 0) };
+    md += &format!("| experiment | status | max err (rad) | RMS err (rad) | saturation % | chatter % | lost steps |{head} tool x / y / z range (m) | wall time incl. recording (s) |\n|---|---|---|---|---|---|---|{rule}---|---|\n");
     for e in &summary.experiments {
         match &e.summary {
             Some(s) => {
                 let r = &s.tool_range;
+                let cell = if collisions { format!(" {} |", collision_cell(s)) } else { String::new() };
                 let _ = writeln!(
                     md,
-                    "| {} | {} | {} | {} | {} | {} | {} | [{:.3}, {:.3}] / [{:.3}, {:.3}] / [{:.3}, {:.3}] | {:.3} |",
+                    "| {} | {} | {} | {} | {} | {} | {} |{cell} [{:.3}, {:.3}] / [{:.3}, {:.3}] / [{:.3}, {:.3}] | {:.3} |",
                     e.name,
                     e.status,
                     per_joint(s, |j| fmt_opt(s.max_abs_error[j])),
@@ -56,7 +75,7 @@ pub fn markdown(summary: &BatchSummary) -> String {
                 );
             }
             None => {
-                let _ = writeln!(md, "| {} | {} | | | | | | | |", e.name, e.status);
+                let _ = writeln!(md, "| {} | {} | | | | | |{} | |", e.name, e.status, " |".repeat(extra));
             }
         }
     }
@@ -69,7 +88,12 @@ pub fn csv(summary: &BatchSummary) -> String {
     for prefix in ["max_err", "rms_err", "saturation_pct", "chatter_pct", "lost_steps"] {
         header.extend((1..=n).map(|j| format!("{prefix}_{j}")));
     }
-    header.extend(["x_min", "x_max", "y_min", "y_max", "z_min", "z_max", "wall_s", "error"].map(String::from));
+    header.extend(["x_min", "x_max", "y_min", "y_max", "z_min", "z_max", "wall_s"].map(String::from));
+    let collisions = checks_collisions(summary);
+    if collisions {
+        header.extend(["collision_steps", "first_contact_s", "first_contact_pair"].map(String::from));
+    }
+    header.push("error".into());
     let mut out = header.join(",") + "\n";
     for e in &summary.experiments {
         let mut row = vec![e.name.clone(), e.status.clone()];
@@ -83,10 +107,18 @@ pub fn csv(summary: &BatchSummary) -> String {
                 row.extend((0..n).map(|j| s.lost_steps.get(j).map_or("0".into(), |l| l.to_string())));
                 let r = &s.tool_range;
                 row.extend([r.x.min, r.x.max, r.y.min, r.y.max, r.z.min, r.z.max, e.wall_time].map(|x| format!("{x:?}")));
+                if collisions {
+                    // empty cells: not checked (steps) or no contact (time, pair)
+                    let c = s.collisions.as_ref();
+                    row.push(c.map_or(String::new(), |c| c.steps_in_contact.to_string()));
+                    let first = c.and_then(|c| c.first_contact.as_ref());
+                    row.push(first.map_or(String::new(), |f| format!("{:?}", f.0)));
+                    row.push(first.map_or(String::new(), |f| format!("{}–{}", f.1, f.2)));
+                }
                 row.push(String::new());
             }
             None => {
-                row.extend(std::iter::repeat_n(String::new(), 5 * n + 7));
+                row.extend(std::iter::repeat_n(String::new(), 5 * n + 7 + if collisions { 3 } else { 0 }));
                 row.push(format!("\"{}\"", e.error.clone().unwrap_or_default().replace('"', "'")));
             }
         }

@@ -60,6 +60,8 @@ pub struct WorldShape {
     pub pose: PPose,
     /// The broad phase: a bounding sphere, or for the floor the height of its plane.
     pub bound: WorldBound,
+    /// What the recordings draw: a scene object's geometry and its pose in the world (None: the floor).
+    pub drawn: Option<(crate::model::Geometry, Pose)>,
 }
 
 pub enum WorldBound {
@@ -70,14 +72,16 @@ pub enum WorldBound {
 impl WorldShape {
     /// A floor at height `z` (world z, m).
     pub fn floor(z: f64) -> Self {
-        Self { name: "floor".into(), shape: SharedShape::halfspace(Vector::new(0.0, 0.0, 1.0)), pose: PPose::from_translation(Vector::new(0.0, 0.0, z)), bound: WorldBound::Below(z) }
+        Self { name: "floor".into(), shape: SharedShape::halfspace(Vector::new(0.0, 0.0, 1.0)), pose: PPose::from_translation(Vector::new(0.0, 0.0, z)), bound: WorldBound::Below(z), drawn: None }
     }
 
-    /// `shape` placed at `pose` in the world (`pose` already turned for parry's axis conventions).
-    pub fn fixed(name: &str, shape: SharedShape, pose: &Pose) -> Self {
+    /// A scene object: `geometry` at `pose` in the world.
+    pub fn fixed(name: &str, geometry: &crate::model::Geometry, pose: &Pose) -> Result<Self, String> {
+        let shape = super::geometry::parry_shape(geometry)?;
+        let placed = super::geometry::shape_pose(geometry, pose);
         let sphere = shape.compute_local_bounding_sphere();
-        let centre = pose.transform_point(&nalgebra::Vector3::new(sphere.center.x, sphere.center.y, sphere.center.z));
-        Self { name: name.to_string(), shape, pose: to_parry(pose), bound: WorldBound::Sphere { centre, radius: sphere.radius } }
+        let centre = placed.transform_point(&nalgebra::Vector3::new(sphere.center.x, sphere.center.y, sphere.center.z));
+        Ok(Self { name: name.to_string(), shape, pose: to_parry(&placed), bound: WorldBound::Sphere { centre, radius: sphere.radius }, drawn: Some((geometry.clone(), *pose)) })
     }
 
     /// How far a sphere at `centre` of `radius` is from this shape's bound at least.

@@ -31,6 +31,8 @@ pub struct Collisions {
     pub pairs: Vec<(usize, usize)>,
     /// Checked against every moving link: the floor first, if any, then the scene's objects.
     pub world: Vec<WorldShape>,
+    /// The payload's shape and its pose in the tool frame (part of the tool link's shapes).
+    pub payload: Option<(crate::model::Geometry, crate::spatial::Pose)>,
     pub notices: Vec<String>,
 }
 
@@ -48,8 +50,7 @@ impl Collisions {
         }
         let mut world: Vec<WorldShape> = scene.floor.map(WorldShape::floor).into_iter().collect();
         for o in &scene.objects {
-            let shape = geometry::parry_shape(&o.geometry).map_err(|e| crate::error::Error::flag("--scene", format!("{}: object '{}': {e}", scene_name(), o.name)))?;
-            world.push(WorldShape::fixed(&o.name, shape, &geometry::shape_pose(&o.geometry, &o.pose)));
+            world.push(WorldShape::fixed(&o.name, &o.geometry, &o.pose).map_err(|e| crate::error::Error::flag("--scene", format!("{}: object '{}': {e}", scene_name(), o.name)))?);
         }
         let found = match srdf {
             Some(p) => Some(p.to_path_buf()),
@@ -63,7 +64,7 @@ impl Collisions {
         if !unknown.is_empty() {
             notices.push(format!("SRDF {}: names links the URDF does not have, ignored: {}", found.as_ref().map_or(String::new(), |p| p.display().to_string()), unknown.join(", ")));
         }
-        Ok(Self { shapes, pairs, world, notices })
+        Ok(Self { shapes, pairs, world, payload: scene.payload.clone(), notices })
     }
 
     /// The name of what a link is checked against: a link's, or the world shape's ("floor", a

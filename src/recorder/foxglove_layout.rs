@@ -63,6 +63,9 @@ pub struct RunPlots<'a> {
     pub torque_axes: &'a [TorqueAxis],
     /// Per joint, its motor has thermal data: a plot of the winding temperatures.
     pub heated: &'a [bool],
+    /// The run checks collisions: the links in contact shown red in 3D, a plot of the pairs in
+    /// contact and the closest distance.
+    pub collisions: bool,
 }
 
 /// `panels` side by side (`direction` "row") or stacked ("column"), each given an equal share.
@@ -78,7 +81,7 @@ fn split_evenly(mut panels: Vec<Value>, direction: &str) -> Value {
 /// The layout of a run of `model` from `q0` showing `plots`. Each joint's torque plot spans
 /// ±`plots.torque_axes[i].half_range` when given.
 pub fn layout_for_run(model: &Model, q0: &[f64], plots: &RunPlots) -> Value {
-    let RunPlots { motors, friction, stepped, torque_axes, heated } = *plots;
+    let RunPlots { motors, friction, stepped, torque_axes, heated, collisions } = *plots;
     let (target, distance) = camera(model, q0);
     let names: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();
     let angles = names
@@ -137,7 +140,7 @@ pub fn layout_for_run(model: &Model, q0: &[f64], plots: &RunPlots) -> Value {
                 },
                 "scene": { "transforms": { "showLabel": false, "axisScale": 0.4 } },
                 "transforms": {},
-                "topics": Value::Object(visible(&["/tf", "/robot/geometry", "/tool/path", "/tool/commanded_path", "/tool/pose"])),
+                "topics": Value::Object(visible(&["/tf", "/robot/geometry", "/tool/path", "/tool/commanded_path", "/tool/pose", "/collisions/contacts"])),
                 "layers": {
                     "grid": {
                         "visible": true, "frameLocked": true, "label": "Grid", "instanceId": "grid", "layerId": "foxglove.Grid",
@@ -168,6 +171,12 @@ pub fn layout_for_run(model: &Model, q0: &[f64], plots: &RunPlots) -> Value {
     }
     if has_steppers {
         doc["configById"]["Plot!steppers"] = plot(steppers);
+    }
+    if collisions {
+        // below the arm, as the temperatures: when and how close
+        doc["configById"]["Plot!collisions"] = plot(vec![series("/collisions.in_contact".into(), "pairs in contact".into()), series("/collisions.min_distance".into(), "closest pair (m; < 0: overlap)".into())]);
+        let arm = doc["layout"]["first"].take();
+        doc["layout"]["first"] = json!({ "first": arm, "second": "Plot!collisions", "direction": "column", "splitPercentage": 75 });
     }
     doc
 }
@@ -214,7 +223,7 @@ mod tests {
         let axes: Vec<TorqueAxis> = (0..n).map(|i| TorqueAxis::new(0.1 * (i + 1) as f64, 35.0)).collect();
         let stepped = [false, true, false, false, false, false];
         let heated = [false, true, false, false, false, false];
-        let l = layout_for_run(&model, &vec![0.0; n], &RunPlots { motors: true, friction: true, stepped: &stepped, torque_axes: &axes, heated: &heated });
+        let l = layout_for_run(&model, &vec![0.0; n], &RunPlots { motors: true, friction: true, stepped: &stepped, torque_axes: &axes, heated: &heated, collisions: false });
         // the tree places every configured panel exactly once, and only those
         let mut ids = Vec::new();
         placed(&l["layout"], &mut ids);

@@ -204,6 +204,8 @@ struct Channels {
     tool_path: Topic<SceneUpdate>,
     commanded_path: Topic<SceneUpdate>,
     robot_description: Topic<RobotDescription>,
+    /// With collision checks: each step's state, and the links and objects in contact.
+    collisions: Option<(Topic<super::mcap_collisions::CollisionState>, Topic<SceneUpdate>)>,
 }
 
 /// Where the MCAP recorder's messages go: a file, live Foxglove clients, or both.
@@ -241,6 +243,7 @@ pub struct McapRecorder {
     motors: Option<std::sync::Arc<crate::actuator::MotorSet>>,
     /// Simulated seconds between republished geometries: 1 for small scenes, longer for big meshes.
     scene_interval_s: i64,
+    collisions: Option<super::mcap_collisions::McapCollisions>,
 }
 
 /// Points of the tool path at most in one piece (a piece every half simulated second at 20 Hz).
@@ -325,6 +328,7 @@ impl McapRecorder {
             last_scene_second: -1,
             motors: None,
             scene_interval_s: 1,
+            collisions: None,
         }
     }
 
@@ -540,6 +544,10 @@ impl Recorder for McapRecorder {
                 tool_path: out.channel(TOPIC_TOOL_PATH, none(), false)?,
                 commanded_path: out.channel(TOPIC_COMMANDED_PATH, none(), true)?,
                 robot_description: out.channel(TOPIC_ROBOT_DESCRIPTION, none(), true)?,
+                collisions: match e.collisions {
+                    Some(_) => Some((out.channel(super::mcap_collisions::TOPIC_COLLISIONS, none(), false)?, out.channel(super::mcap_collisions::TOPIC_CONTACTS, none(), true)?)),
+                    None => None,
+                },
             })
         })()
         .map_err(|err| self.err(err))?;
@@ -606,6 +614,11 @@ impl Recorder for McapRecorder {
         };
         self.motors = e.motors.clone();
         self.scene = scene_from_model(model).map_err(|(path, err)| Error::output(&path, err))?;
+        self.collisions = e.collisions.clone().map(|c| super::mcap_collisions::McapCollisions::new(e.model.clone(), c));
+        if let Some(c) = &self.collisions {
+            // the scene's objects and the payload, republished with the robot's geometry
+            self.scene.entities.extend(c.world_entities());
+        }
         let scene_bytes = foxglove::Encode::encoded_len(&self.scene).unwrap_or(0);
         self.scene_interval_s = scene_interval_s(scene_bytes);
 
@@ -685,6 +698,12 @@ impl Recorder for McapRecorder {
         }
         out.log(&mut ch.joint_states, &self.joints_msg, stamp).map_err(fail)?;
         out.log(&mut ch.controller, &self.telemetry, stamp).map_err(fail)?;
+        if let (Some(c), Some((state, contacts))) = (self.collisions.as_mut(), ch.collisions.as_mut()) {
+            if let Some(update) = c.record(s, ts.unwrap_or_default()) {
+                out.log(contacts, &update, stamp).map_err(fail)?;
+            }
+            out.log(state, &c.state, stamp).map_err(fail)?;
+        }
         // the tool pose at a display rate, 50 Hz (every step's tool position is in /controller)
         if s.k.is_multiple_of(self.steps_per_tool_pose) || s.is_final {
             let tool = frame_pose_in(model, s.body_pose, model.tool_frame);
@@ -748,7 +767,7 @@ fn write_layout(run: &RunInfo, mcap: &std::path::Path, torque_axes: &[super::tor
     let e = run.experiment;
     let stepped = e.stepped_joints();
     let heated: Vec<bool> = e.motor_heat().iter().map(Option::is_some).collect();
-    let plots = super::foxglove_layout::RunPlots { motors: e.motors.is_some(), friction: e.joint_has_friction().contains(&true), stepped: &stepped, torque_axes, heated: &heated };
+    let plots = super::foxglove_layout::RunPlots { motors: e.motors.is_some(), friction: e.joint_has_friction().contains(&true), stepped: &stepped, torque_axes, heated: &heated, collisions: e.collisions.is_some() };
     let layout = super::foxglove_layout::layout_for_run(&e.model, &e.initial_state().0, &plots);
     let layout_path = super::foxglove_layout::layout_path(mcap);
     std::fs::write(&layout_path, serde_json::to_string_pretty(&layout).unwrap_or_default()).map_err(|err| Error::output(&layout_path, err))

@@ -2,14 +2,17 @@
 //! trait; a new format is one new file.
 
 mod console;
+mod contacts;
 pub mod foxglove_layout;
 pub mod foxglove_live;
 mod mcap;
+pub mod mcap_collisions;
 mod output_file;
 mod overview;
 mod pacer;
 pub mod rrd;
 mod robot_description;
+mod rrd_collisions;
 pub(crate) mod rrd_file;
 mod summary_json;
 pub mod telemetry;

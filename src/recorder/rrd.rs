@@ -16,6 +16,7 @@ use rerun::blueprint::{Blueprint, BlueprintActivation, BlueprintPanel, Container
 use rerun::blueprint::components::{PanelState, PlayState};
 use rerun::{RecordingStream, TimeColumn};
 use super::torque_axis::TorqueAxis;
+use super::rrd_collisions::{Recolour, RrdCollisions, log_geometry};
 use std::collections::VecDeque;
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -138,6 +139,8 @@ pub struct RerunRecorder {
     notice_sink: Option<Box<dyn Fn(&str) + Send>>,
     /// Per joint: its motor has thermal data (its winding temperature is recorded).
     heated: Vec<bool>,
+    /// With collision checks: what is in contact, drawn and plotted.
+    collisions: Option<RrdCollisions>,
 }
 
 /// Steps per block in a file-only recording: ~4 s of simulation per chunk (fewer, larger chunks
@@ -181,6 +184,7 @@ impl RerunRecorder {
             notices: Vec::new(),
             notice_sink: None,
             heated: Vec::new(),
+            collisions: None,
         }
     }
 
@@ -256,10 +260,10 @@ impl RerunRecorder {
             .map_err(|e| self.err(e))
     }
 
-    fn log_static_scene(&self, rec: &RecordingStream, model: &Model) -> Result<(), Error> {
-        let e = |err: rerun::RecordingStreamError| self.err(err);
-        rec.log_static("world", &rerun::ViewCoordinates::RIGHT_HAND_Z_UP()).map_err(e)?;
-        for frame in &model.frames {
+    fn log_static_scene(&mut self, rec: &RecordingStream, model: &Model) -> Result<(), Error> {
+        rec.log_static("world", &rerun::ViewCoordinates::RIGHT_HAND_Z_UP()).map_err(|x| self.err(x))?;
+        for (f, frame) in model.frames.iter().enumerate() {
+            let e = |err: rerun::RecordingStreamError| self.err(err);
             let entity = link_entity(&frame.name);
             // a link on no body is fixed in the world: its placement is its pose
             if frame.body.is_none() {
@@ -271,36 +275,21 @@ impl RerunRecorder {
                 if let Geometry::Mesh { scale, .. } = &visual.geometry {
                     t = t.with_scale([scale[0] as f32, scale[1] as f32, scale[2] as f32]);
                 }
-                rec.log_static(path.as_str(), &t).map_err(e)?;
+                rec.log_static(path.as_str(), &t).map_err(|x| self.err(x))?;
                 let color = visual.rgba.map(|c| rerun::Color::from_unmultiplied_rgba((c[0] * 255.0) as u8, (c[1] * 255.0) as u8, (c[2] * 255.0) as u8, (c[3] * 255.0) as u8));
                 let color = color.unwrap_or(rerun::Color::from_rgb(170, 170, 180));
-                match &visual.geometry {
-                    Geometry::Box { size } => rec.log_static(
-                        path.as_str(),
-                        &rerun::Boxes3D::from_half_sizes([[size[0] as f32 / 2.0, size[1] as f32 / 2.0, size[2] as f32 / 2.0]])
-                            .with_colors([color])
-                            .with_fill_mode(rerun::FillMode::Solid),
-                    ),
-                    Geometry::Cylinder { radius, length } => rec.log_static(
-                        path.as_str(),
-                        &rerun::Cylinders3D::from_lengths_and_radii([*length as f32], [*radius as f32])
-                            .with_colors([color])
-                            .with_fill_mode(rerun::FillMode::Solid),
-                    ),
-                    Geometry::Capsule { radius, length } => rec.log_static(
-                        path.as_str(),
-                        &rerun::Capsules3D::from_lengths_and_radii([*length as f32], [*radius as f32]).with_colors([color]),
-                    ),
-                    Geometry::Sphere { radius } => rec.log_static(
-                        path.as_str(),
-                        &rerun::Ellipsoids3D::from_radii([*radius as f32]).with_colors([color]).with_fill_mode(rerun::FillMode::Solid),
-                    ),
-                    Geometry::Mesh { path: file, .. } => {
-                        let asset = rerun::Asset3D::from_file_path(file).map_err(|err| Error::output(file, err))?;
-                        rec.log_static(path.as_str(), &asset.with_albedo_factor(color.0))
-                    }
+                // a checked link turns red in contact: its colour is then temporal, not static
+                let highlighted = self.collisions.as_ref().is_some_and(|c| c.checked(f));
+                let kind = log_geometry(rec, &path, &visual.geometry, (!highlighted).then_some(color)).map_err(|m| self.err(m))?;
+                if let (true, Some(c)) = (highlighted, self.collisions.as_mut()) {
+                    c.register(f, Recolour { path, kind, colour: color });
                 }
-                .map_err(e)?;
+            }
+        }
+        if let Some(c) = self.collisions.as_mut() {
+            let tool = link_entity(&model.frames[model.tool_frame].name);
+            if let Err(m) = c.log_world(rec, &tool) {
+                return Err(self.err(m));
             }
         }
         Ok(())
@@ -355,6 +344,10 @@ impl RerunRecorder {
         )
         .map_err(e)?;
         rec.log_static("tool_error", &rerun::SeriesLines::new().with_names(["tool tip error |p − p_cmd| (m)"]).with_colors([rerun::Color::from_rgb(230, 60, 60)])).map_err(e)?;
+        if self.collisions.is_some() {
+            rec.log_static("collisions/in_contact", &rerun::SeriesLines::new().with_names(["pairs in contact"]).with_colors([super::rrd_collisions::CONTACT])).map_err(e)?;
+            rec.log_static("collisions/min_distance", &rerun::SeriesLines::new().with_names(["closest pair distance (m; < 0: overlap)"]).with_colors([rerun::Color::from_rgb(60, 90, 220)])).map_err(e)?;
+        }
         Ok(())
     }
 
@@ -404,6 +397,10 @@ impl RerunRecorder {
         }
         send("tool/position", time.clone(), scalars(&self.tool, 3))?;
         send("tool_error", time.clone(), scalars(&self.tool_error, 1))?;
+        if let Some(c) = &self.collisions {
+            send("collisions/in_contact", time.clone(), scalars(&c.count, 1))?;
+            send("collisions/min_distance", time.clone(), scalars(&c.min_distance, 1))?;
+        }
         if !self.trail_times.is_empty() {
             let times = TimeColumn::new_duration_secs(TIMELINE, self.trail_times.iter().copied());
             let strips = rerun::LineStrips3D::update_fields().with_strips(self.trail_strips.iter().cloned()).columns_of_unit_batches().map_err(|x| self.err(x))?;
@@ -426,6 +423,9 @@ impl RerunRecorder {
         }
         self.tool.clear();
         self.tool_error.clear();
+        if let Some(c) = self.collisions.as_mut() {
+            c.flush(&rec).map_err(|x| self.err(x))?;
+        }
         self.trail_times.clear();
         self.trail_strips.clear();
         if send_poses {
@@ -509,7 +509,7 @@ fn link_entity(name: &str) -> String {
     format!("world/robot/{name}")
 }
 
-fn transform(pose: &Pose) -> rerun::Transform3D {
+pub(super) fn transform(pose: &Pose) -> rerun::Transform3D {
     let t = pose.translation;
     rerun::Transform3D::from_translation_mat3x3([t.x as f32, t.y as f32, t.z as f32], mat3(pose))
 }
@@ -556,7 +556,7 @@ pub fn joint_color(j: usize) -> rerun::Color {
 /// With steppers driven open loop (`stepped`), a third row: each one's load angle and lost steps.
 /// Each torque view's y range is `torque_axes`' (the motion's own torque, the limit beside it where
 /// near; [`TorqueAxis`]): returned beside the blueprint as (view, half range), for [`send_blueprint`].
-pub fn blueprint(joint_names: &[String], stepped: &[bool], heated: &[bool], torque_axes: &[TorqueAxis], prefix: &str) -> (Blueprint, Vec<(rerun::EntityPath, f64)>) {
+pub fn blueprint(joint_names: &[String], stepped: &[bool], heated: &[bool], collisions: bool, torque_axes: &[TorqueAxis], prefix: &str) -> (Blueprint, Vec<(rerun::EntityPath, f64)>) {
     let angle_views = joint_names.iter().map(|j| {
         TimeSeriesView::new(format!("{j} angle vs target"))
             .with_origin(format!("{prefix}joints/{j}"))
@@ -590,6 +590,17 @@ pub fn blueprint(joint_names: &[String], stepped: &[bool], heated: &[bool], torq
     if !windings.is_empty() {
         left_views.push(TimeSeriesView::new("motor winding temperature (°C)").with_origin(format!("/{prefix}joints")).with_contents(windings).into());
         left_shares.push(1.0);
+    }
+    if collisions {
+        left_views.push(
+            Horizontal::new([
+                TimeSeriesView::new("pairs in contact").with_origin(format!("{prefix}collisions/in_contact")).into(),
+                TimeSeriesView::new("closest pair within 5 cm (m)").with_origin(format!("{prefix}collisions/min_distance")).into(),
+                rerun::blueprint::TextLogView::new("contacts").with_origin(format!("{prefix}collisions/events")).into(),
+            ])
+            .into(),
+        );
+        left_shares.push(1.2);
     }
     let left = Vertical::new(left_views).with_row_shares(left_shares);
     let stepper_views: Vec<_> = joint_names
@@ -709,13 +720,14 @@ impl Recorder for RerunRecorder {
             .map(|(frame, f)| MovingLink { frame, entity: link_entity(&f.name), translations: Vec::with_capacity(cap), rotations: Vec::with_capacity(cap) })
             .collect();
         self.model = Some(e.model.clone());
+        self.collisions = e.collisions.clone().map(|c| RrdCollisions::new(e.model.clone(), c));
         self.steps_per_trail_point = ((1.0 / TRAIL_RATE_HZ) / e.config.dt).round().max(1.0) as usize;
         self.steps_per_pose = super::steps_per_pose(e.config.dt);
 
         // the layout: a live viewer needs it now (scaled by the motion's torque); a file gets it at
         // the end, scaled by what the run did as well
         if self.live {
-            let (layout, torque_ranges) = blueprint(&self.joint_names, &self.stepped, &self.heated, &run.torque_axes, "");
+            let (layout, torque_ranges) = blueprint(&self.joint_names, &self.stepped, &self.heated, self.collisions.is_some(), &run.torque_axes, "");
             send_blueprint(&rec, &layout, &torque_ranges).map_err(|x| self.err(x))?;
         }
         self.log_static_scene(&rec, model)?;
@@ -775,6 +787,9 @@ impl Recorder for RerunRecorder {
         let p = s.tool_position;
         self.tool.extend_from_slice(&[p.x, p.y, p.z]);
         self.tool_error.push(s.tool_error());
+        if let Some(c) = self.collisions.as_mut() {
+            c.record(s);
+        }
         let tip = [p.x as f32, p.y as f32, p.z as f32];
         if s.k.is_multiple_of(self.steps_per_pose) || s.is_final {
             let model = self.model.as_deref().expect("started");
@@ -811,7 +826,7 @@ impl Recorder for RerunRecorder {
         let settled = |i: usize| summary.peak_abs_torque_after_settle.get(i).copied().flatten();
         let axes: Vec<_> = run.torque_axes.iter().enumerate().map(|(i, axis)| axis.after_run(settled(i))).collect();
         if !self.live || axes != run.torque_axes {
-            let (layout, torque_ranges) = blueprint(&self.joint_names, &self.stepped, &self.heated, &axes, "");
+            let (layout, torque_ranges) = blueprint(&self.joint_names, &self.stepped, &self.heated, self.collisions.is_some(), &axes, "");
             send_blueprint(&rec, &layout, &torque_ranges).map_err(|x| self.err(x))?;
         }
         if self.path.points().len() > 1 {

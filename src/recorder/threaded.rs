@@ -41,6 +41,9 @@ struct SampleBlock {
     friction: Vec<f64>,
     stuck: Vec<bool>,
     winding_temperature: Vec<f64>,
+    /// Every sample's close pairs back to back, and where each sample's end.
+    collisions: Vec<crate::collision::PairDistance>,
+    collisions_end: Vec<usize>,
     tool: Vec<Vector3<f64>>,
     tool_target: Vec<Vector3<f64>>,
     body_pose: Vec<Pose>,
@@ -70,6 +73,8 @@ impl SampleBlock {
             friction: Vec::new(),
             stuck: Vec::new(),
             winding_temperature: Vec::new(),
+            collisions: Vec::new(),
+            collisions_end: Vec::with_capacity(capacity),
             tool: Vec::with_capacity(capacity),
             tool_target: Vec::with_capacity(capacity),
             body_pose: Vec::with_capacity(capacity * bodies),
@@ -99,6 +104,8 @@ impl SampleBlock {
         self.friction.extend_from_slice(s.friction);
         self.stuck.extend_from_slice(s.stuck);
         self.winding_temperature.extend_from_slice(s.winding_temperature);
+        self.collisions.extend_from_slice(s.collisions);
+        self.collisions_end.push(self.collisions.len());
         self.tool.push(s.tool_position);
         self.tool_target.push(s.tool_target);
         self.body_pose.extend_from_slice(s.body_pose);
@@ -126,6 +133,7 @@ impl SampleBlock {
             friction: if self.friction.is_empty() { &[] } else { &self.friction[a..b] },
             stuck: if self.stuck.is_empty() { &[] } else { &self.stuck[a..b] },
             winding_temperature: if self.winding_temperature.is_empty() { &[] } else { &self.winding_temperature[a..b] },
+            collisions: &self.collisions[if i == 0 { 0 } else { self.collisions_end[i - 1] }..self.collisions_end[i]],
             tool_position: self.tool[i],
             tool_target: self.tool_target[i],
             body_pose: &self.body_pose[i * self.bodies..(i + 1) * self.bodies],
@@ -147,6 +155,8 @@ impl Reusable for SampleBlock {
         self.at_limit.clear();
         self.friction.clear();
         self.stuck.clear();
+        self.collisions.clear();
+        self.collisions_end.clear();
         self.tool.clear();
         self.tool_target.clear();
         self.body_pose.clear();

@@ -1,0 +1,233 @@
+//! The collision checks in the `.mcap`: a `/collisions` channel per control step (pairs in contact,
+//! the smallest distance within 5 cm, the pairs' names — protobuf `armscope.CollisionState`), the
+//! scene's objects and the payload drawn with the robot's geometry, and `/collisions/contacts`, a
+//! `SceneUpdate` that paints the links and objects in contact red. Each contacts message replaces
+//! the whole set (all deleted, those in contact added), so the latest one, all a viewer reads after
+//! seeking, is right on its own; it is sent only when the set changes.
+
+use super::contacts::{Body, ContactTracker, pair_name};
+use crate::collision::Collisions;
+use crate::model::{Geometry, Model};
+use crate::spatial::Pose;
+use foxglove::messages::{Color, CubePrimitive, CylinderPrimitive, SceneEntity, SceneEntityDeletion, SceneUpdate, SpherePrimitive, Timestamp, Vector3};
+use prost::Message;
+use prost_types::field_descriptor_proto::{Label, Type};
+use prost_types::{DescriptorProto, FieldDescriptorProto, FileDescriptorProto, FileDescriptorSet};
+use std::sync::Arc;
+
+pub const TOPIC_COLLISIONS: &str = "/collisions";
+pub const TOPIC_CONTACTS: &str = "/collisions/contacts";
+pub const SCHEMA_NAME: &str = "armscope.CollisionState";
+
+/// One control step's collision check.
+#[derive(Clone, PartialEq, Message)]
+pub struct CollisionState {
+    /// Simulation time, s.
+    #[prost(double, tag = "1")]
+    pub time: f64,
+    /// Pairs in contact (distance ≤ 0).
+    #[prost(uint32, tag = "2")]
+    pub in_contact: u32,
+    /// The smallest distance among the checked pairs, m (negative: overlap); NaN when none is
+    /// within 5 cm.
+    #[prost(double, tag = "3")]
+    pub min_distance: f64,
+    /// The pairs within 5 cm, nearest first, "link — other".
+    #[prost(string, repeated, tag = "4")]
+    pub pairs: Vec<String>,
+    /// Their distances, m, in the same order.
+    #[prost(double, repeated, tag = "5")]
+    pub distances: Vec<f64>,
+}
+
+pub fn file_descriptor_set() -> Vec<u8> {
+    let field = |name: &str, number: i32, repeated: bool, r#type: Type| FieldDescriptorProto {
+        name: Some(name.into()),
+        number: Some(number),
+        label: Some(if repeated { Label::Repeated } else { Label::Optional } as i32),
+        r#type: Some(r#type as i32),
+        json_name: Some(name.into()),
+        ..Default::default()
+    };
+    let message = DescriptorProto {
+        name: Some("CollisionState".into()),
+        field: vec![
+            field("time", 1, false, Type::Double),
+            field("in_contact", 2, false, Type::Uint32),
+            field("min_distance", 3, false, Type::Double),
+            field("pairs", 4, true, Type::String),
+            field("distances", 5, true, Type::Double),
+        ],
+        ..Default::default()
+    };
+    let file = FileDescriptorProto {
+        name: Some("armscope/collision_state.proto".into()),
+        package: Some("armscope".into()),
+        message_type: vec![message],
+        syntax: Some("proto3".into()),
+        ..Default::default()
+    };
+    FileDescriptorSet { file: vec![file] }.encode_to_vec()
+}
+
+impl foxglove::Encode for CollisionState {
+    type Error = prost::EncodeError;
+
+    fn get_schema() -> Option<foxglove::Schema> {
+        Some(foxglove::Schema::new(SCHEMA_NAME, "protobuf", file_descriptor_set()))
+    }
+
+    fn get_message_encoding() -> String {
+        "protobuf".into()
+    }
+
+    fn encode(&self, buf: &mut impl bytes::BufMut) -> Result<(), Self::Error> {
+        Message::encode(self, buf)
+    }
+
+    fn encoded_len(&self) -> Option<usize> {
+        Some(Message::encoded_len(self))
+    }
+}
+
+const RED: Color = Color { r: 0.92, g: 0.12, b: 0.12, a: 0.75 };
+const SCENE_GREY: Color = Color { r: 0.6, g: 0.6, b: 0.65, a: 0.6 };
+const PAYLOAD: Color = Color { r: 0.8, g: 0.63, b: 0.24, a: 1.0 };
+
+fn pose(p: &Pose) -> foxglove::messages::Pose {
+    let t = p.translation;
+    let [x, y, z, w] = p.quaternion_xyzw();
+    foxglove::messages::Pose { position: Some(Vector3 { x: t.x, y: t.y, z: t.z }), orientation: Some(foxglove::messages::Quaternion { x, y, z, w }) }
+}
+
+/// `geometry` at `origin` as primitives in `entity`, grown by `grow` (m, each side: a highlight over
+/// the link's own surfaces); a mesh as its bounding box.
+fn add_primitives(entity: &mut SceneEntity, geometry: &Geometry, origin: &Pose, colour: Color, grow: f64) {
+    let v = |x: f64, y: f64, z: f64| Some(Vector3 { x: x + 2.0 * grow, y: y + 2.0 * grow, z: z + 2.0 * grow });
+    match geometry {
+        Geometry::Box { size } => entity.cubes.push(CubePrimitive { pose: Some(pose(origin)), size: v(size[0], size[1], size[2]), color: Some(colour) }),
+        Geometry::Cylinder { radius, length } | Geometry::Capsule { radius, length } => {
+            entity.cylinders.push(CylinderPrimitive { pose: Some(pose(origin)), size: v(2.0 * radius, 2.0 * radius, *length), bottom_scale: 1.0, top_scale: 1.0, color: Some(colour) });
+            if matches!(geometry, Geometry::Capsule { .. }) {
+                for end in [-0.5, 0.5] {
+                    let cap = origin.compose(&Pose::new(nalgebra::Matrix3::identity(), nalgebra::Vector3::new(0.0, 0.0, end * length)));
+                    entity.spheres.push(SpherePrimitive { pose: Some(pose(&cap)), size: v(2.0 * radius, 2.0 * radius, 2.0 * radius), color: Some(colour) });
+                }
+            }
+        }
+        Geometry::Sphere { radius } => entity.spheres.push(SpherePrimitive { pose: Some(pose(origin)), size: v(2.0 * radius, 2.0 * radius, 2.0 * radius), color: Some(colour) }),
+        Geometry::Mesh { .. } => {
+            if let Ok(shape) = crate::collision::geometry::parry_shape(geometry) {
+                let aabb = shape.compute_local_aabb();
+                let (c, h) = (aabb.center(), aabb.half_extents());
+                let centre = origin.compose(&Pose::new(nalgebra::Matrix3::identity(), nalgebra::Vector3::new(c.x, c.y, c.z)));
+                entity.cubes.push(CubePrimitive { pose: Some(pose(&centre)), size: v(2.0 * h.x, 2.0 * h.y, 2.0 * h.z), color: Some(colour) });
+            }
+        }
+    }
+}
+
+/// The recorder's collision state over a run.
+pub struct McapCollisions {
+    model: Arc<Model>,
+    collisions: Arc<Collisions>,
+    tracker: ContactTracker,
+    pub state: CollisionState,
+    /// Per link, its names of pairs (cached: the names are built once per pair).
+    names: std::collections::HashMap<(usize, crate::collision::Against), String>,
+}
+
+impl McapCollisions {
+    pub fn new(model: Arc<Model>, collisions: Arc<Collisions>) -> Self {
+        let tracker = ContactTracker::new(&model, &collisions);
+        Self { model, collisions, tracker, state: CollisionState::default(), names: Default::default() }
+    }
+
+    /// The scene's objects (in the world frame; the floor a thin square plate) and the payload (on the
+    /// tool), drawn with the robot's geometry.
+    pub fn world_entities(&self) -> Vec<SceneEntity> {
+        let mut out = Vec::new();
+        for shape in &self.collisions.world {
+            let mut entity = SceneEntity { frame_id: "world".into(), id: format!("scene-{}", shape.name), frame_locked: true, ..Default::default() };
+            match &shape.drawn {
+                Some((g, p)) => add_primitives(&mut entity, g, p, SCENE_GREY, 0.0),
+                None => {
+                    let z = shape.pose.translation.z;
+                    add_primitives(&mut entity, &Geometry::Box { size: [2.0, 2.0, 0.002] }, &Pose::new(nalgebra::Matrix3::identity(), nalgebra::Vector3::new(0.0, 0.0, z - 0.001)), SCENE_GREY, 0.0);
+                }
+            }
+            out.push(entity);
+        }
+        if let Some((g, p)) = &self.collisions.payload {
+            let tool = &self.model.frames[self.model.tool_frame].name;
+            let mut entity = SceneEntity { frame_id: tool.clone(), id: "payload".into(), frame_locked: true, ..Default::default() };
+            add_primitives(&mut entity, g, p, PAYLOAD, 0.0);
+            out.push(entity);
+        }
+        out
+    }
+
+    /// Fill `state` from one sample; a contacts update when what is in contact changed.
+    pub fn record(&mut self, s: &crate::sample::Sample, timestamp: Timestamp) -> Option<SceneUpdate> {
+        let (model, collisions) = (&self.model, &self.collisions);
+        let st = &mut self.state;
+        st.time = s.t;
+        st.in_contact = s.collisions.iter().filter(|p| p.distance <= 0.0).count() as u32;
+        st.min_distance = s.collisions.first().map_or(f64::NAN, |p| p.distance);
+        st.pairs.clear();
+        st.distances.clear();
+        for p in s.collisions {
+            st.pairs.push(self.names.entry((p.a, p.b)).or_insert_with(|| pair_name(model, collisions, (p.a, p.b))).clone());
+            st.distances.push(p.distance);
+        }
+        if !self.tracker.update(s.collisions) {
+            return None;
+        }
+        let mut entities = Vec::new();
+        let mut touching: Vec<Body> = Vec::new();
+        for &(a, b) in self.tracker.pairs() {
+            touching.push(Body::Link(a));
+            touching.push(match b {
+                crate::collision::Against::Link(f) => Body::Link(f),
+                crate::collision::Against::World(w) => Body::World(w),
+            });
+        }
+        touching.dedup();
+        let mut seen = Vec::new();
+        for body in touching {
+            if seen.contains(&body) {
+                continue;
+            }
+            seen.push(body);
+            let entity = match body {
+                Body::Link(f) => {
+                    let frame = &model.frames[f];
+                    let mut e = SceneEntity { timestamp: Some(timestamp), frame_id: frame.name.clone(), id: format!("contact-{}", frame.name), frame_locked: true, ..Default::default() };
+                    for c in &frame.collisions {
+                        add_primitives(&mut e, &c.geometry, &c.origin, RED, 0.002);
+                    }
+                    if let (true, Some((g, p))) = (f == model.tool_frame, &collisions.payload) {
+                        add_primitives(&mut e, g, p, RED, 0.002);
+                    }
+                    e
+                }
+                Body::World(w) => {
+                    let shape = &collisions.world[w];
+                    let mut e = SceneEntity { timestamp: Some(timestamp), frame_id: "world".into(), id: format!("contact-scene-{}", shape.name), frame_locked: true, ..Default::default() };
+                    match &shape.drawn {
+                        Some((g, p)) => add_primitives(&mut e, g, p, RED, 0.002),
+                        None => {
+                            let z = shape.pose.translation.z;
+                            add_primitives(&mut e, &Geometry::Box { size: [2.0, 2.0, 0.002] }, &Pose::new(nalgebra::Matrix3::identity(), nalgebra::Vector3::new(0.0, 0.0, z - 0.001)), RED, 0.001);
+                        }
+                    }
+                    e
+                }
+            };
+            entities.push(entity);
+        }
+        // every entity of this topic deleted before those in contact now are added
+        let all = foxglove::messages::scene_entity_deletion::Type::All as i32;
+        Some(SceneUpdate { deletions: vec![SceneEntityDeletion { timestamp: Some(timestamp), r#type: all, id: String::new() }], entities })
+    }
+}
