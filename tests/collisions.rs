@@ -241,7 +241,9 @@ fn model_writes_the_srdf_of_pairs_that_never_touch() {
 
 /// `size` checks the commanded motion for self-collision: a ±90° wave folds the box model's forearm
 /// into its base, and the sizing says so and is no valid one (exit 1, `verified` false, the pair and
-/// time in size.json); the tutorial's ±30° wave collides nowhere and sizes as before.
+/// time in size.json); the tutorial's ±30° wave collides nowhere and sizes as before. The chosen
+/// set's full simulation is checked at every control step too (with a floor: the simulated arm
+/// meets it where the command does not).
 #[test]
 fn size_refuses_a_motion_that_collides() {
     let dir = tempfile::tempdir().unwrap();
@@ -257,6 +259,26 @@ fn size_refuses_a_motion_that_collides() {
     assert!(c[2].is_string() && c[3].is_string() && c[1].as_f64().unwrap() >= 0.0, "{c}");
     let (code, tutorial) = size("30", "tutorial");
     assert_eq!((code, tutorial["collision"].is_null()), (0, true));
+    // the chosen set's full simulation is checked at every control step as well: no contact, and
+    // the closest approach is the one a run with those drives reports
+    let simulated = &tutorial["simulated_collisions"][0][1];
+    assert!(simulated["first_contact"].is_null() && simulated["pairs_checked"] == 15, "{simulated}");
+    // with a floor at −0.2 m (size takes --floor too): the command stays above it in these 2 s,
+    // but the chosen drives' arm sags through it — the full simulation's check finds it, the sizing
+    // is no valid one, and a run of the written motor file with the same flags meets the floor at
+    // the same step
+    let out = dir.path().join("floor");
+    let code = common::armscope(&["size", "--floor", "-0.2", "--duration", "2", "--candidates", "17HS4401,23HS22-2804S,XM540-W270", "--parts-in-urdf", "--out", out.to_str().unwrap()]);
+    let floor: Value = serde_json::from_str(&std::fs::read_to_string(out.join("size.json")).unwrap()).unwrap();
+    let simulated = &floor["simulated_collisions"][0][1]["first_contact"];
+    assert_eq!((code, floor["verified"].as_bool(), floor["collision"].is_null()), (1, Some(false), true), "{floor}");
+    assert_eq!((simulated[1].as_str(), simulated[2].as_str()), (Some("tool_link"), Some("floor")), "{simulated}");
+    assert!(std::fs::read_to_string(out.join("size.md")).unwrap().contains("**The simulated arm collides**"));
+    let summary = dir.path().join("run.json");
+    let motors = out.join("motors.toml");
+    assert_eq!(common::armscope(&["run", "--quiet", "--motors", motors.to_str().unwrap(), "--duration", "2", "--auto-tune", "--floor", "-0.2", "--summary-json", summary.to_str().unwrap()]), 0);
+    let run: Value = serde_json::from_str(&std::fs::read_to_string(&summary).unwrap()).unwrap();
+    assert_eq!(run["summary"]["collisions"]["first_contact"], *simulated, "the run of the chosen motors");
 }
 
 /// A bad scene file stops `run` and `trajectory` before anything is written: exit 2 and one line

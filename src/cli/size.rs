@@ -31,6 +31,16 @@ pub struct SizeArgs {
     /// A payload at the tool, kg.
     #[arg(long, default_value_t = 0.0)]
     pub payload: f64,
+    /// Check the motion against a scene file's objects, floor and payload shape too (TOML; see
+    /// `armscope run --scene`). Self-collision is always checked.
+    #[arg(long, value_name = "FILE")]
+    pub scene: Option<PathBuf>,
+    /// Check the motion against a floor at this height (world z, m; without a value, at the base's).
+    #[arg(long, value_name = "Z", num_args = 0..=1, default_missing_value = "NaN", allow_negative_numbers = true)]
+    pub floor: Option<f64>,
+    /// An SRDF whose <disable_collisions> pairs are not checked (default: the one beside the URDF).
+    #[arg(long, value_name = "FILE")]
+    pub srdf: Option<PathBuf>,
     /// A catalogue of your own, on top of the built-in assets/motors/catalogue.toml (its entries
     /// added, or replacing built-in ones of the same name).
     #[arg(long, value_name = "FILE")]
@@ -167,6 +177,9 @@ fn motions(args: &SizeArgs) -> Result<Vec<(String, RunConfig)>, Error> {
         // servo candidates under PD: gains tuned to the arm with their rotors (the tutorial's gains
         // chatter on the box model's wrist at 1 kHz, and a chattering servo shakes the steppers)
         auto_tune: true,
+        scene: args.scene.clone(),
+        floor: args.floor,
+        srdf: args.srdf.clone(),
         ..RunConfig::default()
     };
     let Some(path) = &args.manifest else {
@@ -188,6 +201,9 @@ fn motions(args: &SizeArgs) -> Result<Vec<(String, RunConfig)>, Error> {
         if args.payload > 0.0 {
             config.payload = args.payload;
         }
+        config.scene = config.scene.or_else(|| args.scene.clone());
+        config.floor = config.floor.or(args.floor);
+        config.srdf = config.srdf.or_else(|| args.srdf.clone());
         out.push((e.name.clone(), config));
     }
     let urdf = &out[0].1.urdf;

@@ -204,9 +204,18 @@ impl SizeReport {
         if let Some((experiment, t, a, b)) = &self.collision {
             md += &format!("\n**The motion collides**: {a} with {b} at t = {t:.2} s of '{experiment}' (its commanded path, checked every 10 ms): no valid sizing until the motion is changed.\n");
         }
+        for (experiment, c) in &self.simulated_collisions {
+            match &c.first_contact {
+                Some((t, a, b)) => md += &format!("\n**The simulated arm collides** in '{experiment}': {a} with {b} at t = {t:.3} s, {} control steps in contact ({} checked): the chosen drives' tracking error takes it there; no valid sizing until the motion (or its clearance) is changed.\n", c.steps_in_contact, c.checked),
+                None => {
+                    let closest = c.pairs.first().map_or("none closer than 5 cm".to_string(), |p| format!("closest {} — {}, {:.1} mm at t = {:.2} s", p.link1, p.link2, 1e3 * p.closest, p.closest_at));
+                    md += &format!("\nCollisions in the chosen set's simulation of '{experiment}': none ({}; {closest}).\n", c.checked);
+                }
+            }
+        }
         md += &format!(
             "\n{} ({} simulation rounds, {} simulations).\n\nWhy not the nearest rejected candidates:\n\n",
-            if self.verified { "The chosen set passed its full simulation, every joint at once" } else if self.collision.is_some() { "The set was simulated, but the motion collides" } else { "**The chosen set did not pass its full simulation**" },
+            if self.verified { "The chosen set passed its full simulation, every joint at once" } else if self.collision.is_some() || self.simulated_collisions.iter().any(|(_, c)| c.first_contact.is_some()) { "The set was simulated, but the motion collides" } else { "**The chosen set did not pass its full simulation**" },
             self.rounds,
             self.simulations
         );

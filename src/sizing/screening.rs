@@ -283,6 +283,10 @@ pub struct SizeReport {
     /// checked every 10 ms of the command; None: it never does.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub collision: Option<(String, f64, String, String)>,
+    /// The chosen set's full simulation, checked for collisions at every control step (the arm as it
+    /// moves, tracking error included): per motion, its collision summary.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub simulated_collisions: Vec<(String, crate::collision::CollisionSummary)>,
     pub simulations: usize,
     /// The duty the thermal check used, s.
     pub duty_seconds: f64,
@@ -791,6 +795,24 @@ pub fn size(request: &SizeRequest) -> Result<SizeReport, Error> {
             }
         }
     }
+    // the chosen set's motion, checked for collisions at every control step (the commanded path
+    // was checked before; the arm as it moves, with its tracking error, is checked here)
+    let simulated_collisions = if collision.is_none() && joints.iter().any(|js| js.chosen.is_some()) {
+        let set: Vec<Option<usize>> = joints.iter().map(|js| js.chosen).collect();
+        simulations += request.motions.len();
+        request
+            .motions
+            .iter()
+            .map(|(name, config)| {
+                let experiment = Experiment::with_motors(RunConfig { collisions: true, ..config.clone() }, request.model.clone(), Some(motor_set(request, &joints, &set)?))?;
+                let summary = crate::sim::simulate(&experiment, &mut [], None)?;
+                Ok((name.clone(), summary.collisions.unwrap_or_default()))
+            })
+            .collect::<Result<Vec<_>, Error>>()?
+    } else {
+        Vec::new()
+    };
+    let simulated_contact = simulated_collisions.iter().any(|(_, c)| c.first_contact.is_some());
     let drive_mass_kg = {
         let set: Vec<Option<usize>> = joints.iter().map(|js| js.chosen).collect();
         motor_set(request, &joints, &set)?.joints.iter().flatten().map(|d| d.mass()).sum()
@@ -815,8 +837,9 @@ pub fn size(request: &SizeRequest) -> Result<SizeReport, Error> {
         motors: request.motors.clone(),
         joints,
         rounds,
-        verified: verified && collision.is_none(),
+        verified: verified && collision.is_none() && !simulated_contact,
         collision,
+        simulated_collisions,
         simulations,
         duty_seconds: duty,
         duty_unchecked: request
