@@ -40,5 +40,30 @@ fn checks(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, checks);
+/// The bar: a run checked at every control step against the same run unchecked (no
+/// recorders). The box model's default wave (3 s), the SmallRobotArm mesh model's (3 s), and the
+/// Panda (meshes, its SRDF) on a ±90° wave when example-robot-data is installed where the CI puts it
+/// (ARMSCOPE_PANDA_URDF overrides).
+fn runs(c: &mut Criterion) {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut group = c.benchmark_group("run_3s");
+    group.sample_size(10);
+    let panda = std::env::var("ARMSCOPE_PANDA_URDF").map(std::path::PathBuf::from).unwrap_or_else(|_| {
+        std::path::PathBuf::from(std::env::var("HOME").unwrap_or_default()).join(".cache/armscope-corpus-venv/lib/python3.11/site-packages/cmeel.prefix/share/example-robot-data/robots/panda_description/urdf/panda.urdf")
+    });
+    let mut models = vec![("box_model", root.join("assets/smallrobot_arm.urdf"), 30.0), ("smallrobotarm_meshes", root.join("assets/smallrobotarm/smallrobotarm.urdf"), 30.0)];
+    if panda.is_file() {
+        models.push(("panda", panda, 90.0));
+    }
+    for (name, urdf, amp) in models {
+        for checked in [false, true] {
+            let config = armscope::config::RunConfig { urdf: urdf.clone(), duration: 3.0, amp_deg: amp, collisions: checked, ..Default::default() };
+            let experiment = armscope::experiment::Experiment::prepare(config).unwrap();
+            group.bench_function(format!("{name}/{}", if checked { "checked" } else { "unchecked" }), |b| b.iter(|| black_box(armscope::sim::simulate(&experiment, &mut [], None).unwrap().peak_abs_torque.len())));
+        }
+    }
+    group.finish();
+}
+
+criterion_group!(benches, checks, runs);
 criterion_main!(benches);
