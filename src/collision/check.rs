@@ -49,6 +49,8 @@ pub struct CollisionData {
     rotations: Vec<[f64; 4]>,
     /// Per pair of shapes, in the order `check_state` visits them.
     measured: Vec<Option<Measured>>,
+    /// Per pair of meshes, the pair of triangles found closest last time.
+    warm: Vec<Option<(u32, u32)>>,
 }
 
 /// A pair of shapes' distance when last measured, and where both shapes were then.
@@ -64,7 +66,7 @@ struct Measured {
 impl CollisionData {
     pub fn new(shapes: &CollisionModel) -> Self {
         let n = shapes.shapes.len();
-        Self { poses: vec![PPose::identity(); n], centres: vec![nalgebra::Vector3::zeros(); n], rotations: vec![[0.0, 0.0, 0.0, 1.0]; n], measured: Vec::new() }
+        Self { poses: vec![PPose::identity(); n], centres: vec![nalgebra::Vector3::zeros(); n], rotations: vec![[0.0, 0.0, 0.0, 1.0]; n], measured: Vec::new(), warm: Vec::new() }
     }
 
     /// How far any point of shape `i` (bounding radius `radius`) can have moved since it was at
@@ -83,6 +85,13 @@ impl CollisionData {
             None => f64::NEG_INFINITY,
             Some(m) => m.distance - self.moved(i, radius_i, &m.centre_a, &m.rotation_a) - j.map_or(0.0, |(j, radius_j)| self.moved(j, radius_j, &m.centre_b, &m.rotation_b)),
         }
+    }
+
+    fn warm_start(&mut self, k: usize) -> &mut Option<(u32, u32)> {
+        if self.warm.len() <= k {
+            self.warm.resize(k + 1, None);
+        }
+        &mut self.warm[k]
     }
 
     fn remember(&mut self, k: usize, distance: f64, i: usize, j: Option<usize>) {
@@ -145,7 +154,13 @@ fn to_parry(p: &Pose) -> PPose {
 /// overlap its contact depth (negative). A mesh is a surface (as coal reads it): overlapping, it has
 /// no depth to measure, and the pair's distance is 0 (parry's depth search over two meshes' triangles
 /// cost ~4 ms a state on the Panda, for a number with no meaning there).
-fn signed_distance(p1: &PPose, s1: &SharedShape, p2: &PPose, s2: &SharedShape) -> f64 {
+///
+/// Two meshes: their distance by [`super::mesh_distance`] when below `limit`, else `limit` (a lower
+/// bound), starting from the pair of triangles `warm` found closest last time.
+fn signed_distance(p1: &PPose, s1: &SharedShape, p2: &PPose, s2: &SharedShape, limit: f64, warm: &mut Option<(u32, u32)>) -> f64 {
+    if let (Some(m1), Some(m2)) = (s1.as_trimesh(), s2.as_trimesh()) {
+        return super::mesh_distance::mesh_mesh_distance(p1, m1, p2, m2, limit, warm);
+    }
     let d = match (s1.as_support_map(), s2.as_support_map()) {
         (Some(a), Some(b)) => parry3d_f64::query::details::distance_support_map_support_map(&p1.inv_mul(p2), a, b),
         // a mesh: a yes/no intersection test first (it stops at the first crossing pair of triangles)
@@ -196,7 +211,9 @@ pub fn check_state(model: &Model, shapes: &CollisionModel, pairs: &[(usize, usiz
                 if gap > limit || data.lower_bound(k - 1, i, si.bounding_radius, Some((j, sj.bounding_radius))) > limit {
                     continue;
                 }
-                let d = signed_distance(&data.poses[i], &si.shape, &data.poses[j], &sj.shape);
+                let mut warm = *data.warm_start(k - 1);
+                let d = signed_distance(&data.poses[i], &si.shape, &data.poses[j], &sj.shape, limit, &mut warm);
+                data.warm[k - 1] = warm;
                 data.remember(k - 1, d, i, Some(j));
                 best = best.min(d);
             }
@@ -218,7 +235,9 @@ pub fn check_state(model: &Model, shapes: &CollisionModel, pairs: &[(usize, usiz
                 if fixed.gap(&data.centres[i], s.bounding_radius) > limit || data.lower_bound(k - 1, i, s.bounding_radius, None) > limit {
                     continue;
                 }
-                let d = signed_distance(&fixed.pose, &fixed.shape, &data.poses[i], &s.shape);
+                let mut warm = *data.warm_start(k - 1);
+                let d = signed_distance(&fixed.pose, &fixed.shape, &data.poses[i], &s.shape, limit, &mut warm);
+                data.warm[k - 1] = warm;
                 data.remember(k - 1, d, i, None);
                 best = best.min(d);
             }
