@@ -149,6 +149,9 @@ impl StickSlipSolver {
     /// Starts from the pieces of the last solve.
     pub fn solve(&mut self, a: &[f64], diagonal: &[f64], b: &[f64], laws: &[JointLaw], x: &mut [f64], g: &mut [f64]) -> Result<(), NotPositiveDefinite> {
         let n = self.n;
+        if self.solve_free(a, diagonal, b, laws, x, g)? {
+            return Ok(());
+        }
         for ((p, points), law) in self.piece.iter_mut().zip(&mut self.points).zip(laws) {
             *points = law.breakpoints();
             let (first, last) = law.piece_range(points.1);
@@ -184,6 +187,44 @@ impl StickSlipSolver {
         }
         self.fallbacks += 1;
         self.coordinate_descent(a, diagonal, b, laws, x, g)
+    }
+
+    /// Without friction (every law's slopes 0), the unconstrained solution when it lies within every
+    /// bound: then it is the solution (the problem is strictly convex), found by the same factorization
+    /// and arithmetic as the pivoting's first solve from those pieces, so bit for bit the same — without
+    /// the pivoting's bookkeeping, which was a fifth of a frictionless plant step away from the
+    /// limits. Returns false (x overwritten) when friction or a bound calls for the pivoting.
+    fn solve_free(&mut self, a: &[f64], diagonal: &[f64], b: &[f64], laws: &[JointLaw], x: &mut [f64], g: &mut [f64]) -> Result<bool, NotPositiveDefinite> {
+        if laws.iter().any(|l| l.below != 0.0 || l.above != 0.0) {
+            return Ok(false);
+        }
+        let n = self.n;
+        self.factor.as_mut_slice().copy_from_slice(a);
+        for i in 0..n {
+            self.factor[(i, i)] += diagonal[i];
+        }
+        let factored = match &self.tree_parents {
+            Some(parents) => ltdl_in_place(&mut self.factor, parents),
+            None => cholesky_in_place(&mut self.factor),
+        };
+        if !factored {
+            return Err(NotPositiveDefinite);
+        }
+        x.copy_from_slice(b);
+        match &self.tree_parents {
+            Some(parents) => ltdl_solve_in_place(&self.factor, parents, x),
+            None => cholesky_solve_in_place(&self.factor, x),
+        }
+        // strictly within: on a bound the pivoting decides whether the joint rests on it
+        if !x.iter().zip(laws).all(|(xi, l)| l.lower < *xi && *xi < l.upper) {
+            return Ok(false);
+        }
+        // each joint on the segment between its bounds (2 past a finite lower bound, else 0)
+        for (p, law) in self.piece.iter_mut().zip(laws) {
+            *p = if law.lower.is_finite() { 2 } else { 0 };
+        }
+        g.fill(0.0);
+        Ok(true)
     }
 
     /// The linear system for the current pieces: x_i fixed on a breakpoint, g_i = the slope on a
@@ -397,6 +438,42 @@ mod tests {
             }
         }
         a
+    }
+
+    #[test]
+    fn frictionless_shortcut_is_the_pivoting_bit_for_bit() {
+        // the shortcut's solution, where it applies, equals the pivoting's from the free pieces
+        // exactly; where the free solution leaves a bound the pivoting takes over and the conditions hold
+        let mut seed = 0x9E37_79B9_7F4A_7C15u64;
+        let (mut shortcut, mut pivoted) = (0, 0);
+        for case in 0..400 {
+            let n = 1 + case % 7;
+            let a = random_spd(n, &mut seed);
+            let b: Vec<f64> = random_spd(n, &mut seed)[..n].to_vec();
+            let width = if case % 2 == 0 { 10.0 } else { 0.3 };
+            let laws: Vec<JointLaw> = (0..n).map(|i| JointLaw { lower: -width * (1.0 + i as f64 * 0.1), upper: width, below: 0.0, above: 0.0 }).collect();
+            let diagonal = vec![0.01; n];
+            let mut solver = StickSlipSolver::new(n, None);
+            let (mut x, mut g) = (vec![0.0; n], vec![0.0; n]);
+            solver.solve(&a, &diagonal, &b, &laws, &mut x, &mut g).unwrap();
+            let inside = x.iter().zip(&laws).all(|(xi, l)| l.lower < *xi && *xi < l.upper);
+            if inside {
+                shortcut += 1;
+                let mut reference = StickSlipSolver::new(n, None);
+                reference.piece.iter_mut().zip(&laws).for_each(|(p, l)| *p = if l.lower.is_finite() { 2 } else { 0 });
+                reference.points.iter_mut().zip(&laws).for_each(|(p, l)| *p = l.breakpoints());
+                let mut y = vec![0.0; n];
+                reference.solve_on_pieces(&a, &diagonal, &b, &laws, &mut y).unwrap();
+                assert!(x.iter().zip(&y).all(|(p, q)| p.to_bits() == q.to_bits()), "case {case}: {x:?} vs {y:?}");
+                assert!((0..n).all(|i| solver.limit_side(&laws, i) == 0) && g.iter().all(|&gi| gi == 0.0));
+            } else {
+                pivoted += 1;
+                for i in 0..n {
+                    assert!(optimality_violation(&laws[i], x[i], g[i]) <= 1e-12, "case {case}, joint {i}");
+                }
+            }
+        }
+        assert!(shortcut > 50 && pivoted > 50, "both paths exercised: {shortcut} / {pivoted}");
     }
 
     #[test]
