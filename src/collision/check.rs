@@ -2,6 +2,7 @@
 //! the pairs in contact, and every pair closer than a threshold.
 
 use super::CollisionModel;
+use super::hull::MeshHull;
 use crate::model::Model;
 use crate::spatial::Pose;
 use parry3d_f64::math::{Pose as PPose, Vector};
@@ -51,6 +52,8 @@ pub struct CollisionData {
     measured: Vec<Option<Measured>>,
     /// Per pair of meshes, the pair of triangles found closest last time.
     warm: Vec<Option<(u32, u32)>>,
+    /// Per pair with a mesh, the triangles its hull's closest points were last found on.
+    hull_hints: Vec<(u32, u32)>,
 }
 
 /// A pair of shapes' distance when last measured, and where both shapes were then.
@@ -66,7 +69,7 @@ struct Measured {
 impl CollisionData {
     pub fn new(shapes: &CollisionModel) -> Self {
         let n = shapes.shapes.len();
-        Self { poses: vec![PPose::identity(); n], centres: vec![nalgebra::Vector3::zeros(); n], rotations: vec![[0.0, 0.0, 0.0, 1.0]; n], measured: Vec::new(), warm: Vec::new() }
+        Self { poses: vec![PPose::identity(); n], centres: vec![nalgebra::Vector3::zeros(); n], rotations: vec![[0.0, 0.0, 0.0, 1.0]; n], measured: Vec::new(), warm: Vec::new(), hull_hints: Vec::new() }
     }
 
     /// How far any point of shape `i` (bounding radius `radius`) can have moved since it was at
@@ -90,6 +93,7 @@ impl CollisionData {
     fn warm_start(&mut self, k: usize) -> &mut Option<(u32, u32)> {
         if self.warm.len() <= k {
             self.warm.resize(k + 1, None);
+            self.hull_hints.resize(k + 1, (0, 0));
         }
         &mut self.warm[k]
     }
@@ -112,6 +116,8 @@ pub struct WorldShape {
     pub bound: WorldBound,
     /// What the recordings draw: a scene object's geometry and its pose in the world (None: the floor).
     pub drawn: Option<(crate::model::Geometry, Pose)>,
+    /// A mesh's convex hull ([`super::hull`]).
+    pub hull: Option<std::sync::Arc<super::hull::MeshHull>>,
 }
 
 pub enum WorldBound {
@@ -122,7 +128,7 @@ pub enum WorldBound {
 impl WorldShape {
     /// A floor at height `z` (world z, m).
     pub fn floor(z: f64) -> Self {
-        Self { name: "floor".into(), shape: SharedShape::halfspace(Vector::new(0.0, 0.0, 1.0)), pose: PPose::from_translation(Vector::new(0.0, 0.0, z)), bound: WorldBound::Below(z), drawn: None }
+        Self { name: "floor".into(), shape: SharedShape::halfspace(Vector::new(0.0, 0.0, 1.0)), pose: PPose::from_translation(Vector::new(0.0, 0.0, z)), bound: WorldBound::Below(z), drawn: None, hull: None }
     }
 
     /// A scene object: `geometry` at `pose` in the world.
@@ -131,7 +137,8 @@ impl WorldShape {
         let placed = super::geometry::shape_pose(geometry, pose);
         let sphere = shape.compute_local_bounding_sphere();
         let centre = placed.transform_point(&nalgebra::Vector3::new(sphere.center.x, sphere.center.y, sphere.center.z));
-        Ok(Self { name: name.to_string(), shape, pose: to_parry(&placed), bound: WorldBound::Sphere { centre, radius: sphere.radius }, drawn: Some((geometry.clone(), *pose)) })
+        let hull = shape.as_trimesh().and_then(super::hull::MeshHull::new).map(std::sync::Arc::new);
+        Ok(Self { name: name.to_string(), shape, pose: to_parry(&placed), bound: WorldBound::Sphere { centre, radius: sphere.radius }, drawn: Some((geometry.clone(), *pose)), hull })
     }
 
     /// How far a sphere at `centre` of `radius` is from this shape's bound at least.
@@ -157,7 +164,13 @@ fn to_parry(p: &Pose) -> PPose {
 ///
 /// Two meshes: their distance by [`super::mesh_distance`] when below `limit`, else `limit` (a lower
 /// bound), starting from the pair of triangles `warm` found closest last time.
-fn signed_distance(p1: &PPose, s1: &SharedShape, p2: &PPose, s2: &SharedShape, limit: f64, warm: &mut Option<(u32, u32)>) -> f64 {
+#[allow(clippy::too_many_arguments)]
+fn signed_distance(p1: &PPose, s1: &SharedShape, h1: Option<&MeshHull>, p2: &PPose, s2: &SharedShape, h2: Option<&MeshHull>, limit: f64, warm: &mut Option<(u32, u32)>, hints: &mut (u32, u32)) -> f64 {
+    if (h1.is_some() || h2.is_some())
+        && let Some(d) = super::hull::certified_distance(p1, s1, h1, p2, s2, h2, limit, hints)
+    {
+        return d;
+    }
     if let (Some(m1), Some(m2)) = (s1.as_trimesh(), s2.as_trimesh()) {
         return super::mesh_distance::mesh_mesh_distance(p1, m1, p2, m2, limit, warm);
     }
@@ -192,8 +205,18 @@ fn signed_distance(p1: &PPose, s1: &SharedShape, p2: &PPose, s2: &SharedShape, l
 #[allow(clippy::too_many_arguments)]
 pub fn check_state(model: &Model, shapes: &CollisionModel, pairs: &[(usize, usize)], world: &[WorldShape], data: &mut CollisionData, frame_pose: impl Fn(usize) -> Pose, threshold: f64, out: &mut StateCollisions) {
     out.close.clear();
+    // a link's shapes follow each other: its pose is worked out once for them
+    let mut link: Option<(usize, Pose)> = None;
     for (i, s) in shapes.shapes.iter().enumerate() {
-        let pose = frame_pose(s.frame).compose(&s.origin);
+        let frame = match link {
+            Some((f, pose)) if f == s.frame => pose,
+            _ => {
+                let pose = frame_pose(s.frame);
+                link = Some((s.frame, pose));
+                pose
+            }
+        };
+        let pose = frame.compose(&s.origin);
         data.centres[i] = pose.transform_point(&s.bounding_centre);
         data.rotations[i] = pose.quaternion_xyzw();
         let [x, y, z, w] = data.rotations[i];
@@ -212,8 +235,10 @@ pub fn check_state(model: &Model, shapes: &CollisionModel, pairs: &[(usize, usiz
                     continue;
                 }
                 let mut warm = *data.warm_start(k - 1);
-                let d = signed_distance(&data.poses[i], &si.shape, &data.poses[j], &sj.shape, limit, &mut warm);
+                let mut hints = data.hull_hints[k - 1];
+                let d = signed_distance(&data.poses[i], &si.shape, si.hull.as_deref(), &data.poses[j], &sj.shape, sj.hull.as_deref(), limit, &mut warm, &mut hints);
                 data.warm[k - 1] = warm;
+                data.hull_hints[k - 1] = hints;
                 data.remember(k - 1, d, i, Some(j));
                 best = best.min(d);
             }
@@ -236,8 +261,10 @@ pub fn check_state(model: &Model, shapes: &CollisionModel, pairs: &[(usize, usiz
                     continue;
                 }
                 let mut warm = *data.warm_start(k - 1);
-                let d = signed_distance(&fixed.pose, &fixed.shape, &data.poses[i], &s.shape, limit, &mut warm);
+                let mut hints = data.hull_hints[k - 1];
+                let d = signed_distance(&fixed.pose, &fixed.shape, fixed.hull.as_deref(), &data.poses[i], &s.shape, s.hull.as_deref(), limit, &mut warm, &mut hints);
                 data.warm[k - 1] = warm;
+                data.hull_hints[k - 1] = hints;
                 data.remember(k - 1, d, i, None);
                 best = best.min(d);
             }

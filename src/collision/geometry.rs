@@ -16,6 +16,8 @@ pub struct LinkShape {
     pub bounding_radius: f64,
     /// Where the bounding sphere's centre sits in the shape's frame.
     pub bounding_centre: nalgebra::Vector3<f64>,
+    /// A mesh's convex hull, the exact shortcut for its distances ([`super::hull`]).
+    pub hull: Option<std::sync::Arc<super::hull::MeshHull>>,
 }
 
 /// The collision shapes of a model, and the notices made building them.
@@ -92,7 +94,8 @@ impl CollisionModel {
         let sphere = shape.compute_local_bounding_sphere();
         let centre = nalgebra::Vector3::new(sphere.center.x, sphere.center.y, sphere.center.z);
         self.of_frame[f].push(self.shapes.len());
-        self.shapes.push(LinkShape { frame: f, origin: shape_pose(geometry, origin), shape, bounding_radius: sphere.radius, bounding_centre: centre });
+        let hull = shape.as_trimesh().and_then(super::hull::MeshHull::new).map(std::sync::Arc::new);
+        self.shapes.push(LinkShape { frame: f, origin: shape_pose(geometry, origin), shape, bounding_radius: sphere.radius, bounding_centre: centre, hull });
         Ok(())
     }
 

@@ -10,6 +10,7 @@
 
 pub mod check;
 pub mod geometry;
+pub mod hull;
 mod mesh_distance;
 pub mod pairs;
 pub mod run_log;
