@@ -50,10 +50,17 @@ pub struct CollisionData {
     rotations: Vec<[f64; 4]>,
     /// Per pair of shapes, in the order `check_state` visits them.
     measured: Vec<Option<Measured>>,
-    /// Per pair of meshes, the pair of triangles found closest last time.
-    warm: Vec<Option<(u32, u32)>>,
-    /// Per pair with a mesh, the triangles its hull's closest points were last found on.
-    hull_hints: Vec<(u32, u32)>,
+    /// Per pair of shapes, where the last measurement found its closest points.
+    warm: Vec<WarmStart>,
+}
+
+/// Where a pair's closest points were found last time, to start the next search there.
+#[derive(Clone, Copy, Debug, Default)]
+struct WarmStart {
+    /// Two meshes: the pair of triangles found closest.
+    triangles: Option<(u32, u32)>,
+    /// A mesh's hull: the triangles of each mesh its closest points lay on.
+    hull: (u32, u32),
 }
 
 /// A pair of shapes' distance when last measured, and where both shapes were then.
@@ -69,7 +76,7 @@ struct Measured {
 impl CollisionData {
     pub fn new(shapes: &CollisionModel) -> Self {
         let n = shapes.shapes.len();
-        Self { poses: vec![PPose::identity(); n], centres: vec![nalgebra::Vector3::zeros(); n], rotations: vec![[0.0, 0.0, 0.0, 1.0]; n], measured: Vec::new(), warm: Vec::new(), hull_hints: Vec::new() }
+        Self { poses: vec![PPose::identity(); n], centres: vec![nalgebra::Vector3::zeros(); n], rotations: vec![[0.0, 0.0, 0.0, 1.0]; n], measured: Vec::new(), warm: Vec::new() }
     }
 
     /// How far any point of shape `i` (bounding radius `radius`) can have moved since it was at
@@ -90,10 +97,9 @@ impl CollisionData {
         }
     }
 
-    fn warm_start(&mut self, k: usize) -> &mut Option<(u32, u32)> {
+    fn warm_start(&mut self, k: usize) -> &mut WarmStart {
         if self.warm.len() <= k {
-            self.warm.resize(k + 1, None);
-            self.hull_hints.resize(k + 1, (0, 0));
+            self.warm.resize(k + 1, WarmStart::default());
         }
         &mut self.warm[k]
     }
@@ -137,7 +143,7 @@ impl WorldShape {
         let placed = super::geometry::shape_pose(geometry, pose);
         let sphere = shape.compute_local_bounding_sphere();
         let centre = placed.transform_point(&nalgebra::Vector3::new(sphere.center.x, sphere.center.y, sphere.center.z));
-        let hull = shape.as_trimesh().and_then(super::hull::MeshHull::new).map(std::sync::Arc::new);
+        let hull = MeshHull::of(&shape);
         Ok(Self { name: name.to_string(), shape, pose: to_parry(&placed), bound: WorldBound::Sphere { centre, radius: sphere.radius }, drawn: Some((geometry.clone(), *pose)), hull })
     }
 
@@ -162,17 +168,18 @@ fn to_parry(p: &Pose) -> PPose {
 /// no depth to measure, and the pair's distance is 0 (parry's depth search over two meshes' triangles
 /// cost ~4 ms a state on the Panda, for a number with no meaning there).
 ///
-/// Two meshes: their distance by [`super::mesh_distance`] when below `limit`, else `limit` (a lower
-/// bound), starting from the pair of triangles `warm` found closest last time.
+/// A mesh with its hull (`h1`, `h2`): first through the hull where that is exact
+/// ([`super::hull`]). Two meshes: their distance by [`super::mesh_distance`] when below `limit`, else
+/// `limit` (a lower bound). `warm`: where both searches found the closest points last time, updated.
 #[allow(clippy::too_many_arguments)]
-fn signed_distance(p1: &PPose, s1: &SharedShape, h1: Option<&MeshHull>, p2: &PPose, s2: &SharedShape, h2: Option<&MeshHull>, limit: f64, warm: &mut Option<(u32, u32)>, hints: &mut (u32, u32)) -> f64 {
+fn signed_distance(p1: &PPose, s1: &SharedShape, h1: Option<&MeshHull>, p2: &PPose, s2: &SharedShape, h2: Option<&MeshHull>, limit: f64, warm: &mut WarmStart) -> f64 {
     if (h1.is_some() || h2.is_some())
-        && let Some(d) = super::hull::certified_distance(p1, s1, h1, p2, s2, h2, limit, hints)
+        && let Some(d) = super::hull::certified_distance(p1, s1, h1, p2, s2, h2, limit, &mut warm.hull)
     {
         return d;
     }
     if let (Some(m1), Some(m2)) = (s1.as_trimesh(), s2.as_trimesh()) {
-        return super::mesh_distance::mesh_mesh_distance(p1, m1, p2, m2, limit, warm);
+        return super::mesh_distance::mesh_mesh_distance(p1, m1, p2, m2, limit, &mut warm.triangles);
     }
     let d = match (s1.as_support_map(), s2.as_support_map()) {
         (Some(a), Some(b)) => parry3d_f64::query::details::distance_support_map_support_map(&p1.inv_mul(p2), a, b),
@@ -235,10 +242,8 @@ pub fn check_state(model: &Model, shapes: &CollisionModel, pairs: &[(usize, usiz
                     continue;
                 }
                 let mut warm = *data.warm_start(k - 1);
-                let mut hints = data.hull_hints[k - 1];
-                let d = signed_distance(&data.poses[i], &si.shape, si.hull.as_deref(), &data.poses[j], &sj.shape, sj.hull.as_deref(), limit, &mut warm, &mut hints);
+                let d = signed_distance(&data.poses[i], &si.shape, si.hull.as_deref(), &data.poses[j], &sj.shape, sj.hull.as_deref(), limit, &mut warm);
                 data.warm[k - 1] = warm;
-                data.hull_hints[k - 1] = hints;
                 data.remember(k - 1, d, i, Some(j));
                 best = best.min(d);
             }
@@ -261,10 +266,8 @@ pub fn check_state(model: &Model, shapes: &CollisionModel, pairs: &[(usize, usiz
                     continue;
                 }
                 let mut warm = *data.warm_start(k - 1);
-                let mut hints = data.hull_hints[k - 1];
-                let d = signed_distance(&fixed.pose, &fixed.shape, fixed.hull.as_deref(), &data.poses[i], &s.shape, s.hull.as_deref(), limit, &mut warm, &mut hints);
+                let d = signed_distance(&fixed.pose, &fixed.shape, fixed.hull.as_deref(), &data.poses[i], &s.shape, s.hull.as_deref(), limit, &mut warm);
                 data.warm[k - 1] = warm;
-                data.hull_hints[k - 1] = hints;
                 data.remember(k - 1, d, i, None);
                 best = best.min(d);
             }

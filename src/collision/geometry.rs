@@ -94,7 +94,7 @@ impl CollisionModel {
         let sphere = shape.compute_local_bounding_sphere();
         let centre = nalgebra::Vector3::new(sphere.center.x, sphere.center.y, sphere.center.z);
         self.of_frame[f].push(self.shapes.len());
-        let hull = shape.as_trimesh().and_then(super::hull::MeshHull::new).map(std::sync::Arc::new);
+        let hull = super::hull::MeshHull::of(&shape);
         self.shapes.push(LinkShape { frame: f, origin: shape_pose(geometry, origin), shape, bounding_radius: sphere.radius, bounding_centre: centre, hull });
         Ok(())
     }

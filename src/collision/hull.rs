@@ -55,6 +55,11 @@ impl SupportMap for MeshHull {
 }
 
 impl MeshHull {
+    /// A shape's hull when it is a mesh that has one.
+    pub fn of(shape: &SharedShape) -> Option<std::sync::Arc<Self>> {
+        shape.as_trimesh().and_then(Self::new).map(std::sync::Arc::new)
+    }
+
     /// The hull of `mesh`; None when it has none (a flat mesh).
     pub fn new(mesh: &TriMesh) -> Option<Self> {
         let vertices = mesh.vertices();
@@ -91,7 +96,7 @@ impl MeshHull {
         Some(Self { points, neighbours, last: 0.into(), surface })
     }
 
-    /// The mesh's triangles on the hull (for the notice and the tests).
+    /// How many of the mesh's triangles lie on the hull.
     pub fn surface_triangles(&self) -> usize {
         self.surface.len()
     }
@@ -144,17 +149,9 @@ pub fn certified_distance(pose1: &Pose, shape1: &SharedShape, hull1: Option<&Mes
         return Some(distance);
     }
     // p1 in shape 1's frame, p2 too (GJK's answer is in the first shape's frame)
-    if let Some(h) = hull1 {
-        if !h.on_surface(p1, &mut hints.0) {
-            return None;
-        }
-    }
-    if let Some(h) = hull2 {
-        if !h.on_surface(pos12.inverse_transform_point(p2), &mut hints.1) {
-            return None;
-        }
-    }
-    Some(distance)
+    let on_surface1 = hull1.is_none_or(|h| h.on_surface(p1, &mut hints.0));
+    let on_surface2 = on_surface1 && hull2.is_none_or(|h| h.on_surface(pos12.inverse_transform_point(p2), &mut hints.1));
+    on_surface2.then_some(distance)
 }
 
 #[cfg(test)]

@@ -198,23 +198,9 @@ impl StickSlipSolver {
         if laws.iter().any(|l| l.below != 0.0 || l.above != 0.0) {
             return Ok(false);
         }
-        let n = self.n;
-        self.factor.as_mut_slice().copy_from_slice(a);
-        for i in 0..n {
-            self.factor[(i, i)] += diagonal[i];
-        }
-        let factored = match &self.tree_parents {
-            Some(parents) => ltdl_in_place(&mut self.factor, parents),
-            None => cholesky_in_place(&mut self.factor),
-        };
-        if !factored {
-            return Err(NotPositiveDefinite);
-        }
+        self.load_matrix(a, diagonal);
         x.copy_from_slice(b);
-        match &self.tree_parents {
-            Some(parents) => ltdl_solve_in_place(&self.factor, parents, x),
-            None => cholesky_solve_in_place(&self.factor, x),
-        }
+        self.factor_and_substitute(x)?;
         // strictly within: on a bound the pivoting decides whether the joint rests on it
         if !x.iter().zip(laws).all(|(xi, l)| l.lower < *xi && *xi < l.upper) {
             return Ok(false);
@@ -231,10 +217,7 @@ impl StickSlipSolver {
     /// segment.
     fn solve_on_pieces(&mut self, a: &[f64], diagonal: &[f64], b: &[f64], laws: &[JointLaw], x: &mut [f64]) -> Result<(), NotPositiveDefinite> {
         let n = self.n;
-        self.factor.as_mut_slice().copy_from_slice(a);
-        for i in 0..n {
-            self.factor[(i, i)] += diagonal[i];
-        }
+        self.load_matrix(a, diagonal);
         self.rhs.copy_from_slice(b);
         for (j, law) in laws.iter().enumerate() {
             let piece = self.piece[j];
@@ -260,6 +243,21 @@ impl StickSlipSolver {
             self.factor[(j, j)] = 1.0;
             self.rhs[j] = fixed;
         }
+        x.copy_from_slice(&self.rhs);
+        self.factor_and_substitute(x)
+    }
+
+    /// A + diag into the factor's workspace.
+    fn load_matrix(&mut self, a: &[f64], diagonal: &[f64]) {
+        self.factor.as_mut_slice().copy_from_slice(a);
+        for (i, d) in diagonal.iter().enumerate() {
+            self.factor[(i, i)] += d;
+        }
+    }
+
+    /// Factor the workspace's matrix (along the tree, or dense Cholesky) and solve for `x`, which
+    /// holds the right-hand side on entry.
+    fn factor_and_substitute(&mut self, x: &mut [f64]) -> Result<(), NotPositiveDefinite> {
         let factored = match &self.tree_parents {
             Some(parents) => ltdl_in_place(&mut self.factor, parents),
             None => cholesky_in_place(&mut self.factor),
@@ -267,7 +265,6 @@ impl StickSlipSolver {
         if !factored {
             return Err(NotPositiveDefinite);
         }
-        x.copy_from_slice(&self.rhs);
         match &self.tree_parents {
             Some(parents) => ltdl_solve_in_place(&self.factor, parents, x),
             None => cholesky_solve_in_place(&self.factor, x),
