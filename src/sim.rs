@@ -56,7 +56,7 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
     let mut heat = crate::actuator::thermal::RunHeat::new(&experiment.motor_heat(), dt);
     let no_temperatures: Vec<f64> = Vec::new();
     // the collision checks, every control step (flags only: the motion is not changed)
-    let mut collision_check = experiment.collisions.as_ref().map(|c| (crate::collision::CollisionData::new(&c.shapes), crate::collision::StateCollisions::default(), crate::collision::RunLog::new(c)));
+    let mut collision_check = experiment.collisions.as_ref().map(|c| (crate::collision::CollisionData::for_run(&c.shapes), crate::collision::StateCollisions::default(), crate::collision::RunLog::new(c)));
 
     for k in 0..=experiment.steps {
         let t = k as f64 * dt;
@@ -85,7 +85,7 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
         body_poses(model, &cmd, &mut command_poses);
         let mut collided = None;
         if let (Some(c), Some((cd, state, log))) = (experiment.collisions.as_ref(), collision_check.as_mut()) {
-            crate::collision::check_state(model, &c.shapes, &c.pairs, &c.world, cd, |f| frame_pose(model, &data, f), COLLISION_BAND, state);
+            crate::collision::check_state(model, &c.shapes, &c.pairs, &c.world, cd, &data.body_pose, COLLISION_BAND, state);
             log.record(model, c, t, state);
             if experiment.config.stop_on_collision {
                 collided = state.colliding().next().map(|p| RunStatus::Collided { time: t, link1: model.frames[p.a].name.clone(), link2: c.name(model, p.b).to_string() });

@@ -16,8 +16,8 @@ pub struct LinkShape {
     pub bounding_radius: f64,
     /// Where the bounding sphere's centre sits in the shape's frame.
     pub bounding_centre: nalgebra::Vector3<f64>,
-    /// A mesh's convex hull, the exact shortcut for its distances ([`super::hull`]).
-    pub hull: Option<std::sync::Arc<super::hull::MeshHull>>,
+    /// What the distance queries keep of it beside parry's shape (a mesh's hull, a box's faces).
+    pub aids: super::aids::ShapeAids,
 }
 
 /// The collision shapes of a model, and the notices made building them.
@@ -94,8 +94,8 @@ impl CollisionModel {
         let sphere = shape.compute_local_bounding_sphere();
         let centre = nalgebra::Vector3::new(sphere.center.x, sphere.center.y, sphere.center.z);
         self.of_frame[f].push(self.shapes.len());
-        let hull = super::hull::MeshHull::of(&shape);
-        self.shapes.push(LinkShape { frame: f, origin: shape_pose(geometry, origin), shape, bounding_radius: sphere.radius, bounding_centre: centre, hull });
+        let aids = super::aids::ShapeAids::of(&shape);
+        self.shapes.push(LinkShape { frame: f, origin: shape_pose(geometry, origin), shape, bounding_radius: sphere.radius, bounding_centre: centre, aids });
         Ok(())
     }
 

@@ -24,7 +24,8 @@ pub struct MeshHull {
     /// Each hull vertex's neighbours along the hull's edges: the support point is found by climbing
     /// from the last one (on a convex polytope a vertex no neighbour beats is the farthest).
     neighbours: Vec<Vec<u32>>,
-    /// Where the last climb ended (shared by threads only as a starting guess).
+    /// Where the last climb ended (shared by threads only as a starting guess), for uses without a
+    /// pair's own [`HullWarmStart`].
     last: std::sync::atomic::AtomicU32,
     /// The mesh's triangles in a supporting plane of the hull (every vertex of the mesh on one side
     /// of its plane): the only ones the hull's closest point can lie on.
@@ -34,23 +35,36 @@ pub struct MeshHull {
 impl SupportMap for MeshHull {
     fn local_support_point(&self, dir: Vector) -> Vector {
         use std::sync::atomic::Ordering::Relaxed;
-        let mut at = self.last.load(Relaxed) as usize;
-        let mut best = self.points[at].dot(dir);
-        loop {
-            let mut next = at;
-            for &n in &self.neighbours[at] {
-                let d = self.points[n as usize].dot(dir);
-                if d > best {
-                    (best, next) = (d, n as usize);
-                }
-            }
-            if next == at {
-                break;
-            }
-            at = next;
-        }
-        self.last.store(at as u32, Relaxed);
-        self.points[at]
+        let at = self.climb(self.last.load(Relaxed), dir);
+        self.last.store(at, Relaxed);
+        self.points[at as usize]
+    }
+}
+
+/// What one pair of shapes found last time, to start the next search there: the surface
+/// triangles its closest points lay on, the hull vertices its support points were, and GJK's last
+/// simplex — its points as the pair of points on the two shapes, each in its own shape's frame, so
+/// that they are points of the two shapes wherever the shapes are now.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct HullWarmStart {
+    pub surface: (u32, u32),
+    pub climb: (u32, u32),
+    simplex: [(Vector, Vector); 4],
+    simplex_points: usize,
+}
+
+/// A hull whose support points are climbed to from where its pair's last search ended: from one
+/// control step to the next the support point moves by a vertex or none.
+struct Climbing<'a> {
+    hull: &'a MeshHull,
+    at: std::cell::Cell<u32>,
+}
+
+impl SupportMap for Climbing<'_> {
+    fn local_support_point(&self, dir: Vector) -> Vector {
+        let at = self.hull.climb(self.at.get(), dir);
+        self.at.set(at);
+        self.hull.points[at as usize]
     }
 }
 
@@ -96,6 +110,25 @@ impl MeshHull {
         Some(Self { points, neighbours, last: 0.into(), surface })
     }
 
+    /// The vertex farthest along `dir`, climbing the hull's edges from vertex `from`.
+    fn climb(&self, from: u32, dir: Vector) -> u32 {
+        let mut at = (from as usize).min(self.points.len() - 1);
+        let mut best = self.points[at].dot(dir);
+        loop {
+            let mut next = at;
+            for &n in &self.neighbours[at] {
+                let d = self.points[n as usize].dot(dir);
+                if d > best {
+                    (best, next) = (d, n as usize);
+                }
+            }
+            if next == at {
+                return at as u32;
+            }
+            at = next;
+        }
+    }
+
     /// How many of the mesh's triangles lie on the hull.
     pub fn surface_triangles(&self) -> usize {
         self.surface.len()
@@ -118,40 +151,117 @@ impl MeshHull {
     }
 }
 
-/// A shape's convex stand-in for GJK: a convex shape itself, or a mesh's hull.
-fn support<'a>(shape: &'a SharedShape, hull: Option<&'a MeshHull>) -> Option<&'a dyn SupportMap> {
-    match hull {
-        Some(h) => Some(h),
-        None => shape.as_support_map(),
+/// A shape's convex stand-in for GJK: a convex shape itself, or a mesh's hull climbed from `from`.
+enum Support<'a> {
+    Convex(&'a dyn SupportMap),
+    Hull(Climbing<'a>),
+}
+
+impl<'a> Support<'a> {
+    fn of(shape: &'a SharedShape, hull: Option<&'a MeshHull>, from: u32) -> Option<Self> {
+        match hull {
+            Some(hull) => Some(Support::Hull(Climbing { hull, at: from.into() })),
+            None => shape.as_support_map().map(Support::Convex),
+        }
+    }
+
+    fn map(&self) -> &dyn SupportMap {
+        match self {
+            Support::Convex(s) => *s,
+            Support::Hull(h) => h,
+        }
+    }
+
+    /// Where a hull's climb ended (a convex shape: `unchanged`).
+    fn climbed(&self, unchanged: u32) -> u32 {
+        match self {
+            Support::Convex(_) => unchanged,
+            Support::Hull(h) => h.at.get(),
+        }
     }
 }
 
-/// The distance of two shapes of which at least one is a mesh with its hull, when the hulls show
-/// it exactly: the hulls apart and the closest points on the meshes themselves; or the hulls'
-/// distance when it is above `limit` (then a lower bound, as the mesh–mesh search returns). None:
-/// measure the meshes. `hints`: the surface triangles found last time, updated.
-#[allow(clippy::too_many_arguments)]
-pub fn certified_distance(pose1: &Pose, shape1: &SharedShape, hull1: Option<&MeshHull>, pose2: &Pose, shape2: &SharedShape, hull2: Option<&MeshHull>, limit: f64, hints: &mut (u32, u32)) -> Option<f64> {
-    let (g1, g2) = (support(shape1, hull1)?, support(shape2, hull2)?);
-    let pos12 = pose1.inv_mul(pose2);
-    let dir = -pos12.translation;
-    let dir = if dir.length_squared() > 1e-24 { dir.normalize() } else { Vector::X };
-    let mut simplex = VoronoiSimplex::new();
-    simplex.reset(CsoPoint::from_shapes(&pos12, g1, g2, dir));
-    let GJKResult::ClosestPoints(p1, p2, _) = gjk::closest_points(&pos12, g1, g2, f64::MAX, true, &mut simplex) else {
+/// GJK's closest points of two convex shapes from `simplex` (both in the first shape's frame), and a
+/// lower bound of their distance that shows how exact they are: every point x of the shapes'
+/// difference has x·u ≥ s·u, with u the direction between the closest points and s the support
+/// point opposite it, so the distance is within [s·u, |p1 − p2|]. None: the shapes overlap.
+fn closest_points(pos12: &Pose, g1: &dyn SupportMap, g2: &dyn SupportMap, simplex: &mut VoronoiSimplex) -> Option<(Vector, Vector, f64)> {
+    let GJKResult::ClosestPoints(p1, p2, _) = gjk::closest_points(pos12, g1, g2, f64::MAX, true, simplex) else {
         return None;
     };
-    let distance = (p1 - p2).length();
-    if distance <= ON_SURFACE {
-        return None;
+    let u = (p1 - p2).normalize_or_zero();
+    let lower = CsoPoint::from_shapes(pos12, g1, g2, -u).point.dot(u);
+    Some((p1, p2, lower))
+}
+
+/// What the hulls of two shapes (at least one a mesh) show of the shapes' distance.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum HullDistance {
+    /// The shapes' distance: the hulls apart and their closest points on the meshes themselves; or a
+    /// lower bound of the hulls' distance when that is above the limit (as the mesh–mesh search
+    /// returns).
+    Exact(f64),
+    /// The hulls are apart (so are the shapes within them), but the distance is the meshes' to
+    /// measure: the hull's closest point lies in a dent of the mesh.
+    Apart,
+    /// The hulls touch or overlap: the meshes are to be measured, contact included.
+    Touching,
+}
+
+/// The distance of two shapes of which at least one is a mesh with its hull, when the hulls show
+/// it exactly ([`HullDistance`]; None: a shape has no support map). `warm`: where the pair's last
+/// search ended, updated — GJK starts from its last simplex (its points are points of the two
+/// shapes wherever they are, so their differences are points of the shapes' difference, as GJK's
+/// simplex must be; after a small motion the closest features are those of last time and GJK stops
+/// after one support point), and each hull's support points are climbed to from the last.
+#[allow(clippy::too_many_arguments)]
+pub fn certified_distance(pose1: &Pose, shape1: &SharedShape, hull1: Option<&MeshHull>, pose2: &Pose, shape2: &SharedShape, hull2: Option<&MeshHull>, limit: f64, warm: &mut HullWarmStart) -> Option<HullDistance> {
+    let (s1, s2) = (Support::of(shape1, hull1, warm.climb.0)?, Support::of(shape2, hull2, warm.climb.1)?);
+    let (g1, g2) = (s1.map(), s2.map());
+    let pos12 = pose1.inv_mul(pose2);
+    let mut simplex = VoronoiSimplex::new();
+    let kept = &warm.simplex[..warm.simplex_points];
+    let mut found = None;
+    if let Some((&(a, b), rest)) = kept.split_first() {
+        simplex.reset(CsoPoint::new(a, pos12.transform_point(b)));
+        for &(a, b) in rest {
+            simplex.add_point(CsoPoint::new(a, pos12.transform_point(b)));
+        }
+        // a simplex of points far from the closest ones can leave GJK stuck short of them (it
+        // drops a new point too close to the simplex's plane): then it starts afresh
+        found = closest_points(&pos12, g1, g2, &mut simplex).filter(|&(p1, p2, lower)| (p1 - p2).length() - lower <= ON_SURFACE);
     }
-    if distance > limit {
-        return Some(distance);
+    if found.is_none() {
+        let dir = -pos12.translation;
+        let dir = if dir.length_squared() > 1e-24 { dir.normalize() } else { Vector::X };
+        simplex.reset(CsoPoint::from_shapes(&pos12, g1, g2, dir));
+        found = closest_points(&pos12, g1, g2, &mut simplex);
+    }
+    warm.climb = (s1.climbed(warm.climb.0), s2.climbed(warm.climb.1));
+    let Some((p1, p2, lower)) = found else {
+        warm.simplex_points = 0;
+        return Some(HullDistance::Touching);
+    };
+    warm.simplex_points = simplex.dimension() + 1;
+    for i in 0..warm.simplex_points {
+        let p = simplex.point(i);
+        warm.simplex[i] = (p.orig1, pos12.inverse_transform_point(p.orig2));
+    }
+    if lower > limit {
+        return Some(HullDistance::Exact(lower));
+    }
+    let distance = (p1 - p2).length();
+    // touching hulls, or closest points GJK did not pin down: the meshes are measured
+    if distance <= ON_SURFACE {
+        return Some(HullDistance::Touching);
+    }
+    if distance - lower > ON_SURFACE {
+        return Some(if lower > 0.0 { HullDistance::Apart } else { HullDistance::Touching });
     }
     // p1 in shape 1's frame, p2 too (GJK's answer is in the first shape's frame)
-    let on_surface1 = hull1.is_none_or(|h| h.on_surface(p1, &mut hints.0));
-    let on_surface2 = on_surface1 && hull2.is_none_or(|h| h.on_surface(pos12.inverse_transform_point(p2), &mut hints.1));
-    on_surface2.then_some(distance)
+    let on_surface1 = hull1.is_none_or(|h| h.on_surface(p1, &mut warm.surface.0));
+    let on_surface2 = on_surface1 && hull2.is_none_or(|h| h.on_surface(pos12.inverse_transform_point(p2), &mut warm.surface.1));
+    Some(if on_surface2 { HullDistance::Exact(distance) } else { HullDistance::Apart })
 }
 
 #[cfg(test)]
@@ -221,8 +331,8 @@ mod tests {
                 (SharedShape::new(m), h)
             };
             let pose2 = random_pose(&mut seed, 0.12);
-            let mut hints = (0, 0);
-            let Some(d) = certified_distance(&pose1, &ball, Some(&hull), &pose2, &other, other_hull.as_deref(), f64::INFINITY, &mut hints) else {
+            let mut warm = HullWarmStart::default();
+            let Some(HullDistance::Exact(d)) = certified_distance(&pose1, &ball, Some(&hull), &pose2, &other, other_hull.as_deref(), f64::INFINITY, &mut warm) else {
                 refused += 1;
                 continue;
             };

@@ -8,6 +8,7 @@
 //! distances (a bounding-sphere broad phase, then parry's exact distance, and its contact depth for
 //! the pairs that overlap).
 
+pub mod aids;
 pub mod check;
 pub mod geometry;
 pub mod hull;
@@ -17,7 +18,7 @@ pub mod run_log;
 pub mod scene;
 pub mod srdf;
 
-pub use check::{Against, CollisionData, PairDistance, StateCollisions, WorldShape, check_state};
+pub use check::{Against, CollisionData, PairDistance, StateCollisions, Wanted, WorldShape, check_state};
 pub use scene::Scene;
 pub use geometry::{CollisionModel, LinkShape};
 pub use pairs::active_pairs;
@@ -125,7 +126,7 @@ impl Checker<'_> {
     pub fn check(&mut self, q: &[f64], threshold: f64) -> &StateCollisions {
         let (model, data) = (self.model, &mut self.data);
         crate::dynamics::forward_kinematics(model, data, q);
-        check_state(model, &self.collisions.shapes, &self.collisions.pairs, &self.collisions.world, &mut self.shapes, |f| crate::dynamics::frame_pose(model, data, f), threshold, &mut self.state);
+        check_state(model, &self.collisions.shapes, &self.collisions.pairs, &self.collisions.world, &mut self.shapes, &data.body_pose, threshold, &mut self.state);
         &self.state
     }
 

@@ -1,6 +1,6 @@
 //! The collision checks in the `.mcap`: a `/collisions` channel per control step (pairs in contact,
-//! the smallest distance within 5 cm, the pairs' names — protobuf `armscope.CollisionState`), the
-//! scene's objects and the payload drawn with the robot's geometry, and `/collisions/contacts`, a
+//! the smallest distance within 5 cm, the pairs in contact or else the nearest by name — protobuf
+//! `armscope.CollisionState`), the scene's objects and the payload drawn with the robot's geometry, and `/collisions/contacts`, a
 //! `SceneUpdate` that paints the links and objects in contact red. Each contacts message replaces
 //! the whole set (all deleted, those in contact added), so the latest one, all a viewer reads after
 //! seeking, is right on its own; it is sent only when the set changes.
@@ -32,7 +32,8 @@ pub struct CollisionState {
     /// within 5 cm.
     #[prost(double, tag = "3")]
     pub min_distance: f64,
-    /// The pairs within 5 cm, nearest first, "link — other".
+    /// The pairs in contact, or when none is, the nearest pair within 5 cm: "link — other",
+    /// nearest first.
     #[prost(string, repeated, tag = "4")]
     pub pairs: Vec<String>,
     /// Their distances, m, in the same order.
@@ -176,7 +177,7 @@ impl McapCollisions {
         st.min_distance = s.collisions.first().map_or(f64::NAN, |p| p.distance);
         st.pairs.clear();
         st.distances.clear();
-        for p in s.collisions {
+        for p in crate::collision::StateCollisions::in_contact_or_nearest(s.collisions) {
             st.pairs.push(self.names.entry((p.a, p.b)).or_insert_with(|| pair_name(model, collisions, (p.a, p.b))).clone());
             st.distances.push(p.distance);
         }
