@@ -42,8 +42,15 @@ impl SpatialInertia {
         let c = pose.transform_point(&body.com);
         let h = c * m;
         let r = &pose.rotation;
-        // R·I_c, then only the six distinct entries of (R·I_c)·Rᵀ
-        let ri = r * body.inertia_com;
+        // R·I_c, then only the six distinct entries of (R·I_c)·Rᵀ; a central inertia on its
+        // principal axes (most URDFs' links) only scales R's columns — the same numbers, as the
+        // full product's other terms are exact zeros
+        let i = &body.inertia_com;
+        let ri = if i[(0, 1)] == 0.0 && i[(0, 2)] == 0.0 && i[(1, 2)] == 0.0 && i[(1, 0)] == 0.0 && i[(2, 0)] == 0.0 && i[(2, 1)] == 0.0 {
+            Matrix3::from_columns(&[r.column(0) * i[(0, 0)], r.column(1) * i[(1, 1)], r.column(2) * i[(2, 2)]])
+        } else {
+            r * i
+        };
         let entry = |a: usize, b: usize| ri[(a, 0)] * r[(b, 0)] + ri[(a, 1)] * r[(b, 1)] + ri[(a, 2)] * r[(b, 2)];
         let (hx, hy, hz) = (h.x, h.y, h.z);
         let (cx, cy, cz) = (c.x, c.y, c.z);
@@ -144,6 +151,25 @@ mod tests {
         let expected = body().transformed(&pose()).spatial_matrix();
         let compact = SpatialInertia::of_body(&body(), &pose());
         assert!((compact.to_matrix() - expected).abs().max() < 1e-15);
+    }
+
+    /// A central inertia on its principal axes takes the shortcut, and gives the numbers of the
+    /// full product R·I_c·Rᵀ (equal as floats: at most a zero's sign differs).
+    #[test]
+    fn a_principal_axes_inertia_gives_the_full_products_numbers() {
+        let diagonal = RigidInertia { mass: 0.4, com: Vector3::new(0.09, 0.0, 0.0), inertia_com: Matrix3::from_diagonal(&Vector3::new(1.66e-4, 1.41e-3, 1.42e-3)) };
+        for (k, rpy) in [[0.3, -1.1, 2.0], [0.0, 0.0, 0.0], [0.0, std::f64::consts::FRAC_PI_2, 0.0], [-2.9, 0.4, 1.3]].iter().enumerate() {
+            let pose = Pose::from_xyz_rpy([0.1 * k as f64, -0.2, 0.7], *rpy);
+            let fast = SpatialInertia::of_body(&diagonal, &pose);
+            // the general path, by the same formula with a full matrix product
+            let r = &pose.rotation;
+            let ri = r * diagonal.inertia_com;
+            let entry = |a: usize, b: usize| ri[(a, 0)] * r[(b, 0)] + ri[(a, 1)] * r[(b, 1)] + ri[(a, 2)] * r[(b, 2)];
+            let c = pose.transform_point(&diagonal.com);
+            let h = c * diagonal.mass;
+            let full = [entry(0, 0) + (h.y * c.y + h.z * c.z), entry(1, 1) + (h.x * c.x + h.z * c.z), entry(2, 2) + (h.x * c.x + h.y * c.y), entry(0, 1) - h.x * c.y, entry(0, 2) - h.x * c.z, entry(1, 2) - h.y * c.z];
+            assert_eq!(fast.rotational, full, "rpy {rpy:?}");
+        }
     }
 
     #[test]
