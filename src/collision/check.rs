@@ -79,7 +79,6 @@ pub struct CollisionData {
     body_poses: Vec<Pose>,
     /// Per frame: its world pose worked out at a check (for the shapes measured), and which.
     frames: Vec<(Pose, u64)>,
-
     /// Per shape, worked out when a check needs it: its bounding sphere's centre and its pose as
     /// parry takes it, and the check they are of.
     placed: Vec<Placed>,
@@ -174,7 +173,6 @@ impl CollisionData {
             paths: Vec::new(),
             body_poses: Vec::new(),
             frames: vec![(Pose::identity(), 0); frames],
-
             placed: vec![Placed { centre: nalgebra::Vector3::zeros(), parry: None, check: 0 }; n],
             checks: Vec::new(),
             pairs: Vec::new(),

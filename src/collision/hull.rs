@@ -24,21 +24,9 @@ pub struct MeshHull {
     /// Each hull vertex's neighbours along the hull's edges: the support point is found by climbing
     /// from the last one (on a convex polytope a vertex no neighbour beats is the farthest).
     neighbours: Vec<Vec<u32>>,
-    /// Where the last climb ended (shared by threads only as a starting guess), for uses without a
-    /// pair's own [`HullWarmStart`].
-    last: std::sync::atomic::AtomicU32,
     /// The mesh's triangles in a supporting plane of the hull (every vertex of the mesh on one side
     /// of its plane): the only ones the hull's closest point can lie on.
     surface: Vec<Triangle>,
-}
-
-impl SupportMap for MeshHull {
-    fn local_support_point(&self, dir: Vector) -> Vector {
-        use std::sync::atomic::Ordering::Relaxed;
-        let at = self.climb(self.last.load(Relaxed), dir);
-        self.last.store(at, Relaxed);
-        self.points[at as usize]
-    }
 }
 
 /// What one pair of shapes found last time, to start the next search there: the surface
@@ -107,7 +95,7 @@ impl MeshHull {
                 above <= planar || below >= -planar
             })
             .collect();
-        Some(Self { points, neighbours, last: 0.into(), surface })
+        Some(Self { points, neighbours, surface })
     }
 
     /// The vertex farthest along `dir`, climbing the hull's edges from vertex `from`.
