@@ -244,6 +244,8 @@ pub struct McapRecorder {
     /// Simulated seconds between republished geometries: 1 for small scenes, longer for big meshes.
     scene_interval_s: i64,
     collisions: Option<super::mcap_collisions::McapCollisions>,
+    /// The last run's file at this path, freed meanwhile on another thread.
+    replaced: Option<super::output_file::Replaced>,
 }
 
 /// Points of the tool path at most in one piece (a piece every half simulated second at 20 Hz).
@@ -329,6 +331,7 @@ impl McapRecorder {
             motors: None,
             scene_interval_s: 1,
             collisions: None,
+            replaced: None,
         }
     }
 
@@ -487,7 +490,9 @@ impl Recorder for McapRecorder {
             Some(path) => {
                 // the Foxglove layout for this model, beside the recording
                 write_layout(run, path, &run.torque_axes)?;
-                Some(super::output_file::create_replacing(path).map_err(|err| self.err(err))?)
+                let (file, replaced) = super::output_file::create_replacing(path).map_err(|err| self.err(err))?;
+                self.replaced = Some(replaced);
+                Some(file)
             }
             None => None,
         };
@@ -758,6 +763,7 @@ impl Recorder for McapRecorder {
                 live.stop();
             }
         }
+        self.replaced = None;
         Ok(())
     }
 }

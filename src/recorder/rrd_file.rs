@@ -27,6 +27,8 @@ pub struct RrdFile {
 struct State {
     /// `None` once closed, or after a write failed.
     encoder: Option<RrdEncoder>,
+    /// The last run's file at this path, freed meanwhile on another thread.
+    _replaced: super::output_file::Replaced,
     error: Option<String>,
 }
 
@@ -38,14 +40,14 @@ pub const FOOTER_UP_TO_SECONDS: f64 = 600.0;
 impl RrdFile {
     /// `footer`: end the file with Rerun's manifest of its chunks.
     pub fn create(path: &Path, footer: bool) -> Result<Self, String> {
-        let file = super::output_file::create_replacing(path).map_err(|e| e.to_string())?;
+        let (file, replaced) = super::output_file::create_replacing(path).map_err(|e| e.to_string())?;
         // the encoder writes each message whole: a buffer smaller than a block's chunks (100–250 KB)
         // gathers the small messages and lets the chunks go straight to the file, uncopied
         let mut encoder = Encoder::new_eager(CrateVersion::LOCAL, EncodingOptions::PROTOBUF_UNCOMPRESSED, BufWriter::with_capacity(64 << 10, file)).map_err(|e| e.to_string())?;
         if !footer {
             encoder.do_not_emit_footer();
         }
-        Ok(Self { path: path.to_path_buf(), state: Arc::new(Mutex::new(State { encoder: Some(encoder), error: None })) })
+        Ok(Self { path: path.to_path_buf(), state: Arc::new(Mutex::new(State { encoder: Some(encoder), _replaced: replaced, error: None })) })
     }
 
     pub fn path(&self) -> &Path {
