@@ -55,6 +55,8 @@ pub fn run_experiment(experiment: &Experiment, outputs: Outputs, stop: Option<&A
     if let Some(out) = outputs.console {
         recorders.push(Box::new(Console::new(out)));
     }
+    // the recordings, each written on its own thread from one copy of the samples
+    let mut threaded = Threaded::new(RECORDER_LATENCY);
     if outputs.rrd.is_some() || outputs.live.is_some() {
         if let Some(path) = &outputs.rrd {
             create_parent(path)?;
@@ -63,7 +65,7 @@ pub fn run_experiment(experiment: &Experiment, outputs: Outputs, stop: Option<&A
         if let Some(notice) = outputs.notice {
             rrd.on_notice(notice);
         }
-        recorders.push(Box::new(Threaded::new(rrd, RECORDER_LATENCY)));
+        threaded = threaded.with(rrd);
     }
     if outputs.mcap.is_some() || outputs.foxglove.is_some() {
         if let Some(path) = &outputs.mcap {
@@ -73,7 +75,10 @@ pub fn run_experiment(experiment: &Experiment, outputs: Outputs, stop: Option<&A
         if let Some(notice) = outputs.notice {
             mcap.on_notice(notice);
         }
-        recorders.push(Box::new(Threaded::new(mcap, RECORDER_LATENCY)));
+        threaded = threaded.with(mcap);
+    }
+    if !threaded.is_empty() {
+        recorders.push(Box::new(threaded));
     }
     if let Some(factor) = outputs.realtime {
         recorders.push(Box::new(Pacer::new(factor)));

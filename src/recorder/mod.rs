@@ -1,6 +1,7 @@
 //! Recorders: everything that turns samples into output. The simulation loop knows only this
 //! trait; a new format is one new file.
 
+mod column_pool;
 mod console;
 mod contacts;
 pub mod foxglove_layout;

@@ -17,6 +17,8 @@ use rerun::blueprint::components::{PanelState, PlayState};
 use rerun::{RecordingStream, TimeColumn};
 use super::torque_axis::TorqueAxis;
 use super::rrd_collisions::{Recolour, RrdCollisions, log_geometry};
+use super::column_pool::ColumnPool;
+use rerun::external::arrow::buffer::{Buffer, OffsetBuffer};
 use std::collections::VecDeque;
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -71,11 +73,12 @@ struct JointColumns {
 }
 
 impl JointColumns {
-    fn with_capacity(n: usize) -> Self {
+    /// The columns sent at every block come from `pool` (see [`ColumnPool`]).
+    fn with_capacity(n: usize, pool: &ColumnPool<f64>) -> Self {
         Self {
-            position: Vec::with_capacity(2 * n),
-            torque: Vec::with_capacity(2 * n),
-            status: Vec::with_capacity(3 * n),
+            position: pool.take(2 * n),
+            torque: pool.take(2 * n),
+            status: pool.take(3 * n),
             saturated_times: Vec::new(),
             saturated_torque: Vec::new(),
             limit: Vec::new(),
@@ -141,6 +144,9 @@ pub struct RerunRecorder {
     heated: Vec<bool>,
     /// With collision checks: what is in contact, drawn and plotted.
     collisions: Option<RrdCollisions>,
+    /// Memory for the columns sent at every block, and for their row ids.
+    values_pool: ColumnPool<f64>,
+    ids_pool: ColumnPool<[u8; 16]>,
 }
 
 /// Steps per block in a file-only recording: ~4 s of simulation per chunk (fewer, larger chunks
@@ -185,6 +191,8 @@ impl RerunRecorder {
             notice_sink: None,
             heated: Vec::new(),
             collisions: None,
+            values_pool: ColumnPool::default(),
+            ids_pool: ColumnPool::default(),
         }
     }
 
@@ -194,8 +202,12 @@ impl RerunRecorder {
     }
 
     fn err(&self, e: impl std::fmt::Display) -> Error {
-        let path = self.options.file.clone().unwrap_or_else(|| PathBuf::from("rerun viewer"));
-        Error::output(&path, e)
+        Error::output(&self.output_path(), e)
+    }
+
+    /// What error messages name: the file, or the viewer.
+    fn output_path(&self) -> PathBuf {
+        self.options.file.clone().unwrap_or_else(|| PathBuf::from("rerun viewer"))
     }
 
     /// The stream to the file and the live viewer; `duration` the run's simulated time (a long run's
@@ -360,14 +372,24 @@ impl RerunRecorder {
         }
         let time = TimeColumn::new_duration_secs(TIMELINE, self.times.iter().copied());
         let steps = self.times.len();
-        let send = |entity: &str, time: TimeColumn, columns: Vec<rerun::SerializedComponentColumn>| send_in_order(&rec, entity, time, columns).map_err(|x| self.err(x));
+        let capacity = FILE_BLOCK_STEPS + 1;
+        // the list offsets of a column of `width` values per row: the same for every such column
+        let offsets: [OffsetBuffer<i32>; 3] = std::array::from_fn(|w| OffsetBuffer::from_lengths(std::iter::repeat_n(w + 1, steps)));
+        // the every-step columns move into Arrow and the recorder goes on in vectors from the pool
+        let (pool, ids) = (&self.values_pool, &self.ids_pool);
+        let lend = |values: &mut Vec<f64>, width: usize| {
+            debug_assert_eq!(values.len(), width * steps);
+            let full = std::mem::replace(values, pool.take(width * capacity));
+            vec![list_column(pool.buffer(full), offsets[width - 1].clone(), rerun::Scalars::descriptor_scalars())]
+        };
+        let out = self.output_path();
+        let send = |entity: &str, time: TimeColumn, columns: Vec<rerun::SerializedComponentColumn>| send_chunk_in_order(&rec, entity, time, columns, ids).map_err(|x| Error::output(&out, x));
         let scalars = |values: &[f64], width: usize| vec![scalar_column(values, width)];
         for (j, name) in self.joint_names.iter().enumerate() {
-            let c = &self.joints[j];
+            let c = &mut self.joints[j];
             let base = format!("joints/{name}");
-            for (leaf, values, width) in [("position", &c.position, 2), ("torque", &c.torque, 2), ("status", &c.status, 3)] {
-                debug_assert_eq!(values.len(), width * steps);
-                send(&format!("{base}/{leaf}"), time.clone(), scalars(values, width))?;
+            for (leaf, values, width) in [("position", &mut c.position, 2), ("torque", &mut c.torque, 2), ("status", &mut c.status, 3)] {
+                send(&format!("{base}/{leaf}"), time.clone(), lend(values, width))?;
             }
             if self.motors.as_ref().is_some_and(|m| m.joints[j].is_some()) {
                 send(&format!("{base}/motor_speed"), time.clone(), scalars(&c.motor_speed, 1))?;
@@ -395,16 +417,15 @@ impl RerunRecorder {
                 send(&format!("{base}/torque_limit"), ends, scalars(&[effort, -effort, effort, -effort], 2))?;
             }
         }
-        send("tool/position", time.clone(), scalars(&self.tool, 3))?;
-        send("tool_error", time.clone(), scalars(&self.tool_error, 1))?;
+        send("tool/position", time.clone(), lend(&mut self.tool, 3))?;
+        send("tool_error", time.clone(), lend(&mut self.tool_error, 1))?;
         if let Some(c) = &self.collisions {
             send("collisions/in_contact", time.clone(), scalars(&c.count, 1))?;
             send("collisions/min_distance", time.clone(), scalars(&c.min_distance, 1))?;
         }
         if !self.trail_times.is_empty() {
             let times = TimeColumn::new_duration_secs(TIMELINE, self.trail_times.iter().copied());
-            let strips = rerun::LineStrips3D::update_fields().with_strips(self.trail_strips.iter().cloned()).columns_of_unit_batches().map_err(|x| self.err(x))?;
-            send("world/tool/trail", times, strips.collect())?;
+            send("world/tool/trail", times, vec![strips_column(&self.trail_strips)])?;
         }
         let send_poses = !self.pose_times.is_empty() && (all || self.live || self.pose_times.len() >= FILE_BLOCK_STEPS);
         if send_poses {
@@ -447,13 +468,35 @@ impl RerunRecorder {
 /// Rerun's generic serialization first turns every value into an `Option` with a validity flag
 /// (a quarter of this recorder's thread's work, in memory that is new for every block).
 pub(crate) fn scalar_column(values: &[f64], width: usize) -> rerun::SerializedComponentColumn {
-    use rerun::external::arrow::array::{ArrayRef, Float64Array, ListArray};
-    use rerun::external::arrow::buffer::OffsetBuffer;
-    use rerun::external::arrow::datatypes::{DataType, Field};
-    let values: ArrayRef = Arc::new(Float64Array::from_iter_values(values.iter().copied()));
     let rows = values.len() / width;
-    let list = ListArray::new(Arc::new(Field::new_list_field(DataType::Float64, true)), OffsetBuffer::from_lengths(std::iter::repeat_n(width, rows)), values, None);
-    rerun::SerializedComponentColumn::new(list, rerun::Scalars::descriptor_scalars())
+    list_column(Buffer::from_slice_ref(values), OffsetBuffer::from_lengths(std::iter::repeat_n(width, rows)), rerun::Scalars::descriptor_scalars())
+}
+
+/// A column of float64 lists, the values' bytes in `values` and each row's in `offsets`.
+fn list_column(values: Buffer, offsets: OffsetBuffer<i32>, descriptor: rerun::ComponentDescriptor) -> rerun::SerializedComponentColumn {
+    use rerun::external::arrow::array::{ArrayRef, Float64Array, ListArray};
+    use rerun::external::arrow::buffer::ScalarBuffer;
+    use rerun::external::arrow::datatypes::{DataType, Field};
+    let count = values.len() / std::mem::size_of::<f64>();
+    let values: ArrayRef = Arc::new(Float64Array::new(ScalarBuffer::new(values, 0, count), None));
+    let list = ListArray::new(Arc::new(Field::new_list_field(DataType::Float64, true)), offsets, values, None);
+    rerun::SerializedComponentColumn::new(list, descriptor)
+}
+
+/// A `LineStrips3D` strips column, one strip per row, built straight from the points: what
+/// `LineStrips3D::update_fields().with_strips(..).columns_of_unit_batches()` makes (test below),
+/// without its generic serialization, a sixth of this recorder's thread for the tool's trail.
+fn strips_column(strips: &[Vec<[f32; 3]>]) -> rerun::SerializedComponentColumn {
+    use rerun::external::arrow::array::{ArrayRef, FixedSizeListArray, Float32Array, ListArray};
+    use rerun::external::arrow::datatypes::{DataType, Field};
+    let strip_type = <rerun::components::LineStrip3D as rerun::Loggable>::arrow_datatype();
+    let DataType::List(point_field) = &strip_type else { unreachable!("a line strip is a list of points") };
+    let DataType::FixedSizeList(coordinate_field, 3) = point_field.data_type() else { unreachable!("a point is three float32") };
+    let coordinates = Float32Array::from_iter_values(strips.iter().flatten().flatten().copied());
+    let points: ArrayRef = Arc::new(FixedSizeListArray::new(coordinate_field.clone(), 3, Arc::new(coordinates), None));
+    let strip_list: ArrayRef = Arc::new(ListArray::new(point_field.clone(), OffsetBuffer::from_lengths(strips.iter().map(Vec::len)), points, None));
+    let rows = ListArray::new(Arc::new(Field::new_list_field(strip_type.clone(), true)), OffsetBuffer::from_lengths(std::iter::repeat_n(1, strips.len())), strip_list, None);
+    rerun::SerializedComponentColumn::new(rows, rerun::LineStrips3D::descriptor_strips())
 }
 
 /// A column of one fixed-size float32 component (a translation, a quaternion) per row, built
@@ -480,13 +523,40 @@ pub(crate) fn send_in_order(
     time: TimeColumn,
     columns: impl IntoIterator<Item = rerun::SerializedComponentColumn>,
 ) -> Result<(), rerun::log::ChunkError> {
-    use rerun::log::{Chunk, ChunkId, RowId};
-    let rows = time.num_rows();
-    let row_ids: Vec<RowId> = std::iter::successors(Some(RowId::new()), |id| Some(id.next())).take(rows).collect();
+    send_chunk_in_order(rec, entity, time, columns, &ColumnPool::default())
+}
+
+/// `send_in_order`, the row ids in memory from `ids`.
+fn send_chunk_in_order(
+    rec: &RecordingStream,
+    entity: &str,
+    time: TimeColumn,
+    columns: impl IntoIterator<Item = rerun::SerializedComponentColumn>,
+    ids: &ColumnPool<[u8; 16]>,
+) -> Result<(), rerun::log::ChunkError> {
+    use rerun::log::{Chunk, ChunkId};
+    let row_ids = consecutive_row_ids(time.num_rows(), ids);
     let components: rerun::log::ChunkComponents = columns.into_iter().map(|c| (c.descriptor, c.list_array)).collect();
     let timelines = std::iter::once((*time.timeline().name(), time)).collect();
-    rec.send_chunk(Chunk::from_native_row_ids(ChunkId::new(), entity.into(), Some(true), &row_ids, timelines, components)?);
+    rec.send_chunk(Chunk::new(ChunkId::new(), entity.into(), Some(true), row_ids, timelines, components)?);
     Ok(())
+}
+
+/// `rows` consecutive row ids from a new one (`RowId::new`, then `next`), as the Arrow column a
+/// chunk keeps them in: each id's 16 bytes big-endian, its time then its counter. Written straight
+/// into the column rather than through Rerun's generic serialization (`RowId::arrow_from_slice`),
+/// which walked every id through optional values and cost a tenth of this recorder's thread.
+fn consecutive_row_ids(rows: usize, pool: &ColumnPool<[u8; 16]>) -> rerun::external::arrow::array::FixedSizeBinaryArray {
+    let first = rerun::log::RowId::new();
+    let (time, counter) = (first.nanos_since_epoch().to_be_bytes(), first.inc());
+    let mut ids = pool.take(rows);
+    ids.extend((0..rows).map(|i| {
+        let mut id = [0u8; 16];
+        id[..8].copy_from_slice(&time);
+        id[8..].copy_from_slice(&counter.wrapping_add(i as u64).to_be_bytes());
+        id
+    }));
+    rerun::external::arrow::array::FixedSizeBinaryArray::new(16, pool.buffer(ids), None)
 }
 
 fn viewer_reachable(url: &str) -> Result<rerun::external::re_uri::ProxyUri, String> {
@@ -710,8 +780,9 @@ impl Recorder for RerunRecorder {
         self.motors = e.motors.clone();
         let cap = FILE_BLOCK_STEPS + 1;
         self.times = Vec::with_capacity(cap);
-        self.joints = (0..model.dof()).map(|_| JointColumns::with_capacity(cap)).collect();
-        self.tool = Vec::with_capacity(3 * cap);
+        self.joints = (0..model.dof()).map(|_| JointColumns::with_capacity(cap, &self.values_pool)).collect();
+        self.tool = self.values_pool.take(3 * cap);
+        self.tool_error = self.values_pool.take(cap);
         self.links = model
             .frames
             .iter()
@@ -840,5 +911,33 @@ impl Recorder for RerunRecorder {
             file.close().map_err(|e| Error::output(file.path(), e))?;
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use rerun::log::RowId;
+
+    #[test]
+    fn a_strips_column_built_straight_is_the_one_rerun_would_make() {
+        let strips = vec![vec![[0.0, 1.0, 2.0], [3.0, 4.0, 5.5]], vec![], vec![[-1.0, 0.25, 9.0]]];
+        let ours = super::strips_column(&strips);
+        let mut rerun_s: Vec<_> = rerun::LineStrips3D::update_fields().with_strips(strips.iter().cloned()).columns_of_unit_batches().unwrap().collect();
+        assert_eq!(rerun_s.len(), 1);
+        let theirs = rerun_s.remove(0);
+        assert_eq!(ours.descriptor, theirs.descriptor);
+        assert_eq!(ours.list_array, theirs.list_array);
+    }
+
+    #[test]
+    fn row_ids_written_straight_are_the_column_rerun_would_make() {
+        let column = super::consecutive_row_ids(5, &super::ColumnPool::default());
+        let ids = RowId::slice_from_arrow(&column);
+        assert_eq!(ids.len(), 5);
+        for pair in ids.windows(2) {
+            assert_eq!(pair[1], pair[0].next(), "consecutive, as `next` makes them");
+        }
+        assert_eq!(RowId::arrow_from_slice(ids), column, "Rerun's own serialization of the same ids");
+        assert_eq!(rerun::external::arrow::array::Array::data_type(&column), &<RowId as rerun::Loggable>::arrow_datatype());
     }
 }

@@ -5,15 +5,23 @@ use crate::sample::Sample;
 use crate::spatial::Pose;
 use crate::summary::Summary;
 use nalgebra::Vector3;
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-/// Runs a recorder on its own thread: the simulation loop only copies each sample into a block,
-/// and the recorder encodes and writes on another core. `start` and `finish` run on the caller's
-/// thread (they need the run's configuration); `record` runs on the worker, in order.
-pub struct Threaded<R: Recorder + Send + 'static> {
-    inner: Option<R>,
+/// A recorder that can run on a thread of its own.
+type SendRecorder = Box<dyn Recorder + Send>;
+
+/// Runs recorders each on a thread of its own: the simulation loop only copies each sample into
+/// a block, once for all of them, and every recorder encodes and writes that block on its own
+/// thread. `start` and `finish` run on the caller's side (they need the run's configuration), the
+/// recorders' side by side; `record` runs on the workers, in order.
+pub struct Threaded {
+    /// Each recorder with its thread's name, here before `start` and after `finish`.
+    recorders: Vec<(String, SendRecorder)>,
     block: SampleBlock,
-    worker: Option<BatchWorker<R, SampleBlock, Error>>,
+    workers: Vec<(String, BatchWorker<SendRecorder, Arc<SampleBlock>, Error>)>,
+    /// The blocks handed over, each taken back for reuse once every worker is done with it.
+    handed: Vec<Arc<SampleBlock>>,
     last_send: Instant,
     block_samples: usize,
     max_latency: Duration,
@@ -163,53 +171,106 @@ impl Reusable for SampleBlock {
     }
 }
 
-impl<R: Recorder + Send + 'static> Threaded<R> {
+/// Blocks handed over and kept for reuse at most (each worker's queue holds a few).
+const BLOCKS_KEPT: usize = 8;
+
+impl Threaded {
     /// `max_latency`: a block is handed over at least this often (for live viewers).
-    pub fn new(inner: R, max_latency: Duration) -> Self {
+    pub fn new(max_latency: Duration) -> Self {
         Self {
-            inner: Some(inner),
+            recorders: Vec::new(),
             block: SampleBlock::new(0, 0, 0),
-            worker: None,
+            workers: Vec::new(),
+            handed: Vec::new(),
             last_send: Instant::now(),
             block_samples: 250,
             max_latency,
         }
     }
 
+    /// Adds a recorder, on a thread named after it (so profiles and debuggers tell them apart).
+    pub fn with<R: Recorder + Send + 'static>(mut self, recorder: R) -> Self {
+        let name = std::any::type_name::<R>().rsplit("::").next().unwrap_or("recorder").to_string();
+        self.recorders.push((name, Box::new(recorder)));
+        self
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.recorders.is_empty() && self.workers.is_empty()
+    }
+
+    /// An emptied block every worker is done with, or a new one.
+    fn empty_block(&mut self) -> SampleBlock {
+        let done = self.handed.iter().position(|b| Arc::strong_count(b) == 1);
+        if let Some(mut block) = done.map(|i| self.handed.swap_remove(i)).and_then(|b| Arc::try_unwrap(b).ok()) {
+            block.clear();
+            return block;
+        }
+        SampleBlock::new(self.block.n, self.block.bodies, self.block_samples)
+    }
+
     fn send_block(&mut self) -> Result<(), Error> {
-        let Some(worker) = &self.worker else { return Ok(()) };
-        if self.block.len() == 0 {
+        if self.workers.is_empty() || self.block.len() == 0 {
             return Ok(());
         }
-        let (n, bodies, capacity) = (self.block.n, self.block.bodies, self.block_samples);
         self.last_send = Instant::now();
-        if !worker.hand_over(&mut self.block, || SampleBlock::new(n, bodies, capacity)) {
-            // the worker stopped on an error: report it
-            return self.join();
+        let empty = self.empty_block();
+        let full = Arc::new(std::mem::replace(&mut self.block, empty));
+        for i in 0..self.workers.len() {
+            if !self.workers[i].1.send(full.clone()) {
+                // the worker stopped on an error: report it
+                return self.join_all();
+            }
         }
+        if self.handed.len() >= BLOCKS_KEPT {
+            self.handed.remove(0);
+        }
+        self.handed.push(full);
         Ok(())
     }
 
-    fn join(&mut self) -> Result<(), Error> {
-        if let Some(joined) = self.worker.as_mut().and_then(BatchWorker::join) {
-            let (inner, result) = joined.expect("recorder thread panicked");
-            self.inner = Some(inner);
-            result?;
+    /// Lets every worker finish what it was sent and takes the recorders back, in order; the
+    /// first error of any.
+    fn join_all(&mut self) -> Result<(), Error> {
+        let mut first_error = None;
+        for (name, mut worker) in self.workers.drain(..) {
+            if let Some(joined) = worker.join() {
+                let (recorder, result) = joined.expect("recorder thread panicked");
+                self.recorders.push((name, recorder));
+                if let Err(e) = result {
+                    first_error.get_or_insert(e);
+                }
+            }
         }
-        Ok(())
+        first_error.map_or(Ok(()), Err)
     }
 }
 
-impl<R: Recorder + Send + 'static> Recorder for Threaded<R> {
+/// Runs `each` on every recorder at once, the first on this thread and the others on threads of
+/// their own; the first error in the recorders' order.
+fn side_by_side(recorders: &mut [(String, SendRecorder)], each: impl Fn(&mut SendRecorder) -> Result<(), Error> + Sync) -> Result<(), Error> {
+    let Some(((_, first), others)) = recorders.split_first_mut() else { return Ok(()) };
+    std::thread::scope(|scope| {
+        let each = &each;
+        let others: Vec<_> = others.iter_mut().map(|(_, r)| scope.spawn(move || each(r))).collect();
+        let mut result = each(first);
+        for other in others {
+            let other = other.join().expect("recorder thread panicked");
+            result = result.and(other);
+        }
+        result
+    })
+}
+
+impl Recorder for Threaded {
     fn start(&mut self, run: &RunInfo) -> Result<(), Error> {
-        let mut inner = self.inner.take().expect("started once");
-        inner.start(run)?;
+        side_by_side(&mut self.recorders, |r| r.start(run))?;
         let model = &run.experiment.model;
         self.block = SampleBlock::new(model.dof(), model.bodies.len(), self.block_samples);
-        // named after the recorder, so profiles and debuggers tell the threads apart
-        let name = std::any::type_name::<R>().rsplit("::").next().unwrap_or("recorder").to_string();
-        let worker = BatchWorker::spawn(&name, inner, |inner: &mut R, block: &SampleBlock| (0..block.len()).try_for_each(|i| inner.record(&block.sample(i))));
-        self.worker = Some(worker.map_err(|e| Error::output(std::path::Path::new("recorder thread"), e))?);
+        for (name, recorder) in std::mem::take(&mut self.recorders) {
+            let worker = BatchWorker::spawn_shared(&name, recorder, |r: &mut SendRecorder, block: &Arc<SampleBlock>| (0..block.len()).try_for_each(|i| r.record(&block.sample(i))));
+            self.workers.push((name, worker.map_err(|e| Error::output(std::path::Path::new("recorder thread"), e))?));
+        }
         self.last_send = Instant::now();
         Ok(())
     }
@@ -226,10 +287,7 @@ impl<R: Recorder + Send + 'static> Recorder for Threaded<R> {
 
     fn finish(&mut self, run: &RunInfo, summary: &Summary) -> Result<(), Error> {
         self.send_block()?;
-        self.join()?;
-        match self.inner.as_mut() {
-            Some(inner) => inner.finish(run, summary),
-            None => Ok(()),
-        }
+        self.join_all()?;
+        side_by_side(&mut self.recorders, |r| r.finish(run, summary))
     }
 }

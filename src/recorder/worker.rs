@@ -15,14 +15,25 @@ pub trait Reusable {
 
 pub struct BatchWorker<S, B, E> {
     tx: Option<SyncSender<B>>,
-    recycled: Receiver<B>,
+    /// `None` for a worker that drops its batches when done (batches shared with other workers).
+    recycled: Option<Receiver<B>>,
     handle: Option<JoinHandle<(S, Result<(), E>)>>,
 }
 
 impl<S: Send + 'static, B: Send + 'static, E: Send + 'static> BatchWorker<S, B, E> {
     /// Starts thread `name` with `state`; `consume` is called with every batch sent, and the first
     /// error it returns stops the thread.
-    pub fn spawn(name: &str, mut state: S, mut consume: impl FnMut(&mut S, &B) -> Result<(), E> + Send + 'static) -> std::io::Result<Self> {
+    pub fn spawn(name: &str, state: S, consume: impl FnMut(&mut S, &B) -> Result<(), E> + Send + 'static) -> std::io::Result<Self> {
+        Self::start(name, state, consume, true)
+    }
+
+    /// As `spawn`, for batches shared with other workers (an `Arc`): each is dropped once
+    /// consumed, so the sender sees when every worker is done with it. Send them with `send`.
+    pub fn spawn_shared(name: &str, state: S, consume: impl FnMut(&mut S, &B) -> Result<(), E> + Send + 'static) -> std::io::Result<Self> {
+        Self::start(name, state, consume, false)
+    }
+
+    fn start(name: &str, mut state: S, mut consume: impl FnMut(&mut S, &B) -> Result<(), E> + Send + 'static, recycle: bool) -> std::io::Result<Self> {
         let (tx, rx) = sync_channel::<B>(QUEUE);
         let (back_tx, recycled) = sync_channel::<B>(QUEUE);
         let handle = std::thread::Builder::new().name(name.to_string()).spawn(move || {
@@ -30,11 +41,19 @@ impl<S: Send + 'static, B: Send + 'static, E: Send + 'static> BatchWorker<S, B, 
                 if let Err(e) = consume(&mut state, &batch) {
                     return (state, Err(e));
                 }
-                let _ = back_tx.try_send(batch);
+                if recycle {
+                    let _ = back_tx.try_send(batch);
+                }
             }
             (state, Ok(()))
         })?;
-        Ok(Self { tx: Some(tx), recycled, handle: Some(handle) })
+        Ok(Self { tx: Some(tx), recycled: recycle.then_some(recycled), handle: Some(handle) })
+    }
+
+    /// Hands `batch` to the thread (waiting while `QUEUE` batches are ahead of it). False when the
+    /// thread has stopped (on an error: `join` for it).
+    pub fn send(&self, batch: B) -> bool {
+        self.tx.as_ref().is_some_and(|tx| tx.send(batch).is_ok())
     }
 
     /// Hands `batch` to the thread and leaves in its place an emptied batch the thread is done
@@ -44,15 +63,15 @@ impl<S: Send + 'static, B: Send + 'static, E: Send + 'static> BatchWorker<S, B, 
     where
         B: Reusable,
     {
-        let empty = match self.recycled.try_recv() {
-            Ok(mut recycled) => {
+        let empty = match self.recycled.as_ref().map(Receiver::try_recv) {
+            Some(Ok(mut recycled)) => {
                 recycled.clear();
                 recycled
             }
-            Err(_) => fresh(),
+            _ => fresh(),
         };
         let full = std::mem::replace(batch, empty);
-        self.tx.as_ref().is_some_and(|tx| tx.send(full).is_ok())
+        self.send(full)
     }
 
     /// Lets the thread finish what was sent and returns its state and result (None if already joined).

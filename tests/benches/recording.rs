@@ -17,12 +17,16 @@ static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
 fn run(experiment: &Experiment, dir: &Path, rrd: bool, mcap: bool) -> usize {
     let mut recorders: Vec<Box<dyn Recorder>> = Vec::new();
+    let mut threaded = Threaded::new(Duration::from_millis(20));
     if rrd {
         let options = RerunOptions { file: Some(dir.join("bench.rrd")), live: None, name: "bench".into() };
-        recorders.push(Box::new(Threaded::new(RerunRecorder::new(options), Duration::from_millis(20))));
+        threaded = threaded.with(RerunRecorder::new(options));
     }
     if mcap {
-        recorders.push(Box::new(Threaded::new(McapRecorder::new(McapOptions { file: Some(dir.join("bench.mcap")), live: None }), Duration::from_millis(20))));
+        threaded = threaded.with(McapRecorder::new(McapOptions { file: Some(dir.join("bench.mcap")), live: None }));
+    }
+    if !threaded.is_empty() {
+        recorders.push(Box::new(threaded));
     }
     let mut refs: Vec<&mut dyn Recorder> = recorders.iter_mut().map(|r| r.as_mut() as &mut dyn Recorder).collect();
     simulate(experiment, &mut refs, None).unwrap().steps
