@@ -57,6 +57,14 @@ struct Batch {
     messages: Vec<(MessageHeader, usize)>,
 }
 
+impl Batch {
+    /// An empty batch with room for a full one of the box model's messages (~400 kB): grown from
+    /// nothing, it was copied along the way.
+    fn sized() -> Self {
+        Self { bytes: Vec::with_capacity(BATCH_MESSAGES * 512), messages: Vec::with_capacity(BATCH_MESSAGES + 1) }
+    }
+}
+
 impl Reusable for Batch {
     fn clear(&mut self) {
         self.bytes.clear();
@@ -143,6 +151,17 @@ impl Out {
 
     fn log<T: Encode>(&mut self, topic: &mut Topic<T>, msg: &T, time_ns: u64) -> Result<(), String> {
         msg.encode(&mut self.batch.bytes).map_err(|e| e.to_string())?;
+        self.logged(topic, time_ns)
+    }
+
+    /// A message of `topic` that `encode` appends to the batch's bytes (see `step_messages`).
+    fn log_encoded<T>(&mut self, topic: &mut Topic<T>, encode: impl FnOnce(&mut Vec<u8>), time_ns: u64) -> Result<(), String> {
+        encode(&mut self.batch.bytes);
+        self.logged(topic, time_ns)
+    }
+
+    /// The message whose bytes end the batch's.
+    fn logged<T>(&mut self, topic: &mut Topic<T>, time_ns: u64) -> Result<(), String> {
         let header = MessageHeader { channel_id: topic.id, sequence: topic.sequence, log_time: time_ns, publish_time: time_ns };
         topic.sequence += 1;
         self.batch.messages.push((header, self.batch.bytes.len()));
@@ -159,7 +178,7 @@ impl Out {
 
     fn send(&mut self) -> Result<(), String> {
         let Some(worker) = &self.worker else { return Ok(()) };
-        if !worker.hand_over(&mut self.batch, Batch::default) {
+        if !worker.hand_over(&mut self.batch, Batch::sized) {
             // the writer stopped on an error: report it
             return self.join();
         }
@@ -701,8 +720,9 @@ impl Recorder for McapRecorder {
         if pose_step {
             out.log(&mut ch.tf, &self.tf_msg, stamp).map_err(fail)?;
         }
-        out.log(&mut ch.joint_states, &self.joints_msg, stamp).map_err(fail)?;
-        out.log(&mut ch.controller, &self.telemetry, stamp).map_err(fail)?;
+        // (the two per-step messages encoded by hand, as prost would)
+        out.log_encoded(&mut ch.joint_states, |bytes| super::step_messages::joint_states(&self.joints_msg, bytes), stamp).map_err(fail)?;
+        out.log_encoded(&mut ch.controller, |bytes| super::step_messages::controller_telemetry(&self.telemetry, bytes), stamp).map_err(fail)?;
         if let (Some(c), Some((state, contacts))) = (self.collisions.as_mut(), ch.collisions.as_mut()) {
             if let Some(update) = c.record(s, ts.unwrap_or_default()) {
                 out.log(contacts, &update, stamp).map_err(fail)?;

@@ -15,6 +15,7 @@ pub mod rrd;
 mod robot_description;
 mod rrd_collisions;
 pub(crate) mod rrd_file;
+mod step_messages;
 mod summary_json;
 pub mod telemetry;
 mod threaded;
