@@ -291,3 +291,78 @@ impl Recorder for Threaded {
         side_by_side(&mut self.recorders, |r| r.finish(run, summary))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::Threaded;
+    use crate::config::RunConfig;
+    use crate::error::Error;
+    use crate::experiment::Experiment;
+    use crate::recorder::{Recorder, RunInfo};
+    use crate::sample::Sample;
+    use crate::summary::Summary;
+    use std::sync::{Arc, Mutex};
+    use std::time::Duration;
+
+    /// What a recorder saw: each sample's step, angle and tool position, and how often it was finished.
+    #[derive(Clone, Default)]
+    struct Seen {
+        samples: Arc<Mutex<Vec<(usize, f64, [f64; 3])>>>,
+        finished: Arc<Mutex<usize>>,
+    }
+
+    struct Collect {
+        seen: Seen,
+        fail_at: Option<usize>,
+    }
+
+    impl Recorder for Collect {
+        fn start(&mut self, _: &RunInfo) -> Result<(), Error> {
+            Ok(())
+        }
+        fn record(&mut self, s: &Sample) -> Result<(), Error> {
+            if Some(s.k) == self.fail_at {
+                return Err(Error::output(std::path::Path::new("collect"), "disk full"));
+            }
+            self.seen.samples.lock().unwrap().push((s.k, s.q[0], s.tool_position.into()));
+            Ok(())
+        }
+        fn finish(&mut self, _: &RunInfo, _: &Summary) -> Result<(), Error> {
+            *self.seen.finished.lock().unwrap() += 1;
+            Ok(())
+        }
+    }
+
+    fn experiment() -> Experiment {
+        let model = crate::model::load_urdf_str(crate::builtin::builtin(std::path::Path::new(crate::builtin::DEFAULT_URDF)).unwrap(), std::path::Path::new("box.urdf")).unwrap();
+        Experiment::with_model(RunConfig { duration: 2.0, ..RunConfig::default() }, model).unwrap()
+    }
+
+    #[test]
+    fn every_recorder_on_its_thread_sees_every_sample_in_order_as_the_loop_made_it() {
+        let experiment = experiment();
+        let (here, first, second) = (Seen::default(), Seen::default(), Seen::default());
+        let mut inline = Collect { seen: here.clone(), fail_at: None };
+        let mut threaded = Threaded::new(Duration::from_millis(20)).with(Collect { seen: first.clone(), fail_at: None }).with(Collect { seen: second.clone(), fail_at: None });
+        crate::sim::simulate(&experiment, &mut [&mut inline, &mut threaded], None).unwrap();
+        let expected = here.samples.lock().unwrap().clone();
+        assert_eq!(expected.len(), experiment.steps + 1);
+        for seen in [&first, &second] {
+            // the same numbers, bit for bit, in the same order: one shared copy, blocks reused
+            assert!(*seen.samples.lock().unwrap() == expected);
+            assert_eq!(*seen.finished.lock().unwrap(), 1);
+        }
+    }
+
+    #[test]
+    fn a_recorder_that_fails_stops_the_run_with_its_error() {
+        let experiment = experiment();
+        let (fine, failing) = (Seen::default(), Seen::default());
+        let mut threaded = Threaded::new(Duration::from_millis(20)).with(Collect { seen: fine.clone(), fail_at: None }).with(Collect { seen: failing.clone(), fail_at: Some(700) });
+        let error = crate::sim::simulate(&experiment, &mut [&mut threaded], None).unwrap_err().to_string();
+        assert!(error.contains("collect") && error.contains("disk full"), "{error}");
+        let failed = failing.samples.lock().unwrap();
+        assert_eq!(failed.len(), 700, "the failing recorder saw the samples before its failure");
+        assert!(failed.iter().enumerate().all(|(i, s)| s.0 == i));
+    }
+}
