@@ -28,7 +28,7 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
         plant: plant.describe(),
         trajectory: experiment.trajectory.describe(),
         commanded_tool_path: if recorders.is_empty() { Vec::new() } else { experiment.commanded_tool_path(0.01) },
-        torque_axes: if recorders.is_empty() { Vec::new() } else { crate::recorder::torque_axis::torque_axes(experiment) },
+        torque_axes: crate::recorder::torque_axis::LazyAxes::of(experiment),
     };
     for r in recorders.iter_mut() {
         r.start(&info)?;

@@ -507,8 +507,6 @@ impl Recorder for McapRecorder {
         let model = &*e.model;
         let file = match &self.options.file {
             Some(path) => {
-                // the Foxglove layout for this model, beside the recording
-                write_layout(run, path, &run.torque_axes)?;
                 let (file, replaced) = super::output_file::create_replacing(path).map_err(|err| self.err(err))?;
                 self.replaced = Some(replaced);
                 Some(file)
@@ -760,13 +758,12 @@ impl Recorder for McapRecorder {
     }
 
     fn finish(&mut self, run: &RunInfo, summary: &Summary) -> Result<(), Error> {
-        // the torque plots' scale from what the run's drives settled to
+        // the Foxglove layout for this model, beside the recording, its torque plots scaled by the
+        // commanded motion and by what the run's drives settled to
         if let Some(path) = &self.options.file {
             let settled = |i: usize| summary.peak_abs_torque_after_settle.get(i).copied().flatten();
-            let axes: Vec<_> = run.torque_axes.iter().enumerate().map(|(i, axis)| axis.after_run(settled(i))).collect();
-            if axes != run.torque_axes {
-                write_layout(run, path, &axes)?;
-            }
+            let axes: Vec<_> = run.torque_axes().iter().enumerate().map(|(i, axis)| axis.after_run(settled(i))).collect();
+            write_layout(run, path, &axes)?;
         }
         let mut meta = BTreeMap::new();
         meta.insert("summary".into(), serde_json::to_string(summary).unwrap_or_default());

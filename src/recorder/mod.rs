@@ -48,8 +48,18 @@ pub struct RunInfo<'a> {
     pub trajectory: String,
     /// The commanded tool path, every 10 ms (computed once for all recorders).
     pub commanded_tool_path: Vec<nalgebra::Vector3<f64>>,
-    /// Each joint's torque plot scale: the motion's own torque, the limit beside it where near.
-    pub torque_axes: Vec<torque_axis::TorqueAxis>,
+    /// Each joint's torque plot scale: the motion's own torque, the limit beside it where near
+    /// (see [`RunInfo::torque_axes`]).
+    pub torque_axes: torque_axis::LazyAxes<'a>,
+}
+
+impl RunInfo<'_> {
+    /// Each joint's torque plot scale, worked out when first asked for: a file's plots are laid out
+    /// when the run ends (where one core is otherwise idle, waiting for Rerun's last chunks), and a
+    /// run without recordings never needs them.
+    pub fn torque_axes(&self) -> &[torque_axis::TorqueAxis] {
+        self.torque_axes.get()
+    }
 }
 
 pub trait Recorder {

@@ -798,7 +798,7 @@ impl Recorder for RerunRecorder {
         // the layout: a live viewer needs it now (scaled by the motion's torque); a file gets it at
         // the end, scaled by what the run did as well
         if self.live {
-            let (layout, torque_ranges) = blueprint(&self.joint_names, &self.stepped, &self.heated, self.collisions.is_some(), &run.torque_axes, "");
+            let (layout, torque_ranges) = blueprint(&self.joint_names, &self.stepped, &self.heated, self.collisions.is_some(), run.torque_axes(), "");
             send_blueprint(&rec, &layout, &torque_ranges).map_err(|x| self.err(x))?;
         }
         self.log_static_scene(&rec, model)?;
@@ -895,8 +895,8 @@ impl Recorder for RerunRecorder {
         // the layout, its torque plots scaled by what the run's drives settled to as well: sent
         // now to a file, again to a live viewer where the scale changed (its second layout)
         let settled = |i: usize| summary.peak_abs_torque_after_settle.get(i).copied().flatten();
-        let axes: Vec<_> = run.torque_axes.iter().enumerate().map(|(i, axis)| axis.after_run(settled(i))).collect();
-        if !self.live || axes != run.torque_axes {
+        let axes: Vec<_> = run.torque_axes().iter().enumerate().map(|(i, axis)| axis.after_run(settled(i))).collect();
+        if !self.live || axes != run.torque_axes() {
             let (layout, torque_ranges) = blueprint(&self.joint_names, &self.stepped, &self.heated, self.collisions.is_some(), &axes, "");
             send_blueprint(&rec, &layout, &torque_ranges).map_err(|x| self.err(x))?;
         }

@@ -76,6 +76,23 @@ fn significant(x: f64) -> String {
     if s.contains('.') { s.trim_end_matches('0').trim_end_matches('.').to_string() } else { s }
 }
 
+/// A run's torque axes, worked out the first time they are asked for (by whichever recorder
+/// asks first; one that asks meanwhile waits for the same axes).
+pub struct LazyAxes<'a> {
+    experiment: &'a Experiment,
+    axes: std::sync::OnceLock<Vec<TorqueAxis>>,
+}
+
+impl<'a> LazyAxes<'a> {
+    pub fn of(experiment: &'a Experiment) -> Self {
+        Self { experiment, axes: std::sync::OnceLock::new() }
+    }
+
+    pub fn get(&self) -> &[TorqueAxis] {
+        self.axes.get_or_init(|| torque_axes(self.experiment))
+    }
+}
+
 /// Every joint's torque axis for `experiment`'s run.
 pub fn torque_axes(experiment: &Experiment) -> Vec<TorqueAxis> {
     let duration = experiment.config.duration;
