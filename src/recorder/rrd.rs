@@ -372,7 +372,9 @@ impl RerunRecorder {
         }
         let time = TimeColumn::new_duration_secs(TIMELINE, self.times.iter().copied());
         let steps = self.times.len();
-        let capacity = FILE_BLOCK_STEPS + 1;
+        // room for a block like this one: a file's are all of FILE_BLOCK_STEPS, a live viewer's a few
+        // steps each (a lent vector's unused room is memory Rerun does not count as in flight)
+        let capacity = steps + 1;
         // the list offsets of a column of `width` values per row: the same for every such column
         let offsets: [OffsetBuffer<i32>; 3] = std::array::from_fn(|w| OffsetBuffer::from_lengths(std::iter::repeat_n(w + 1, steps)));
         // the every-step columns move into Arrow and the recorder goes on in vectors from the pool
