@@ -250,16 +250,10 @@ impl CollisionData {
 
     /// Link (frame) `f`'s world pose at this check.
     fn frame_pose(&mut self, model: &Model, f: usize) -> Pose {
-        let (pose, at) = &mut self.frames[f];
-        if *at != self.check {
-            let frame = &model.frames[f];
-            *pose = match frame.body {
-                Some(b) => self.body_poses[b].compose(&frame.placement),
-                None => frame.placement,
-            };
-            *at = self.check;
+        if self.frames[f].1 != self.check {
+            self.frames[f] = (crate::dynamics::frame_pose_in(model, &self.body_poses, f), self.check);
         }
-        *pose
+        self.frames[f].0
     }
 
     /// Shape `i`'s bounding-sphere centre at this check.

@@ -100,7 +100,7 @@ impl Collisions {
 
     /// A checker of states of `model` one after another (its workspaces made once).
     pub fn checker<'a>(&'a self, model: &'a Model) -> Checker<'a> {
-        Checker { model, collisions: self, data: crate::dynamics::Data::new(model), shapes: CollisionData::new(&self.shapes), state: StateCollisions::default() }
+        Checker { model, collisions: self, body_poses: vec![crate::spatial::Pose::identity(); model.bodies.len()], shapes: CollisionData::new(&self.shapes), state: StateCollisions::default() }
     }
 
     /// The pairs closer than `threshold` (m) at joint positions `q`: (link, link or world shape,
@@ -116,7 +116,8 @@ impl Collisions {
 pub struct Checker<'a> {
     model: &'a Model,
     collisions: &'a Collisions,
-    data: crate::dynamics::Data,
+    /// The bodies' world poses at the state checked (all a check needs of the kinematics).
+    body_poses: Vec<crate::spatial::Pose>,
     shapes: CollisionData,
     state: StateCollisions,
 }
@@ -124,9 +125,9 @@ pub struct Checker<'a> {
 impl Checker<'_> {
     /// The pairs closer than `threshold` (m) at joint positions `q`, nearest first.
     pub fn check(&mut self, q: &[f64], threshold: f64) -> &StateCollisions {
-        let (model, data) = (self.model, &mut self.data);
-        crate::dynamics::forward_kinematics(model, data, q);
-        check_state(model, &self.collisions.shapes, &self.collisions.pairs, &self.collisions.world, &mut self.shapes, &data.body_pose, threshold, &mut self.state);
+        let model = self.model;
+        crate::dynamics::body_poses(model, q, &mut self.body_poses);
+        check_state(model, &self.collisions.shapes, &self.collisions.pairs, &self.collisions.world, &mut self.shapes, &self.body_poses, threshold, &mut self.state);
         &self.state
     }
 

@@ -20,12 +20,6 @@ pub struct ColumnPool<T> {
     free: Arc<Mutex<Vec<Vec<T>>>>,
 }
 
-impl<T> Clone for ColumnPool<T> {
-    fn clone(&self) -> Self {
-        Self { free: self.free.clone() }
-    }
-}
-
 impl<T> Default for ColumnPool<T> {
     fn default() -> Self {
         Self { free: Arc::new(Mutex::new(Vec::new())) }
