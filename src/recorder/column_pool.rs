@@ -74,7 +74,7 @@ impl<T: Copy + Send + Sync + std::panic::RefUnwindSafe + 'static> ColumnPool<T> 
 #[cfg(test)]
 mod tests {
     use super::ColumnPool;
-    use rerun::external::arrow::array::{Array, Float64Array};
+    use rerun::external::arrow::array::Float64Array;
     use rerun::external::arrow::buffer::ScalarBuffer;
 
     #[test]
