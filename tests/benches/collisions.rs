@@ -5,7 +5,7 @@
 //!     cargo bench --bench collisions
 
 use armscope::collision::{CollisionData, Collisions, StateCollisions, check_state};
-use armscope::dynamics::{Data, forward_kinematics, frame_pose};
+use armscope::dynamics::{Data, forward_kinematics};
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::hint::black_box;
 use std::path::Path;
