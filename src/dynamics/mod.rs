@@ -14,6 +14,7 @@ mod energy;
 mod gravity_stiffness;
 mod jacobian;
 mod kinematics;
+mod ldlt;
 mod ltdl;
 mod rnea;
 
@@ -24,6 +25,7 @@ pub use data::Data;
 pub use gravity_stiffness::gravity_stiffness;
 pub use energy::{kinetic_energy, kinetic_energy_from_velocities, potential_energy_from_kinematics};
 pub use jacobian::frame_jacobian;
+pub use ldlt::{ldlt_in_place, ldlt_solve_in_place};
 pub use ltdl::{ltdl_in_place, ltdl_solve_in_place};
 pub use kinematics::{body_poses, forward_kinematics, frame_pose, frame_pose_in};
 pub use rnea::{bias_forces, gravity_and_bias_from_kinematics, gravity_forces, gravity_from_kinematics, rnea, rnea_from_kinematics};

@@ -88,11 +88,19 @@ impl DiscretePlant {
             self.rhs[i] += h * (u[i] + data.gravity[i] - data.bias[i]);
         }
         // each joint's h·D, velocity bounds (the limits reached at the step's end) and friction impulses
-        for (i, joint) in model.joints.iter().enumerate() {
-            self.damping_step[i] = h * (joint.damping + self.friction.viscous(i));
-            let (law, locked_up, locked_down) = self.friction.law(i, u[i], h, (joint.lower - q[i]) / h, (joint.upper - q[i]) / h);
-            self.laws[i] = law;
-            self.locked[i] = (locked_up, locked_down);
+        if self.friction.any {
+            for (i, joint) in model.joints.iter().enumerate() {
+                self.damping_step[i] = h * (joint.damping + self.friction.viscous(i));
+                let (law, locked_up, locked_down) = self.friction.law(i, u[i], h, (joint.lower - q[i]) / h, (joint.upper - q[i]) / h);
+                self.laws[i] = law;
+                self.locked[i] = (locked_up, locked_down);
+            }
+        } else {
+            // without friction or gear losses only the limits bound a joint (the same laws)
+            for (((joint, damping), law), q) in model.joints.iter().zip(&mut self.damping_step).zip(&mut self.laws).zip(&*q) {
+                *damping = h * joint.damping;
+                *law = JointLaw { lower: (joint.lower - q) / h, upper: (joint.upper - q) / h, below: 0.0, above: 0.0 };
+            }
         }
         // M + hD is symmetric positive definite for any valid model; a failure means the state is
         // no longer finite, which the simulation loop reports as divergence

@@ -22,7 +22,7 @@
 //! previous step's pieces start the search, so a stuck joint costs one solve. What ends the search
 //! is exact: every condition holds to the rounding of the solve (no regularization, no creep).
 
-use crate::dynamics::{cholesky_in_place, cholesky_solve_in_place, ltdl_in_place, ltdl_solve_in_place};
+use crate::dynamics::{ldlt_in_place, ldlt_solve_in_place, ltdl_in_place, ltdl_solve_in_place};
 use nalgebra::DMatrix;
 
 /// One joint's φ_i.
@@ -109,7 +109,7 @@ pub struct StickSlipSolver {
     piece: Vec<usize>,
     /// Per joint, the breakpoints of the current solve's law and how many (worked out once per solve).
     points: Vec<([f64; 3], usize)>,
-    /// Each joint's parent joint when A has a branched tree's sparsity (LᵀDL), else dense Cholesky.
+    /// Each joint's parent joint when A has a branched tree's sparsity (LᵀDL), else dense LDLᵀ.
     tree_parents: Option<Vec<Option<usize>>>,
     violated: Vec<usize>,
     /// Solves that needed the fallback (coordinate descent) because pivoting did not finish.
@@ -255,19 +255,19 @@ impl StickSlipSolver {
         }
     }
 
-    /// Factor the workspace's matrix (along the tree, or dense Cholesky) and solve for `x`, which
+    /// Factor the workspace's matrix (along the tree, or dense LDLᵀ) and solve for `x`, which
     /// holds the right-hand side on entry.
     fn factor_and_substitute(&mut self, x: &mut [f64]) -> Result<(), NotPositiveDefinite> {
         let factored = match &self.tree_parents {
             Some(parents) => ltdl_in_place(&mut self.factor, parents),
-            None => cholesky_in_place(&mut self.factor),
+            None => ldlt_in_place(&mut self.factor),
         };
         if !factored {
             return Err(NotPositiveDefinite);
         }
         match &self.tree_parents {
             Some(parents) => ltdl_solve_in_place(&self.factor, parents, x),
-            None => cholesky_solve_in_place(&self.factor, x),
+            None => ldlt_solve_in_place(&self.factor, x),
         }
         Ok(())
     }
