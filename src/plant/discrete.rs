@@ -76,16 +76,15 @@ impl DiscretePlant {
         let n = model.dof();
         let h = self.time_step;
         crba_from_kinematics(model, data);
-        // b = M·v + h·(u + τ_g − C·v), M·v by columns (M is stored by columns)
+        // b = M·v + h·(u + τ_g − C·v); row i of M·v from column i (M is symmetric and stored by
+        // columns), summed over j in order
         let mass = data.mass_matrix.as_slice();
-        self.rhs.fill(0.0);
-        for (column, vj) in mass.chunks_exact(n).zip(v.iter()) {
-            for (b, mij) in self.rhs.iter_mut().zip(column) {
-                *b += mij * vj;
+        for (i, (b, column)) in self.rhs.iter_mut().zip(mass.chunks_exact(n)).enumerate() {
+            let mut momentum = 0.0;
+            for (mij, vj) in column.iter().zip(v.iter()) {
+                momentum += mij * vj;
             }
-        }
-        for i in 0..n {
-            self.rhs[i] += h * (u[i] + data.gravity[i] - data.bias[i]);
+            *b = momentum + h * (u[i] + data.gravity[i] - data.bias[i]);
         }
         // each joint's h·D, velocity bounds (the limits reached at the step's end) and friction impulses
         if self.friction.any {
