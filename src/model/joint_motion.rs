@@ -38,10 +38,16 @@ impl JointMotion {
     /// The body frame in the parent body's frame at joint position `q`.
     #[inline]
     pub fn local_pose(&self, q: f64) -> (Matrix3<f64>, Vector3<f64>) {
+        let sin_cos = if self.prismatic { (0.0, 1.0) } else { q.sin_cos() };
+        self.local_pose_from(q, sin_cos)
+    }
+
+    /// [`local_pose`](Self::local_pose) with q's (sin q, cos q) given (used by a revolute joint only).
+    #[inline]
+    pub fn local_pose_from(&self, q: f64, (s, c): (f64, f64)) -> (Matrix3<f64>, Vector3<f64>) {
         if self.prismatic {
             (self.fixed, self.origin + self.axis * q)
         } else {
-            let (s, c) = q.sin_cos();
             (self.fixed + self.cosine * c + self.sine * s, self.origin)
         }
     }
