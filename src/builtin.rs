@@ -6,11 +6,12 @@ use std::path::Path;
 
 pub const DEFAULT_URDF: &str = "assets/smallrobot_arm.urdf";
 pub const DEFAULT_MANIFEST: &str = "assets/experiments/tutorial.toml";
+pub const DEFAULT_CATALOGUE: &str = "assets/motors/catalogue.toml";
 
 const FILES: [(&str, &str); 6] = [
     (DEFAULT_URDF, include_str!("../assets/smallrobot_arm.urdf")),
     (DEFAULT_MANIFEST, include_str!("../assets/experiments/tutorial.toml")),
-    (crate::actuator::catalogue::DEFAULT_CATALOGUE, include_str!("../assets/motors/catalogue.toml")),
+    (DEFAULT_CATALOGUE, include_str!("../assets/motors/catalogue.toml")),
     ("assets/motors/tutorial.toml", include_str!("../assets/motors/tutorial.toml")),
     ("assets/motors/smallrobotarm.toml", include_str!("../assets/motors/smallrobotarm.toml")),
     ("assets/motors/so100.toml", include_str!("../assets/motors/so100.toml")),

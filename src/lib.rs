@@ -16,6 +16,7 @@ pub mod diagnose;
 pub mod dynamics;
 pub mod error;
 pub mod experiment;
+pub mod flags;
 pub mod inspect;
 pub mod meshgen;
 pub mod model;

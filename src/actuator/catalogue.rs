@@ -52,7 +52,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use toml::Value;
 
-pub const DEFAULT_CATALOGUE: &str = "assets/motors/catalogue.toml";
+pub use crate::builtin::DEFAULT_CATALOGUE;
 
 /// Catalogue entries by name: motors as TOML tables (each made into a motor when a joint uses it),
 /// reductions parsed.

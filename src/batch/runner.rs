@@ -3,7 +3,7 @@ use super::outcome::ExperimentOutcome;
 use super::table::{BatchSummary, write_tables};
 use super::compare::{ComparedRun, Comparison, SeriesRecorder, build_comparison};
 
-use crate::cli::RunArgs;
+use crate::flags::RunArgs;
 use crate::error::Error;
 use crate::experiment::Experiment;
 use crate::runner::{Outputs, run_experiment};

@@ -7,7 +7,6 @@ mod compare;
 mod envelope;
 mod model;
 mod run;
-mod shared;
 mod size;
 mod trajectory;
 
@@ -17,8 +16,8 @@ pub use catalogue::{CatalogueArgs, catalogue};
 pub use compare::{CompareArgs, compare};
 pub use envelope::{EnvelopeArgs, envelope};
 pub use model::{ModelArgs, model};
-pub use run::{RunArgs, default_run_name, run};
-pub use shared::{GainArgs, MotorArgs, WaveArgs};
+pub use crate::flags::{GainArgs, MotorArgs, RunArgs, WaveArgs};
+pub use run::{default_run_name, run};
 pub use size::{SizeArgs, parse_ratios, size};
 pub use trajectory::{TrajectoryArgs, trajectory};
 

@@ -1,6 +1,8 @@
 //! Flag groups more than one subcommand takes, defined once so that they read and default alike.
 
-use super::*;
+use crate::config::RunConfig;
+use clap::Args;
+use std::path::PathBuf;
 
 /// The controller's gains.
 #[derive(Args, Debug, Clone, Default)]
