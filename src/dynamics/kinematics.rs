@@ -16,7 +16,9 @@ fn world_pose(parent: Option<&Pose>, (rotation, translation): (Matrix3<f64>, Vec
 /// The bodies are walked a batch at a time, their joints' sines and cosines first: the calls do not
 /// depend on each other and, made in a row, overlap, and the walk then makes no call that would
 /// spill the parent's pose from the registers (a tenth of the 6-joint arm's kinematics; the same
-/// values). A prismatic joint's are computed and not used.
+/// values). A prismatic joint's are computed and not used. The walk is written out in both
+/// functions below: one walk shared through a closure measured 3 % slower (0.182 → 0.187 µs), CRBA's
+/// margin over Pinocchio's 1.05–1.10× instead of 1.08–1.15×.
 const BATCH: usize = 16;
 
 /// (sin, cos) of the joint positions of bodies `bodies` (at most [`BATCH`]) into `sin_cos`.
