@@ -35,19 +35,20 @@ impl<S: Send + 'static, B: Send + 'static, E: Send + 'static> BatchWorker<S, B, 
 
     fn start(name: &str, mut state: S, mut consume: impl FnMut(&mut S, &B) -> Result<(), E> + Send + 'static, recycle: bool) -> std::io::Result<Self> {
         let (tx, rx) = sync_channel::<B>(QUEUE);
-        let (back_tx, recycled) = sync_channel::<B>(QUEUE);
+        // the way back only for batches the sender reuses
+        let (back_tx, recycled) = recycle.then(|| sync_channel::<B>(QUEUE)).unzip();
         let handle = std::thread::Builder::new().name(name.to_string()).spawn(move || {
             for batch in rx {
                 if let Err(e) = consume(&mut state, &batch) {
                     return (state, Err(e));
                 }
-                if recycle {
+                if let Some(back_tx) = &back_tx {
                     let _ = back_tx.try_send(batch);
                 }
             }
             (state, Ok(()))
         })?;
-        Ok(Self { tx: Some(tx), recycled: recycle.then_some(recycled), handle: Some(handle) })
+        Ok(Self { tx: Some(tx), recycled, handle: Some(handle) })
     }
 
     /// Hands `batch` to the thread (waiting while `QUEUE` batches are ahead of it). False when the
