@@ -48,9 +48,9 @@ pub struct RunInfo<'a> {
     pub trajectory: String,
     /// The commanded tool path, every 10 ms (computed once for all recorders).
     pub commanded_tool_path: Vec<nalgebra::Vector3<f64>>,
-    /// Each joint's torque plot scale: the motion's own torque, the limit beside it where near
-    /// (see [`RunInfo::torque_axes`]).
-    pub torque_axes: torque_axis::LazyAxes<'a>,
+    /// Each joint's torque plot scale, worked out on first use: recorders read it through
+    /// [`RunInfo::torque_axes`]; only the loop that makes a `RunInfo` sets it.
+    pub(crate) torque_axes: torque_axis::LazyAxes<'a>,
 }
 
 impl RunInfo<'_> {
