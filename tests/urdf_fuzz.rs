@@ -81,6 +81,24 @@ fn apply(text: &str, m: &Mutation) -> String {
     }
 }
 
+/// Found by the test below: a tool of 1e308 kg whose inertial origin is lost (an unknown tag in
+/// its place) loaded, with finite numbers everywhere, yet the mass matrix was singular: the joints'
+/// own inertias (1e-4 kg·m²) vanished in sums of 1e307. The loader refuses it, naming the first
+/// joint whose inertia the factorization cannot find.
+#[test]
+fn a_mass_that_swamps_the_joints_inertias_is_an_error_naming_the_joint() {
+    let text = base_text();
+    let tool = "<link name=\"tool_link\">\n    <inertial>\n      <origin xyz=\"0.02 0 0\" rpy=\"0 0 0\"/>\n      <mass value=\"0.05\"/>";
+    assert!(text.contains(tool), "the box model's tool link changed");
+    let heavy = text.replace(tool, "<link name=\"tool_link\">\n    <inertial>\n      <onanrigin xyz=\"0.02 0 0\" rpy=\"0 0 0\"/>\n      <mass value=\"1e308\"/>");
+    let msg = load_urdf_str(&heavy, Path::new("heavy.urdf")).unwrap_err().to_string();
+    assert!(msg.starts_with("heavy.urdf: joint 'J3': the mass matrix is singular"), "{msg}");
+    assert!(!msg.contains('\n'), "{msg}");
+    // the same tool at a plain 1e3 kg loads: the check is about rounding, not about heavy tools
+    let loaded = load_urdf_str(&text.replace(tool, &tool.replace("0.05", "1e3")), Path::new("ok.urdf"));
+    assert!(loaded.is_ok(), "{:?}", loaded.err().map(|e| e.to_string()));
+}
+
 proptest! {
     #![proptest_config(ProptestConfig { cases: 4000, failure_persistence: None, .. ProptestConfig::default() })]
 

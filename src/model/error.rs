@@ -48,6 +48,8 @@ pub enum ModelErrorKind {
     NegativeMass { link: String, mass: f64 },
     #[error("joint '{joint}' moves nothing: link '{link}' and everything beyond it have no mass or inertia about the joint's motion; give link '{link}' an <inertial>")]
     MovesNothing { joint: String, link: String },
+    #[error("joint '{joint}': the mass matrix is singular there (q = 0): the inertia it moves is lost in rounding against numbers many orders of magnitude larger; check the masses, inertias and origins from link '{link}' on")]
+    MassMatrixSingular { joint: String, link: String },
     #[error("this is a xacro file; expand it to a URDF first: xacro FILE.urdf.xacro > FILE.urdf (ROS's xacro, also `pip install xacro`)")]
     Xacro,
     #[error("link '{link}': inertia is not positive definite (principal moments {moments})")]
