@@ -98,7 +98,7 @@ impl DiscretePlant {
             // without friction or gear losses only the limits bound a joint (the same laws)
             for (((joint, damping), law), q) in model.joints.iter().zip(&mut self.damping_step).zip(&mut self.laws).zip(&*q) {
                 *damping = h * joint.damping;
-                *law = JointLaw { lower: (joint.lower - q) / h, upper: (joint.upper - q) / h, below: 0.0, above: 0.0 };
+                *law = JointLaw { lower: (joint.lower - q) / h, upper: (joint.upper - q) / h, ..JointLaw::FREE };
             }
         }
         // M + hD is symmetric positive definite for any valid model; a failure means the state is
