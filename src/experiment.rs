@@ -59,6 +59,8 @@ impl Experiment {
     /// As [`Self::with_model`], with the motors given directly instead of by `config.motors` (which
     /// only names their file here): how `armscope size` tries candidate motor sets.
     pub fn with_motors(config: RunConfig, mut model: Model, motors: Option<MotorSet>) -> Result<Self, Error> {
+        // the URDF's own numbers first: its errors name the file
+        crate::dynamics::check_solvable(&model)?;
         let positive = |flag: &str, value: f64| {
             if value.is_finite() && value > 0.0 { Ok(()) } else { Err(Error::flag(flag, format!("must be a positive number of seconds (got {value})"))) }
         };
@@ -90,6 +92,11 @@ impl Experiment {
         let mut model = model.with_payload(config.payload);
         if let Some(set) = &motors {
             install_drive_trains(&mut model, set)?;
+        }
+        // a payload (or the parts carried) heavy enough to swamp the joints' own inertias in
+        // rounding leaves a plant that cannot be solved: said here, naming what made it so
+        if let Err(e) = crate::dynamics::check_solvable(&model) {
+            return Err(if config.payload > 0.0 { Error::flag("--payload", format!("{:e} kg: {}", config.payload, e.kind)) } else { Error::flag("--motors", e.kind.to_string()) });
         }
         let motors = motors.map(Arc::new);
         let mut plant = plant_spec(&config)?;

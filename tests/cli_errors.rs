@@ -175,3 +175,30 @@ fn bad_flags_name_the_flag() {
     assert_error(run(&["run", "--no-such-flag"]), 2, &["--no-such-flag"]);
     assert_error(run(&["run", "--tool", "nowhere"]), 2, &["--tool", "nowhere"]);
 }
+
+/// A payload so heavy that the joints' own inertias vanish beside it in rounding: the plant could
+/// not be solved (before, the run diverged at its first step with a hint to try the continuous
+/// plant). The flag is named, with the joint whose inertia is lost; no recording is started.
+#[test]
+fn a_payload_that_swamps_the_arm_in_rounding_is_an_error_naming_the_flag() {
+    let dir = tempfile::tempdir().unwrap();
+    let rrd = dir.path().join("p.rrd");
+    let (status, stderr) = run(&["run", "--quiet", "--no-mcap", "--duration", "0.01", "--payload", "1e16", "--rrd", rrd.to_str().unwrap()]);
+    assert_error((status, stderr), 2, &["--payload", "1e16 kg", "joint 'J3'", "the mass matrix is singular"]);
+    assert!(!rrd.exists(), "no recording of a run that never started");
+}
+
+/// The same check on a URDF's own numbers (a 1e308 kg tool whose inertial origin is lost, see
+/// urdf_fuzz.rs) names the file and the joint, in `run` and in `model`.
+#[test]
+fn a_urdf_whose_mass_matrix_is_singular_in_rounding_is_an_error_naming_the_joint() {
+    let text = std::fs::read_to_string(common::box_urdf()).unwrap();
+    let tool = "<origin xyz=\"0.02 0 0\" rpy=\"0 0 0\"/>\n      <mass value=\"0.05\"/>";
+    assert!(text.contains(tool), "the box model's tool link changed");
+    let heavy = text.replace(tool, "<onanrigin xyz=\"0.02 0 0\" rpy=\"0 0 0\"/>\n      <mass value=\"1e308\"/>");
+    assert_error(run_with_urdf(&heavy, &[]), 2, &["bad.urdf", "joint 'J3'", "the mass matrix is singular"]);
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("heavy.urdf");
+    std::fs::write(&path, &heavy).unwrap();
+    assert_error(run(&["model", "--urdf", path.to_str().unwrap()]), 2, &["heavy.urdf", "joint 'J3'", "the mass matrix is singular"]);
+}

@@ -1,8 +1,11 @@
-//! Thousands of mutated URDF texts through the loader: never a panic, always a model or a
-//! one-line error that names the file.
+//! Thousands of mutated URDF texts through the loader and the dynamics' solvability check: never a
+//! panic, always a model or a one-line error that names the file.
 
 mod common;
 
+use armscope::config::RunConfig;
+use armscope::dynamics::check_solvable;
+use armscope::experiment::Experiment;
 use armscope::model::load_urdf_str;
 use proptest::prelude::*;
 use std::path::Path;
@@ -83,20 +86,24 @@ fn apply(text: &str, m: &Mutation) -> String {
 
 /// Found by the test below: a tool of 1e308 kg whose inertial origin is lost (an unknown tag in
 /// its place) loaded, with finite numbers everywhere, yet the mass matrix was singular: the joints'
-/// own inertias (1e-4 kg·m²) vanished in sums of 1e307. The loader refuses it, naming the first
-/// joint whose inertia the factorization cannot find.
+/// own inertias (1e-4 kg·m²) vanished in sums of 1e307. The parser takes the numbers as written;
+/// the dynamics' check refuses the model, naming the first joint whose inertia the factorization
+/// cannot find, and so does every experiment built on it.
 #[test]
 fn a_mass_that_swamps_the_joints_inertias_is_an_error_naming_the_joint() {
     let text = base_text();
     let tool = "<link name=\"tool_link\">\n    <inertial>\n      <origin xyz=\"0.02 0 0\" rpy=\"0 0 0\"/>\n      <mass value=\"0.05\"/>";
     assert!(text.contains(tool), "the box model's tool link changed");
     let heavy = text.replace(tool, "<link name=\"tool_link\">\n    <inertial>\n      <onanrigin xyz=\"0.02 0 0\" rpy=\"0 0 0\"/>\n      <mass value=\"1e308\"/>");
-    let msg = load_urdf_str(&heavy, Path::new("heavy.urdf")).unwrap_err().to_string();
+    let model = load_urdf_str(&heavy, Path::new("heavy.urdf")).expect("every number is finite: the parser takes it");
+    let msg = check_solvable(&model).unwrap_err().to_string();
     assert!(msg.starts_with("heavy.urdf: joint 'J3': the mass matrix is singular"), "{msg}");
     assert!(!msg.contains('\n'), "{msg}");
-    // the same tool at a plain 1e3 kg loads: the check is about rounding, not about heavy tools
-    let loaded = load_urdf_str(&text.replace(tool, &tool.replace("0.05", "1e3")), Path::new("ok.urdf"));
-    assert!(loaded.is_ok(), "{:?}", loaded.err().map(|e| e.to_string()));
+    let refused = Experiment::with_model(RunConfig::default(), model).err().expect("no experiment on a plant that cannot be solved").to_string();
+    assert_eq!(refused, msg);
+    // the same tool at a plain 1e3 kg passes: the check is about rounding, not about heavy tools
+    let model = load_urdf_str(&text.replace(tool, &tool.replace("0.05", "1e3")), Path::new("ok.urdf")).unwrap();
+    assert!(check_solvable(&model).is_ok());
 }
 
 proptest! {
@@ -113,6 +120,12 @@ proptest! {
         match result.unwrap() {
             Ok(model) => {
                 prop_assert!(model.dof() > 0);
+                // what the parser took, the dynamics may still refuse: in one line naming the file
+                if let Err(e) = check_solvable(&model) {
+                    let msg = e.to_string();
+                    prop_assert!(msg.starts_with("mutated.urdf: ") && !msg.contains('\n'), "{msg:?}");
+                    return Ok(());
+                }
                 // every moving joint moves something: a positive diagonal of the mass matrix
                 let mut data = armscope::dynamics::Data::new(&model);
                 let m = armscope::dynamics::crba(&model, &mut data, &vec![0.0; model.dof()]);

@@ -48,6 +48,7 @@ pub struct ModelArgs {
 /// `armscope model`.
 pub fn model(args: &ModelArgs) -> Result<i32, Error> {
     let mut model = crate::model::load_urdf_with(&args.urdf, crate::model::LoadOptions { strict_inertia: args.strict_inertia })?;
+    crate::dynamics::check_solvable(&model)?;
     for notice in &model.notices {
         eprintln!("armscope: notice: {notice}");
     }

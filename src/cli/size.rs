@@ -235,6 +235,7 @@ pub fn size(args: &SizeArgs) -> Result<i32, Error> {
     let motions = motions(args)?;
     let first = &motions[0].1;
     let model = crate::model::load_urdf(&first.urdf)?;
+    crate::dynamics::check_solvable(&model)?;
     for notice in &model.notices {
         eprintln!("armscope: notice: {notice}");
     }

@@ -17,6 +17,7 @@ mod kinematics;
 mod ldlt;
 mod ltdl;
 mod rnea;
+mod solvable;
 
 pub use aba::{aba, aba_from_kinematics};
 pub use cholesky::{cholesky_in_place, cholesky_solve_in_place};
@@ -28,4 +29,5 @@ pub use jacobian::frame_jacobian;
 pub use ldlt::{ldlt_in_place, ldlt_solve_in_place};
 pub use ltdl::{ltdl_in_place, ltdl_solve_in_place};
 pub use kinematics::{body_poses, forward_kinematics, frame_pose, frame_pose_in};
+pub use solvable::check_solvable;
 pub use rnea::{bias_forces, gravity_and_bias_from_kinematics, gravity_forces, gravity_from_kinematics, rnea, rnea_from_kinematics};

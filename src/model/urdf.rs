@@ -230,30 +230,9 @@ fn build(text: &str, source: &Path, options: LoadOptions) -> Result<Model, K> {
         notices,
     };
     model.set_actuators(actuators);
-    // finite numbers whose products overflow (a massless link 1e308 m away): the mass matrix the
-    // simulation will use, computed once here, must be finite
-    let mut data = crate::dynamics::Data::new(&model);
-    let m = crate::dynamics::crba(&model, &mut data, &vec![0.0; model.dof()]);
-    if let Some(j) = (0..model.dof()).find(|&j| m.row(j).iter().any(|x| !x.is_finite())) {
-        return Err(K::NonFinite { element: format!("link '{}'", model.joints[j].child_link), field: "mass matrix (numbers too large)", value: f64::INFINITY });
-    }
-    // finite numbers so far apart that the smaller vanish in the sums (a 1e308 kg tool swamps its
-    // own 1e-4 kg·m² about the last joint): every coordinate moves something, yet the mass matrix
-    // is singular and the plant cannot be solved
-    if let Some(j) = first_singular_coordinate(&m) {
-        return Err(K::MassMatrixSingular { joint: model.joints[j].name.clone(), link: model.joints[j].child_link.clone() });
-    }
+    // (whether its plant can be solved — the mass matrix finite and positive definite — is the
+    // dynamics' verdict, `dynamics::check_solvable`, asked where the model is simulated)
     Ok(model)
-}
-
-/// The first coordinate j for which the leading (j+1)×(j+1) block of `m` is not positive definite
-/// (None when `m` is): the joint whose inertia the factorization cannot find.
-fn first_singular_coordinate(m: &nalgebra::DMatrix<f64>) -> Option<usize> {
-    if m.clone().cholesky().is_some() {
-        return None;
-    }
-    // only on the way to an error: each leading block in turn
-    (0..m.nrows()).find(|&j| m.view((0, 0), (j + 1, j + 1)).clone_owned().cholesky().is_none())
 }
 
 fn pose(p: &urdf_rs::Pose) -> Pose {
