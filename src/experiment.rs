@@ -94,8 +94,12 @@ impl Experiment {
             install_drive_trains(&mut model, set)?;
         }
         // a payload (or the parts carried) heavy enough to swamp the joints' own inertias in
-        // rounding leaves a plant that cannot be solved: said here, naming what made it so
-        if let Err(e) = crate::dynamics::check_solvable(&model) {
+        // rounding leaves a plant that cannot be solved: said here, naming what made it so (without
+        // either, the inertias are the URDF's, checked above)
+        let added_mass = config.payload > 0.0 || motors.is_some();
+        if added_mass
+            && let Err(e) = crate::dynamics::check_solvable(&model)
+        {
             return Err(if config.payload > 0.0 { Error::flag("--payload", format!("{:e} kg: {}", config.payload, e.kind)) } else { Error::flag("--motors", e.kind.to_string()) });
         }
         let motors = motors.map(Arc::new);
