@@ -163,6 +163,13 @@ fn mcap_has_the_channels_schemas_and_per_step_messages_and_equals_the_trace() {
     let summary = mcap::Summary::read(&bytes).unwrap().expect("summary section");
     assert!(!summary.chunk_indexes.is_empty());
     assert!(summary.chunk_indexes.iter().all(|c| c.compression == "zstd"));
+    // the stepper and motor fields are left empty in a run without steppers or motors (as friction's)
+    let schema_data = mcap::MessageStream::new(&bytes).unwrap().map(|m| m.unwrap()).find(|m| m.channel.topic == "/controller").unwrap().channel.schema.clone().unwrap();
+    let pool = prost_reflect::DescriptorPool::decode(&schema_data.data[..]).unwrap();
+    let telemetry = prost_reflect::DynamicMessage::decode(pool.get_message_by_name(&schema_data.name).unwrap(), &topics["/controller"][0].3[..]).unwrap();
+    for (field, len) in [("torque", 6), ("torque_limit", 6), ("load_angle", 0), ("lost_steps", 0), ("motor_speed", 0), ("friction", 0)] {
+        assert_eq!(telemetry.get_field_by_name(field).unwrap().as_list().unwrap().len(), len, "/controller.{field}");
+    }
     // Foxglove refuses to preload a file with a chunk that has no message index
     assert!(summary.chunk_indexes.iter().all(|c| !c.message_index_offsets.is_empty()), "a chunk without message indexes");
     let names: Vec<String> = summary.metadata_indexes.iter().map(|m| m.name.clone()).collect();
@@ -205,6 +212,12 @@ fn rrd_holds_every_joint_series_with_one_row_per_step_equal_to_the_trace() {
     for (a, axis) in ["x", "y", "z"].iter().enumerate() {
         assert_eq!(tool.iter().map(|r| r.1[a]).collect::<Vec<_>>(), run.trace.column(axis), "tool {axis}");
     }
+    // a series the run does not record gets no entity (no steppers, motors, friction or heat here)
+    let entities = rrd.entities();
+    for leaf in ["load_angle", "lost_steps", "motor_speed", "friction", "winding_temperature"] {
+        assert!(!entities.keys().any(|e| e.ends_with(&format!("/{leaf}"))), "{leaf}: {:?}", entities.keys().collect::<Vec<_>>());
+    }
+    assert!(entities.contains_key("/joints/J1/torque_limit") && entities.contains_key("/joints/J1/saturated_torque"));
 }
 
 #[test]

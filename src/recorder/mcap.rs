@@ -616,6 +616,11 @@ impl Recorder for McapRecorder {
         };
         let n = model.dof();
         let has_friction = run.experiment.joint_has_friction().contains(&true);
+        // a run records only what it has, as with friction: the stepper fields when some joint is
+        // driven open loop, the motor speeds with `--motors` (zeros at every step were a seventh
+        // of the file's messages)
+        let stepped = e.stepped_joints().contains(&true);
+        let per_joint = |recorded: bool| if recorded { vec![0.0; n] } else { Vec::new() };
         self.telemetry = ControllerTelemetry {
             time: 0.0,
             target: vec![0.0; n],
@@ -627,9 +632,9 @@ impl Recorder for McapRecorder {
             tool_error: 0.0,
             tool_position: Vec::with_capacity(3),
             torque_limit: vec![0.0; n],
-            load_angle: vec![0.0; n],
-            lost_steps: vec![0; n],
-            motor_speed: vec![0.0; n],
+            load_angle: per_joint(stepped),
+            lost_steps: if stepped { vec![0; n] } else { Vec::new() },
+            motor_speed: per_joint(e.motors.is_some()),
             friction: if has_friction { vec![0.0; n] } else { Vec::new() },
             stuck: if has_friction { vec![0; n] } else { Vec::new() },
             winding_temperature: Vec::new(),
@@ -699,9 +704,15 @@ impl Recorder for McapRecorder {
             tel.saturated[j] = s.saturated[j] as u32;
             tel.chatter[j] = s.chatter[j] as u32;
             tel.torque_limit[j] = s.torque_limit[j];
-            tel.load_angle[j] = s.load_angle[j];
-            tel.lost_steps[j] = s.lost_steps[j];
-            tel.motor_speed[j] = self.motors.as_ref().and_then(|m| m.motor_speed(j, s.v[j])).unwrap_or(0.0);
+        }
+        if !tel.load_angle.is_empty() {
+            tel.load_angle.copy_from_slice(s.load_angle);
+            tel.lost_steps.copy_from_slice(s.lost_steps);
+        }
+        if let Some(motors) = &self.motors {
+            for (j, speed) in tel.motor_speed.iter_mut().enumerate() {
+                *speed = motors.motor_speed(j, s.v[j]).unwrap_or(0.0);
+            }
         }
         tel.winding_temperature.clear();
         tel.winding_temperature.extend_from_slice(s.winding_temperature);

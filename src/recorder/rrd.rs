@@ -307,7 +307,10 @@ impl RerunRecorder {
         Ok(())
     }
 
-    fn log_series_styles(&self, rec: &RecordingStream) -> Result<(), Error> {
+    /// The names, colours and widths of the series this run records (a series it does not
+    /// record gets no style: an entity with a style alone is an empty entry in the viewer's tree,
+    /// and every entity costs the file's footer).
+    fn log_series_styles(&self, rec: &RecordingStream, friction: bool) -> Result<(), Error> {
         let e = |err: rerun::RecordingStreamError| self.err(err);
         let grey = rerun::Color::from_rgb(140, 140, 140);
         let red = rerun::Color::from_rgb(220, 50, 50);
@@ -335,7 +338,15 @@ impl RerunRecorder {
                 ("friction", lines(&[format!("{name} friction (N·m)"), format!("{name} stuck (0/1)")], &[rerun::Color::from_rgb(150, 100, 200), rerun::Color::from_rgb(100, 100, 100)], &[1.0, 1.0])),
                 ("winding_temperature", lines(&[format!("{name} winding (°C)")], &[c], &[1.5])),
             ];
-            for (leaf, style) in styles {
+            let has_motor = self.motors.as_ref().is_some_and(|m| m.joints.get(j).is_some_and(Option::is_some));
+            let recorded = |leaf: &str| match leaf {
+                "load_angle" | "lost_steps" => self.stepped[j],
+                "motor_speed" => has_motor,
+                "friction" => friction,
+                "winding_temperature" => self.heated[j],
+                _ => true,
+            };
+            for (leaf, style) in styles.into_iter().filter(|(leaf, _)| recorded(leaf)) {
                 rec.log_static(format!("{base}/{leaf}"), &style).map_err(e)?;
             }
             rec.log_static(
@@ -804,7 +815,7 @@ impl Recorder for RerunRecorder {
             send_blueprint(&rec, &layout, &torque_ranges).map_err(|x| self.err(x))?;
         }
         self.log_static_scene(&rec, model)?;
-        self.log_series_styles(&rec)?;
+        self.log_series_styles(&rec, e.joint_has_friction().contains(&true))?;
         rec.log_static("config", &rerun::TextDocument::from_markdown(config_markdown(run))).map_err(|x| self.err(x))?;
         let commanded: Vec<[f32; 3]> = run.commanded_tool_path.iter().map(|p| [p.x as f32, p.y as f32, p.z as f32]).collect();
         // a command that holds still has no path to draw

@@ -45,13 +45,15 @@ pub struct ControllerTelemetry {
     /// the motor gives at the joint's speed through its gearbox.
     #[prost(double, repeated, tag = "10")]
     pub torque_limit: Vec<f64>,
-    /// Stepper mode: each joint's load angle, electrical degrees (0 where not a stepper).
+    /// Stepper mode: each joint's load angle, electrical degrees (0 where not a stepper; empty
+    /// when no joint is driven open loop).
     #[prost(double, repeated, tag = "11")]
     pub load_angle: Vec<f64>,
-    /// Stepper mode: full steps each joint has lost so far.
+    /// Stepper mode: full steps each joint has lost so far (empty when no joint is driven open loop).
     #[prost(int64, repeated, tag = "12")]
     pub lost_steps: Vec<i64>,
-    /// With `--motors`: each motor's shaft speed N·q̇, rev/s (0 where no motor file entry).
+    /// With `--motors`: each motor's shaft speed N·q̇, rev/s (0 where no motor file entry; empty
+    /// without `--motors`).
     #[prost(double, repeated, tag = "13")]
     pub motor_speed: Vec<f64>,
     /// Coulomb friction torque on each joint, N·m (empty when no joint has friction).
