@@ -31,6 +31,8 @@ pub struct Outputs {
     pub summary_json: Option<PathBuf>,
     /// Called with messages for the user (e.g. no viewer reachable).
     pub notice: Option<fn(&str)>,
+    /// Compress the recordings' chunks (`--compress`): smaller files, more CPU.
+    pub compress: bool,
     /// Further recorders, run after the others (a batch's comparison series).
     pub recorders: Vec<Box<dyn Recorder>>,
 }
@@ -61,7 +63,7 @@ pub fn run_experiment(experiment: &Experiment, outputs: Outputs, stop: Option<&A
         if let Some(path) = &outputs.rrd {
             create_parent(path)?;
         }
-        let mut rrd = RerunRecorder::new(RerunOptions { file: outputs.rrd.clone(), live: outputs.live, name: outputs.name.clone() });
+        let mut rrd = RerunRecorder::new(RerunOptions { file: outputs.rrd.clone(), live: outputs.live, name: outputs.name.clone(), compress: outputs.compress });
         if let Some(notice) = outputs.notice {
             rrd.on_notice(notice);
         }
@@ -71,7 +73,7 @@ pub fn run_experiment(experiment: &Experiment, outputs: Outputs, stop: Option<&A
         if let Some(path) = &outputs.mcap {
             create_parent(path)?;
         }
-        let mut mcap = McapRecorder::new(McapOptions { file: outputs.mcap.clone(), live: outputs.foxglove.clone() });
+        let mut mcap = McapRecorder::new(McapOptions { file: outputs.mcap.clone(), live: outputs.foxglove.clone(), compress: outputs.compress });
         if let Some(notice) = outputs.notice {
             mcap.on_notice(notice);
         }

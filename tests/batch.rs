@@ -243,3 +243,26 @@ fn batch_tables_count_collisions() {
     let md = std::fs::read_to_string(out.join("summary.md")).unwrap();
     assert!(md.contains("| collisions |") && md.contains("not checked") && md.contains("tool_link–floor"), "{md}");
 }
+
+/// `batch --compress` compresses every experiment's recordings; an experiment's own `compress = true`
+/// its own (as `run --compress`). The others keep their chunks as they are.
+#[test]
+fn batch_compress_applies_to_every_experiment_or_to_one() {
+    let dir = tempfile::tempdir().unwrap();
+    let manifest = dir.path().join("two.toml");
+    std::fs::write(&manifest, "name = \"two\"\n[defaults]\nduration = 0.3\n[[experiment]]\nname = \"plain\"\n[[experiment]]\nname = \"packed\"\ncompress = true\n").unwrap();
+    let compression = |out: &Path, name: &str| {
+        let bytes = std::fs::read(out.join(format!("{name}.mcap"))).unwrap();
+        let summary = mcap::Summary::read(&bytes).unwrap().expect("summary section");
+        let kinds: std::collections::BTreeSet<String> = summary.chunk_indexes.iter().map(|c| c.compression.clone()).collect();
+        kinds.into_iter().collect::<Vec<_>>()
+    };
+    let each = dir.path().join("each");
+    assert_eq!(armscope(&["batch", manifest.to_str().unwrap(), "--out", each.to_str().unwrap(), "--no-compare"]), 0);
+    assert_eq!(compression(&each, "plain"), [""]);
+    assert_eq!(compression(&each, "packed"), ["zstd"]);
+    let all = dir.path().join("all");
+    assert_eq!(armscope(&["batch", manifest.to_str().unwrap(), "--out", all.to_str().unwrap(), "--no-compare", "--compress"]), 0);
+    assert_eq!(compression(&all, "plain"), ["zstd"]);
+    assert_eq!(compression(&all, "packed"), ["zstd"]);
+}

@@ -139,7 +139,7 @@ pub struct Comparison {
 impl Comparison {
     /// Written as the runs' own `.rrd` files are (Rerun's encoder without LZ4, see `RrdFile`).
     pub fn create(out: &Path, name: &str) -> Result<Self, Error> {
-        let file = RrdFile::create(out, true).map_err(|e| Error::output(out, e))?;
+        let file = RrdFile::create(out, true, false).map_err(|e| Error::output(out, e))?;
         let rec = rerun::RecordingStreamBuilder::new("armscope-compare").recording_name(name).set_sinks(vec![file.sink()]).map_err(|e| Error::output(out, e))?;
         Ok(Self { rec, file, out: out.to_path_buf(), joints: Mutex::new(None) })
     }

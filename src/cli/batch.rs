@@ -22,6 +22,9 @@ pub struct BatchArgs {
     /// Skip the comparison recording.
     #[arg(long)]
     pub no_compare: bool,
+    /// Compress every experiment's recordings (as `run --compress`): smaller files, more CPU.
+    #[arg(long)]
+    pub compress: bool,
 }
 
 #[derive(Subcommand, Debug)]
@@ -57,6 +60,7 @@ pub fn batch(args: &BatchArgs) -> Result<i32, Error> {
                 shard: args.shard.as_deref().map(parse_shard).transpose()?,
                 out: args.out.clone(),
                 compare: !args.no_compare,
+                compress: args.compress,
                 progress: true,
             };
             if options.jobs == 0 {

@@ -86,6 +86,7 @@ pub fn run(args: &RunArgs) -> Result<i32, Error> {
         csv: args.csv.clone(),
         trace: args.trace.clone(),
         summary_json: args.summary_json.clone(),
+        compress: args.compress,
         notice: Some(|n| eprintln!("armscope: notice: {n}")),
         recorders: Vec::new(),
     };

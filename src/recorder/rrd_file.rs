@@ -1,8 +1,8 @@
 //! The `.rrd` file: Rerun's own encoder (same format, same footer), writing its chunks without
-//! LZ4. Rerun's `FileSink` always compresses; on armscope's recordings (mostly row ids, times and
-//! floats) LZ4 saves only a third of the size but was ~40 % of all the CPU the Rerun recording
-//! costs, on a machine whose two cores the simulation and both recorders share.
-//! `rerun rrd optimize IN.rrd -o OUT.rrd` writes a compressed copy (~40 % smaller) when size matters more.
+//! LZ4 unless asked (`--compress`). Rerun's `FileSink` always compresses; on armscope's recordings
+//! (mostly row ids, times and floats) LZ4 saves only a third of the size but was ~40 % of all the
+//! CPU the Rerun recording costs, on a machine whose two cores the simulation and both recorders
+//! share. `rerun rrd optimize IN.rrd -o OUT.rrd` writes a compressed copy afterwards.
 
 use rerun::external::re_build_info::CrateVersion;
 use rerun::external::re_log_encoding::{Encoder, EncodingOptions};
@@ -38,12 +38,13 @@ struct State {
 pub const FOOTER_UP_TO_SECONDS: f64 = 600.0;
 
 impl RrdFile {
-    /// `footer`: end the file with Rerun's manifest of its chunks.
-    pub fn create(path: &Path, footer: bool) -> Result<Self, String> {
+    /// `footer`: end the file with Rerun's manifest of its chunks; `compress`: LZ4 its chunks.
+    pub fn create(path: &Path, footer: bool, compress: bool) -> Result<Self, String> {
         let (file, replaced) = super::output_file::create_replacing(path).map_err(|e| e.to_string())?;
         // the encoder writes each message whole: a buffer smaller than a block's chunks (100–250 KB)
         // gathers the small messages and lets the chunks go straight to the file, uncopied
-        let mut encoder = Encoder::new_eager(CrateVersion::LOCAL, EncodingOptions::PROTOBUF_UNCOMPRESSED, BufWriter::with_capacity(64 << 10, file)).map_err(|e| e.to_string())?;
+        let options = if compress { EncodingOptions::PROTOBUF_COMPRESSED } else { EncodingOptions::PROTOBUF_UNCOMPRESSED };
+        let mut encoder = Encoder::new_eager(CrateVersion::LOCAL, options, BufWriter::with_capacity(64 << 10, file)).map_err(|e| e.to_string())?;
         if !footer {
             encoder.do_not_emit_footer();
         }

@@ -19,11 +19,11 @@ fn run(experiment: &Experiment, dir: &Path, rrd: bool, mcap: bool) -> usize {
     let mut recorders: Vec<Box<dyn Recorder>> = Vec::new();
     let mut threaded = Threaded::new(Duration::from_millis(20));
     if rrd {
-        let options = RerunOptions { file: Some(dir.join("bench.rrd")), live: None, name: "bench".into() };
+        let options = RerunOptions { file: Some(dir.join("bench.rrd")), live: None, name: "bench".into(), compress: false };
         threaded = threaded.with(RerunRecorder::new(options));
     }
     if mcap {
-        threaded = threaded.with(McapRecorder::new(McapOptions { file: Some(dir.join("bench.mcap")), live: None }));
+        threaded = threaded.with(McapRecorder::new(McapOptions { file: Some(dir.join("bench.mcap")), live: None, compress: false }));
     }
     if !threaded.is_empty() {
         recorders.push(Box::new(threaded));
