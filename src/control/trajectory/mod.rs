@@ -23,6 +23,16 @@ pub trait Trajectory: Send + Sync {
     fn period(&self) -> Option<f64> {
         None
     }
+    /// The time from which it repeats with [`Trajectory::period`]: 0, or where a ramp-in ends.
+    fn periodic_from(&self) -> f64 {
+        0.0
+    }
+}
+
+/// The part of a `duration`-second command that holds all of its motion: up to the end of its
+/// first period after it starts repeating (the rest repeats what is in it), or the whole run.
+pub fn span_with_every_motion(trajectory: &dyn Trajectory, duration: f64) -> f64 {
+    trajectory.period().map_or(duration, |period| (trajectory.periodic_from() + period).min(duration))
 }
 
 /// 2π/ω for a wave of angular frequency ω (none for ω = 0: it stands still).

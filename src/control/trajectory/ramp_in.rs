@@ -58,6 +58,10 @@ impl Trajectory for RampIn {
         self.inner.period()
     }
 
+    fn periodic_from(&self) -> f64 {
+        self.duration + self.inner.periodic_from()
+    }
+
     fn describe(&self) -> String {
         format!("{}, brought in from the start pose over {:.3} s (quintic blend)", self.inner.describe(), self.duration)
     }
