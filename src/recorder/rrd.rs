@@ -133,7 +133,7 @@ pub struct RerunRecorder {
     trail: VecDeque<[f32; 3]>,
     /// The trail as it was at each of its updates in this block (sent with the block).
     trail_times: Vec<f64>,
-    trail_strips: Vec<Vec<[f32; 3]>>,
+    trail_strips: Strips,
     /// The whole tool path, thinned to at most `PATH_POINTS` (logged once, at the end).
     path: Overview<[f32; 3]>,
     steps_per_trail_point: usize,
@@ -146,9 +146,10 @@ pub struct RerunRecorder {
     heated: Vec<bool>,
     /// With collision checks: what is in contact, drawn and plotted.
     collisions: Option<RrdCollisions>,
-    /// Memory for the columns sent at every block, and for their row ids.
+    /// Memory for the columns sent at every block, for their row ids and the trail's points.
     values_pool: ColumnPool<f64>,
     ids_pool: ColumnPool<[u8; 16]>,
+    points_pool: ColumnPool<[f32; 3]>,
 }
 
 /// Steps per block in a file-only recording: ~4 s of simulation per chunk (fewer, larger chunks
@@ -184,7 +185,7 @@ impl RerunRecorder {
             steps_per_pose: 10,
             trail: VecDeque::new(),
             trail_times: Vec::new(),
-            trail_strips: Vec::new(),
+            trail_strips: Strips::default(),
             path: Overview::new(PATH_POINTS),
             steps_per_trail_point: 20,
             live: false,
@@ -195,6 +196,7 @@ impl RerunRecorder {
             collisions: None,
             values_pool: ColumnPool::default(),
             ids_pool: ColumnPool::default(),
+            points_pool: ColumnPool::default(),
         }
     }
 
@@ -438,9 +440,9 @@ impl RerunRecorder {
             send("collisions/in_contact", time.clone(), scalars(&c.count, 1))?;
             send("collisions/min_distance", time.clone(), scalars(&c.min_distance, 1))?;
         }
-        if !self.trail_times.is_empty() {
+        if !self.trail_strips.is_empty() {
             let times = TimeColumn::new_duration_secs(TIMELINE, self.trail_times.iter().copied());
-            send("world/tool/trail", times, vec![strips_column(&self.trail_strips)])?;
+            send("world/tool/trail", times, vec![self.trail_strips.take_column(&self.points_pool)])?;
         }
         let send_poses = !self.pose_times.is_empty() && (all || self.live || self.pose_times.len() >= FILE_BLOCK_STEPS);
         if send_poses {
@@ -463,7 +465,6 @@ impl RerunRecorder {
             c.flush(&rec).map_err(|x| self.err(x))?;
         }
         self.trail_times.clear();
-        self.trail_strips.clear();
         if send_poses {
             self.pose_times.clear();
             for link in &mut self.links {
@@ -498,20 +499,51 @@ fn list_column(values: Buffer, offsets: OffsetBuffer<i32>, descriptor: rerun::Co
     rerun::SerializedComponentColumn::new(list, descriptor)
 }
 
-/// A `LineStrips3D` strips column, one strip per row, built straight from the points: what
-/// `LineStrips3D::update_fields().with_strips(..).columns_of_unit_batches()` makes (test below),
-/// without its generic serialization, a sixth of this recorder's thread for the tool's trail.
-fn strips_column(strips: &[Vec<[f32; 3]>]) -> rerun::SerializedComponentColumn {
-    use rerun::external::arrow::array::{ArrayRef, FixedSizeListArray, Float32Array, ListArray};
-    use rerun::external::arrow::datatypes::{DataType, Field};
-    let strip_type = <rerun::components::LineStrip3D as rerun::Loggable>::arrow_datatype();
-    let DataType::List(point_field) = &strip_type else { unreachable!("a line strip is a list of points") };
-    let DataType::FixedSizeList(coordinate_field, 3) = point_field.data_type() else { unreachable!("a point is three float32") };
-    let coordinates = Float32Array::from_iter_values(strips.iter().flatten().flatten().copied());
-    let points: ArrayRef = Arc::new(FixedSizeListArray::new(coordinate_field.clone(), 3, Arc::new(coordinates), None));
-    let strip_list: ArrayRef = Arc::new(ListArray::new(point_field.clone(), OffsetBuffer::from_lengths(strips.iter().map(Vec::len)), points, None));
-    let rows = ListArray::new(Arc::new(Field::new_list_field(strip_type.clone(), true)), OffsetBuffer::from_lengths(std::iter::repeat_n(1, strips.len())), strip_list, None);
-    rerun::SerializedComponentColumn::new(rows, rerun::LineStrips3D::descriptor_strips())
+/// Line strips, one a row, stored as a `LineStrips3D` column keeps them: every strip's points back
+/// to back, and each strip's length. A trail update appends its strip without a vector of its own
+/// (one per update was a fifth of this recorder's thread), and the points move into Arrow uncopied.
+#[derive(Default)]
+struct Strips {
+    points: Vec<[f32; 3]>,
+    lengths: Vec<usize>,
+    /// Points the last block's strips had (the next block's room).
+    last_points: usize,
+}
+
+impl Strips {
+    fn is_empty(&self) -> bool {
+        self.lengths.is_empty()
+    }
+
+    /// Appends a strip; a block's first takes its points' memory from `pool`.
+    fn push(&mut self, strip: impl ExactSizeIterator<Item = [f32; 3]>, pool: &ColumnPool<[f32; 3]>) {
+        if self.points.capacity() == 0 {
+            self.points = pool.take(self.last_points.max(strip.len()));
+        }
+        self.lengths.push(strip.len());
+        self.points.extend(strip);
+    }
+
+    /// The strips column, one strip per row: what `LineStrips3D::update_fields().with_strips(..)
+    /// .columns_of_unit_batches()` makes (test below), without its generic serialization.
+    /// The strips so far as a column (see [`Strips`]); the next block starts empty.
+    fn take_column(&mut self, pool: &ColumnPool<[f32; 3]>) -> rerun::SerializedComponentColumn {
+        use rerun::external::arrow::array::{ArrayRef, FixedSizeListArray, Float32Array, ListArray};
+        use rerun::external::arrow::buffer::ScalarBuffer;
+        use rerun::external::arrow::datatypes::{DataType, Field};
+        let strip_type = <rerun::components::LineStrip3D as rerun::Loggable>::arrow_datatype();
+        let DataType::List(point_field) = &strip_type else { unreachable!("a line strip is a list of points") };
+        let DataType::FixedSizeList(coordinate_field, 3) = point_field.data_type() else { unreachable!("a point is three float32") };
+        let points = std::mem::take(&mut self.points);
+        self.last_points = points.len();
+        let count = 3 * points.len();
+        let coordinates = Float32Array::new(ScalarBuffer::new(pool.buffer(points), 0, count), None);
+        let points: ArrayRef = Arc::new(FixedSizeListArray::new(coordinate_field.clone(), 3, Arc::new(coordinates), None));
+        let strip_list: ArrayRef = Arc::new(ListArray::new(point_field.clone(), OffsetBuffer::from_lengths(self.lengths.iter().copied()), points, None));
+        let rows = ListArray::new(Arc::new(Field::new_list_field(strip_type.clone(), true)), OffsetBuffer::from_lengths(std::iter::repeat_n(1, self.lengths.len())), strip_list, None);
+        self.lengths.clear();
+        rerun::SerializedComponentColumn::new(rows, rerun::LineStrips3D::descriptor_strips())
+    }
 }
 
 /// A column of one fixed-size float32 component (a translation, a quaternion) per row, built
@@ -895,7 +927,7 @@ impl Recorder for RerunRecorder {
             }
             self.path.push(tip);
             self.trail_times.push(s.t);
-            self.trail_strips.push(self.trail.iter().copied().collect());
+            self.trail_strips.push(self.trail.iter().copied(), &self.points_pool);
         }
         let due = self.times.len() >= FILE_BLOCK_STEPS || (self.live && self.last_flush.elapsed() >= LIVE_FLUSH) || s.is_final;
         if due {
@@ -936,7 +968,13 @@ mod tests {
     #[test]
     fn a_strips_column_built_straight_is_the_one_rerun_would_make() {
         let strips = vec![vec![[0.0, 1.0, 2.0], [3.0, 4.0, 5.5]], vec![], vec![[-1.0, 0.25, 9.0]]];
-        let ours = super::strips_column(&strips);
+        let pool = super::ColumnPool::default();
+        let mut built = super::Strips::default();
+        for strip in &strips {
+            built.push(strip.iter().copied(), &pool);
+        }
+        let ours = built.take_column(&pool);
+        assert!(built.is_empty());
         let mut rerun_s: Vec<_> = rerun::LineStrips3D::update_fields().with_strips(strips.iter().cloned()).columns_of_unit_batches().unwrap().collect();
         assert_eq!(rerun_s.len(), 1);
         let theirs = rerun_s.remove(0);
