@@ -244,6 +244,14 @@ fn rrd_holds_every_joint_series_with_one_row_per_step_equal_to_the_trace() {
         assert!(!entities.keys().any(|e| e.ends_with(&format!("/{leaf}"))), "{leaf}: {:?}", entities.keys().collect::<Vec<_>>());
     }
     assert!(entities.contains_key("/joints/J1/torque_limit") && entities.contains_key("/joints/J1/saturated_torque"));
+    // the ±effort lines span the whole run, two rows (a live viewer gets them block by block)
+    for (j, effort) in [8.0, 12.0, 8.0, 5.0, 3.0, 1.5].into_iter().enumerate() {
+        let lines = rrd.series(&format!("/joints/J{}/torque_limit", j + 1));
+        assert_eq!(lines.len(), 2, "J{}", j + 1);
+        for ((time, values), want) in lines.iter().zip([t[0], t[steps - 1]]) {
+            assert!((time - want).abs() < 1e-9 && *values == [effort, -effort], "J{}: {lines:?}", j + 1);
+        }
+    }
 }
 
 #[test]

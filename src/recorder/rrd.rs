@@ -122,6 +122,9 @@ pub struct RerunRecorder {
     /// each motor's shaft speed is recorded.
     motors: Option<Arc<crate::actuator::MotorSet>>,
     times: Vec<f64>,
+    /// The first and last samples' times (the limit lines of a file span them).
+    first_time: f64,
+    last_time: f64,
     joints: Vec<JointColumns>,
     /// [x, y, z] per step.
     tool: Vec<f64>,
@@ -177,6 +180,8 @@ impl RerunRecorder {
             stepped: Vec::new(),
             motors: None,
             times: Vec::new(),
+            first_time: 0.0,
+            last_time: 0.0,
             joints: Vec::new(),
             tool: Vec::new(),
             tool_error: Vec::new(),
@@ -426,10 +431,12 @@ impl RerunRecorder {
                 send(&format!("{base}/saturated_torque"), times, scalars(&c.saturated_torque, 1))?;
             }
             // the limits: at every step when they fall with speed, else as lines spanning the block
+            // the limits: at every step when they fall with speed, else as lines spanning each block
+            // for a live viewer (they grow with the run; a file gets them once, `limit_lines`)
             let effort = self.effort[j];
             if self.motors.is_some() {
                 send(&format!("{base}/torque_limit"), time.clone(), scalars(&c.limit, 2))?;
-            } else if effort.is_finite() {
+            } else if effort.is_finite() && self.live {
                 let ends = TimeColumn::new_duration_secs(TIMELINE, [self.times[0], self.times[steps - 1]]);
                 send(&format!("{base}/torque_limit"), ends, scalars(&[effort, -effort, effort, -effort], 2))?;
             }
@@ -476,6 +483,22 @@ impl RerunRecorder {
             let _ = rec.flush_async();
         }
         self.last_flush = Instant::now();
+        Ok(())
+    }
+}
+
+impl RerunRecorder {
+    /// A file's ±limit lines without `--motors`, each spanning the whole run, sent once at its end:
+    /// a chunk of two rows per joint and block cost as much to encode as a full one, and a seventh
+    /// of the file's chunks were those (a live viewer gets them with every block instead).
+    fn limit_lines(&self, rec: &RecordingStream) -> Result<(), Error> {
+        if self.live || self.motors.is_some() {
+            return Ok(());
+        }
+        for (name, &effort) in self.joint_names.iter().zip(&self.effort).filter(|(_, e)| e.is_finite()) {
+            let ends = TimeColumn::new_duration_secs(TIMELINE, [self.first_time, self.last_time]);
+            send_in_order(rec, &format!("joints/{name}/torque_limit"), ends, [scalar_column(&[effort, -effort, effort, -effort], 2)]).map_err(|x| self.err(x))?;
+        }
         Ok(())
     }
 }
@@ -875,6 +898,10 @@ impl Recorder for RerunRecorder {
     }
 
     fn record(&mut self, s: &Sample) -> Result<(), Error> {
+        if s.k == 0 {
+            self.first_time = s.t;
+        }
+        self.last_time = s.t;
         self.times.push(s.t);
         for (j, c) in self.joints.iter_mut().enumerate() {
             let flag = |b: bool| if b { 1.0 } else { 0.0 };
@@ -939,6 +966,7 @@ impl Recorder for RerunRecorder {
     fn finish(&mut self, run: &RunInfo, summary: &Summary) -> Result<(), Error> {
         self.flush_block(true)?;
         let Some(rec) = self.rec.take() else { return Ok(()) };
+        self.limit_lines(&rec)?;
         // the layout, its torque plots scaled by what the run's drives settled to as well: sent
         // now to a file, again to a live viewer where the scale changed (its second layout)
         let settled = |i: usize| summary.peak_abs_torque_after_settle.get(i).copied().flatten();
