@@ -49,6 +49,21 @@ fn mcap_messages(path: &Path) -> BTreeMap<String, Vec<(u64, String, String, Vec<
     by_topic
 }
 
+/// Every chunk's CRC of its records, then the data section's CRC (0: not computed).
+fn chunk_and_data_crcs(path: &Path) -> Vec<u32> {
+    let bytes = std::fs::read(path).unwrap();
+    let mut crcs = Vec::new();
+    for record in mcap::read::LinearReader::new(&bytes).unwrap() {
+        match record.unwrap() {
+            mcap::records::Record::Chunk { header, .. } => crcs.push(header.uncompressed_crc),
+            mcap::records::Record::DataEnd(end) => crcs.push(end.data_section_crc),
+            _ => {}
+        }
+    }
+    assert!(crcs.len() >= 2, "chunks and the data end");
+    crcs
+}
+
 fn col(trace: &Table, prefix: &str, j: usize) -> Vec<f64> {
     trace.column(&format!("{prefix}{}", j + 1))
 }
@@ -192,6 +207,9 @@ fn compressed_recordings_are_smaller_and_hold_the_same_data() {
     assert!(size(&packed.mcap) < 0.8 * size(&plain.mcap), "mcap {} vs {}", size(&packed.mcap), size(&plain.mcap));
     let summary = mcap::Summary::read(&std::fs::read(&packed.mcap).unwrap()).unwrap().expect("summary section");
     assert!(!summary.chunk_indexes.is_empty() && summary.chunk_indexes.iter().all(|c| c.compression == "zstd"));
+    // CRCs with --compress (the mcap crate checks them as it reads, below), none without
+    assert_eq!(chunk_and_data_crcs(&packed.mcap).iter().filter(|&&c| c == 0).count(), 0);
+    assert!(chunk_and_data_crcs(&plain.mcap).iter().all(|&c| c == 0));
     let (a, b) = (mcap_messages(&plain.mcap), mcap_messages(&packed.mcap));
     assert_eq!(a.keys().collect::<Vec<_>>(), b.keys().collect::<Vec<_>>());
     // /controller's payloads bit for bit (the other topics' stamps carry each run's wall-clock start)

@@ -527,6 +527,12 @@ impl Recorder for McapRecorder {
             // within zstd's window at this level, so no block takes its slower "external
             // dictionary" path (−5 % of the writer's work at the same size)
             .chunk_size(Some(512 * 1024))
+            // CRCs with --compress only: the crate checksums every record field by field as it
+            // writes it, twice (5 % of the run's instructions), and the data section's CRC needs
+            // the chunks' (the default is rosbag2's "fastwrite": chunks as they are, no CRCs;
+            // readers skip a zero CRC)
+            .calculate_chunk_crcs(self.options.compress)
+            .calculate_data_section_crc(self.options.compress)
             .library(format!("armscope {} (foxglove-sdk schemas, mcap-rust)", env!("CARGO_PKG_VERSION")));
         // zstd hands its output over in pieces of up to 128 KiB: gathered here, a chunk (~200 KiB
         // compressed) takes a write call or two
