@@ -9,6 +9,7 @@
 use super::foxglove_live::FoxgloveLive;
 use super::overview::Overview;
 use super::robot_description::RobotDescription;
+use super::step_messages::JointStatesLayout;
 use super::telemetry::ControllerTelemetry;
 use super::worker::{BatchWorker, Reusable};
 use super::{Recorder, RunInfo};
@@ -254,7 +255,9 @@ pub struct McapRecorder {
     tf_msg: FrameTransforms,
     /// The transforms of fixed joints (constant; sent with the geometry, once a simulated second).
     fixed_tf_msg: FrameTransforms,
-    joints_msg: JointStates,
+    /// `/joint_states`: its layout and a step's values.
+    joint_states: JointStatesLayout,
+    joint_values: Vec<f64>,
     telemetry: ControllerTelemetry,
     scene: SceneUpdate,
     model: Option<std::sync::Arc<Model>>,
@@ -343,7 +346,8 @@ impl McapRecorder {
             joint_tfs: Vec::new(),
             tf_msg: FrameTransforms::default(),
             fixed_tf_msg: FrameTransforms::default(),
-            joints_msg: JointStates::default(),
+            joint_states: JointStatesLayout::new(&[]),
+            joint_values: Vec::new(),
             telemetry: ControllerTelemetry::default(),
             scene: SceneUpdate::default(),
             model: None,
@@ -620,12 +624,12 @@ impl Recorder for McapRecorder {
                 .collect(),
         };
         self.model = Some(run.experiment.model.clone());
-        // the coordinates, then the joints that mimic them (position and velocity only)
-        let names: Vec<String> = model.joints.iter().map(|j| j.name.clone()).chain(model.mimic_bodies().map(|(_, b, _)| b.name.clone())).collect();
-        self.joints_msg = JointStates {
-            timestamp: None,
-            joints: names.iter().map(|n| JointState { name: n.clone(), ..Default::default() }).collect(),
-        };
+        // the coordinates (position, velocity, effort), then the joints that mimic them (position and
+        // velocity only)
+        let coordinates = model.joints.iter().map(|j| JointState { name: j.name.clone(), position: Some(0.0), velocity: Some(0.0), effort: Some(0.0), ..Default::default() });
+        let mimics = model.mimic_bodies().map(|(_, b, _)| JointState { name: b.name.clone(), position: Some(0.0), velocity: Some(0.0), ..Default::default() });
+        self.joint_states = JointStatesLayout::new(&coordinates.chain(mimics).collect::<Vec<_>>());
+        self.joint_values = Vec::with_capacity(self.joint_states.values());
         let n = model.dof();
         let has_friction = run.experiment.joint_has_friction().contains(&true);
         // a run records only what it has, as with friction: the stepper fields when some joint is
@@ -692,16 +696,13 @@ impl Recorder for McapRecorder {
                 set_transform(m, &tf.pose(&model.bodies[tf.joint], model.couplings[tf.joint].position(s.q)), ts);
             }
         }
-        self.joints_msg.timestamp = ts;
-        let (coordinates, mimics) = self.joints_msg.joints.split_at_mut(s.q.len());
-        for (j, state) in coordinates.iter_mut().enumerate() {
-            state.position = Some(s.q[j]);
-            state.velocity = Some(s.v[j]);
-            state.effort = Some(s.u[j]);
+        // /joint_states' values in its layout's order
+        self.joint_values.clear();
+        for j in 0..s.q.len() {
+            self.joint_values.extend_from_slice(&[s.q[j], s.v[j], s.u[j]]);
         }
-        for (state, (_, _, coupling)) in mimics.iter_mut().zip(model.mimic_bodies()) {
-            state.position = Some(coupling.position(s.q));
-            state.velocity = Some(coupling.multiplier * s.v[coupling.coordinate]);
+        for (_, _, coupling) in model.mimic_bodies() {
+            self.joint_values.extend_from_slice(&[coupling.position(s.q), coupling.multiplier * s.v[coupling.coordinate]]);
         }
         let tel = &mut self.telemetry;
         tel.time = s.t;
@@ -742,7 +743,7 @@ impl Recorder for McapRecorder {
             out.log(&mut ch.tf, &self.tf_msg, stamp).map_err(fail)?;
         }
         // (the two per-step messages encoded by hand, as prost would)
-        out.log_encoded(&mut ch.joint_states, |bytes| super::step_messages::joint_states(&self.joints_msg, bytes), stamp).map_err(fail)?;
+        out.log_encoded(&mut ch.joint_states, |bytes| self.joint_states.encode(ts.as_ref(), &self.joint_values, bytes), stamp).map_err(fail)?;
         out.log_encoded(&mut ch.controller, |bytes| super::step_messages::controller_telemetry(&self.telemetry, bytes), stamp).map_err(fail)?;
         if let (Some(c), Some((state, contacts))) = (self.collisions.as_mut(), ch.collisions.as_mut()) {
             if let Some(update) = c.record(s, ts.unwrap_or_default()) {

@@ -80,7 +80,7 @@ fn timestamp_len(t: &Timestamp) -> usize {
     field(t.sec()) + field(t.nsec())
 }
 
-fn timestamp(tag: u32, t: &Timestamp, out: &mut Vec<u8>) {
+fn timestamp_field(tag: u32, t: &Timestamp, out: &mut Vec<u8>) {
     key(tag, LENGTH_DELIMITED, out);
     varint(timestamp_len(t) as u64, out);
     for (field, v) in [(1, t.sec()), (2, t.nsec())] {
@@ -100,7 +100,7 @@ fn joint_state_len(j: &JointState) -> usize {
 /// `message` as prost encodes it, appended to `out`.
 pub fn joint_states(message: &JointStates, out: &mut Vec<u8>) {
     if let Some(t) = &message.timestamp {
-        timestamp(1, t, out);
+        timestamp_field(1, t, out);
     }
     for joint in &message.joints {
         key(2, LENGTH_DELIMITED, out);
@@ -114,6 +114,59 @@ pub fn joint_states(message: &JointStates, out: &mut Vec<u8>) {
             if let Some(v) = value {
                 double(tag, v, out);
             }
+        }
+    }
+}
+
+/// `/joint_states` laid out once for a run: every message is the same bytes but for its timestamp
+/// and its values, since each joint's name and the values it carries (position, velocity, effort…)
+/// stay the same. A message is then one copy of the layout and a store per value, instead of being
+/// built field by field (the MCAP recorder's largest encoding).
+pub struct JointStatesLayout {
+    /// The joints' part of a message, the values zero.
+    body: Vec<u8>,
+    /// Where each value's 8 bytes are in `body`: per joint, its position, velocity, acceleration
+    /// and effort, those it has.
+    slots: Vec<usize>,
+}
+
+impl JointStatesLayout {
+    /// The layout of messages with `joints`' names and fields (their values are not used).
+    pub fn new(joints: &[JointState]) -> Self {
+        let zeroed: Vec<JointState> = joints.iter().map(|j| JointState { name: j.name.clone(), position: j.position.map(|_| 0.0), velocity: j.velocity.map(|_| 0.0), acceleration: j.acceleration.map(|_| 0.0), effort: j.effort.map(|_| 0.0) }).collect();
+        let mut body = Vec::new();
+        joint_states(&JointStates { timestamp: None, joints: zeroed.clone() }, &mut body);
+        // each value is its key's byte then 8 bytes, in the order `joint_states` writes them
+        let mut slots = Vec::new();
+        let mut at = 0;
+        for joint in &zeroed {
+            let mut entry = Vec::new();
+            joint_states(&JointStates { timestamp: None, joints: vec![joint.clone()] }, &mut entry);
+            let present = [joint.position, joint.velocity, joint.acceleration, joint.effort].iter().filter(|v| v.is_some()).count();
+            let values_start = at + entry.len() - 9 * present;
+            slots.extend((0..present).map(|i| values_start + 9 * i + 1));
+            at += entry.len();
+        }
+        debug_assert_eq!(at, body.len());
+        Self { body, slots }
+    }
+
+    /// Values a message carries, in order (see `slots`).
+    pub fn values(&self) -> usize {
+        self.slots.len()
+    }
+
+    /// The message with `values` (one per slot) and `timestamp`, as `joint_states` encodes it.
+    pub fn encode(&self, timestamp: Option<&Timestamp>, values: &[f64], out: &mut Vec<u8>) {
+        assert_eq!(values.len(), self.slots.len(), "one value per slot");
+        if let Some(t) = timestamp {
+            timestamp_field(1, t, out);
+        }
+        let start = out.len();
+        out.extend_from_slice(&self.body);
+        let body = &mut out[start..];
+        for (&slot, value) in self.slots.iter().zip(values) {
+            body[slot..slot + 8].copy_from_slice(&value.to_le_bytes());
         }
     }
 }
@@ -177,6 +230,42 @@ mod tests {
                     let message = JointStates { timestamp, joints: joints.clone() };
                     let mut ours = vec![0xAB]; // appended, not overwritten
                     joint_states(&message, &mut ours);
+                    assert_eq!(ours[1..], prost(&message)[..], "{message:?}");
+                }
+            }
+        }
+    }
+
+    /// The layout's messages are `joint_states`' (so prost's) for any names, fields, values and stamp.
+    #[test]
+    fn joint_states_from_their_layout_are_the_same_bytes() {
+        let long = "y".repeat(150);
+        let names = ["", "J1", "shoulder_pan_joint", long.as_str()];
+        for count in [0usize, 1, 6, 9] {
+            let joints: Vec<JointState> = (0..count)
+                .map(|i| JointState {
+                    name: names[i % names.len()].to_string(),
+                    position: Some(0.0),
+                    velocity: (i % 3 != 2).then_some(0.0),
+                    acceleration: (i % 4 == 1).then_some(0.0),
+                    effort: (i % 5 != 4).then_some(0.0),
+                })
+                .collect();
+            let layout = JointStatesLayout::new(&joints);
+            for shift in 0..9 {
+                let values: Vec<f64> = (0..layout.values()).map(|i| DOUBLES[(i + shift) % 9]).collect();
+                let mut next = values.iter().copied();
+                let filled: Vec<JointState> = joints
+                    .iter()
+                    .map(|j| {
+                        let mut take = |present: Option<f64>| present.map(|_| next.next().unwrap());
+                        JointState { name: j.name.clone(), position: take(j.position), velocity: take(j.velocity), acceleration: take(j.acceleration), effort: take(j.effort) }
+                    })
+                    .collect();
+                for timestamp in [None, Some(Timestamp::new(1_764_000_000 + shift as u32, 999_999_999 / (shift as u32 + 1)))] {
+                    let message = JointStates { timestamp, joints: filled.clone() };
+                    let mut ours = vec![0xEF];
+                    layout.encode(timestamp.as_ref(), &values, &mut ours);
                     assert_eq!(ours[1..], prost(&message)[..], "{message:?}");
                 }
             }
