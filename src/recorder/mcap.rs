@@ -100,8 +100,8 @@ impl Sinks {
 }
 
 /// The MCAP output, written on a thread of its own: this (recorder) thread encodes the messages,
-/// the writer thread frames and compresses them (zstd, the larger half of the work), so the two
-/// halves run on both cores instead of one.
+/// the writer thread frames and writes them (and with `--compress` zstds them, then the larger half
+/// of the work), so the two halves run on both cores instead of one.
 struct Out {
     /// The sinks while schemas, channels and metadata are added (before `spawn`, after `close`).
     sinks: Option<Sinks>,

@@ -430,7 +430,6 @@ impl RerunRecorder {
                 let times = TimeColumn::new_duration_secs(TIMELINE, c.saturated_times.iter().copied());
                 send(&format!("{base}/saturated_torque"), times, scalars(&c.saturated_torque, 1))?;
             }
-            // the limits: at every step when they fall with speed, else as lines spanning the block
             // the limits: at every step when they fall with speed, else as lines spanning each block
             // for a live viewer (they grow with the run; a file gets them once, `limit_lines`)
             let effort = self.effort[j];
@@ -485,9 +484,7 @@ impl RerunRecorder {
         self.last_flush = Instant::now();
         Ok(())
     }
-}
 
-impl RerunRecorder {
     /// A file's ±limit lines without `--motors`, each spanning the whole run, sent once at its end:
     /// a chunk of two rows per joint and block cost as much to encode as a full one, and a seventh
     /// of the file's chunks were those (a live viewer gets them with every block instead).

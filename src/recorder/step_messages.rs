@@ -134,20 +134,15 @@ impl JointStatesLayout {
     /// The layout of messages with `joints`' names and fields (their values are not used).
     pub fn new(joints: &[JointState]) -> Self {
         let zeroed: Vec<JointState> = joints.iter().map(|j| JointState { name: j.name.clone(), position: j.position.map(|_| 0.0), velocity: j.velocity.map(|_| 0.0), acceleration: j.acceleration.map(|_| 0.0), effort: j.effort.map(|_| 0.0) }).collect();
-        let mut body = Vec::new();
-        joint_states(&JointStates { timestamp: None, joints: zeroed.clone() }, &mut body);
-        // each value is its key's byte then 8 bytes, in the order `joint_states` writes them
-        let mut slots = Vec::new();
-        let mut at = 0;
-        for joint in &zeroed {
-            let mut entry = Vec::new();
-            joint_states(&JointStates { timestamp: None, joints: vec![joint.clone()] }, &mut entry);
+        // a message without its timestamp is its joints' entries back to back, each ending with its
+        // values: a key's byte, then 8 bytes, in the order `joint_states` writes them
+        let (mut body, mut slots) = (Vec::new(), Vec::new());
+        for joint in zeroed {
             let present = [joint.position, joint.velocity, joint.acceleration, joint.effort].iter().filter(|v| v.is_some()).count();
-            let values_start = at + entry.len() - 9 * present;
+            joint_states(&JointStates { timestamp: None, joints: vec![joint] }, &mut body);
+            let values_start = body.len() - 9 * present;
             slots.extend((0..present).map(|i| values_start + 9 * i + 1));
-            at += entry.len();
         }
-        debug_assert_eq!(at, body.len());
         Self { body, slots }
     }
 
