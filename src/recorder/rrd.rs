@@ -492,9 +492,9 @@ impl RerunRecorder {
         if self.live || self.motors.is_some() {
             return Ok(());
         }
+        let ends = TimeColumn::new_duration_secs(TIMELINE, [self.first_time, self.last_time]);
         for (name, &effort) in self.joint_names.iter().zip(&self.effort).filter(|(_, e)| e.is_finite()) {
-            let ends = TimeColumn::new_duration_secs(TIMELINE, [self.first_time, self.last_time]);
-            send_in_order(rec, &format!("joints/{name}/torque_limit"), ends, [scalar_column(&[effort, -effort, effort, -effort], 2)]).map_err(|x| self.err(x))?;
+            send_in_order(rec, &format!("joints/{name}/torque_limit"), ends.clone(), [scalar_column(&[effort, -effort, effort, -effort], 2)]).map_err(|x| self.err(x))?;
         }
         Ok(())
     }
@@ -544,9 +544,9 @@ impl Strips {
         self.points.extend(strip);
     }
 
-    /// The strips column, one strip per row: what `LineStrips3D::update_fields().with_strips(..)
-    /// .columns_of_unit_batches()` makes (test below), without its generic serialization.
-    /// The strips so far as a column (see [`Strips`]); the next block starts empty.
+    /// The strips so far as a column, one strip per row: what `LineStrips3D::update_fields()
+    /// .with_strips(..).columns_of_unit_batches()` makes (test below), without its generic
+    /// serialization. The next block starts empty.
     fn take_column(&mut self, pool: &ColumnPool<[f32; 3]>) -> rerun::SerializedComponentColumn {
         use rerun::external::arrow::array::{ArrayRef, FixedSizeListArray, Float32Array, ListArray};
         use rerun::external::arrow::buffer::ScalarBuffer;

@@ -123,7 +123,7 @@ pub fn joint_states(message: &JointStates, out: &mut Vec<u8>) {
 /// stay the same. A message is then one copy of the layout and a store per value, instead of being
 /// built field by field (the MCAP recorder's largest encoding).
 pub struct JointStatesLayout {
-    /// The joints' part of a message, the values zero.
+    /// The joints' part of a message (its values are overwritten by every `encode`).
     body: Vec<u8>,
     /// Where each value's 8 bytes are in `body`: per joint, its position, velocity, acceleration
     /// and effort, those it has.
@@ -133,13 +133,12 @@ pub struct JointStatesLayout {
 impl JointStatesLayout {
     /// The layout of messages with `joints`' names and fields (their values are not used).
     pub fn new(joints: &[JointState]) -> Self {
-        let zeroed: Vec<JointState> = joints.iter().map(|j| JointState { name: j.name.clone(), position: j.position.map(|_| 0.0), velocity: j.velocity.map(|_| 0.0), acceleration: j.acceleration.map(|_| 0.0), effort: j.effort.map(|_| 0.0) }).collect();
         // a message without its timestamp is its joints' entries back to back, each ending with its
         // values: a key's byte, then 8 bytes, in the order `joint_states` writes them
         let (mut body, mut slots) = (Vec::new(), Vec::new());
-        for joint in zeroed {
+        for joint in joints {
             let present = [joint.position, joint.velocity, joint.acceleration, joint.effort].iter().filter(|v| v.is_some()).count();
-            joint_states(&JointStates { timestamp: None, joints: vec![joint] }, &mut body);
+            joint_states(&JointStates { timestamp: None, joints: vec![joint.clone()] }, &mut body);
             let values_start = body.len() - 9 * present;
             slots.extend((0..present).map(|i| values_start + 9 * i + 1));
         }
