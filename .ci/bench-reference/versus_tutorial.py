@@ -13,7 +13,8 @@ import tempfile
 import time
 
 here = os.path.dirname(os.path.abspath(__file__))
-armscope, python = sys.argv[1], sys.argv[2]
+# the runs happen in a scratch folder: a relative path (target/release/armscope) is made absolute
+armscope, python = (os.path.abspath(a) if os.sep in a else a for a in sys.argv[1:3])
 rounds = int(sys.argv[3]) if len(sys.argv) > 3 and sys.argv[3] != "--" else 7
 urdf = os.path.join(here, "..", "..", "assets", "smallrobot_arm.urdf")
 cases = {"both files": [], "no files": ["--no-rrd", "--no-mcap"]}
