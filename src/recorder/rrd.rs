@@ -321,8 +321,7 @@ impl RerunRecorder {
     /// and every entity costs the file's footer).
     fn log_series_styles(&self, rec: &RecordingStream, friction: bool) -> Result<(), Error> {
         let e = |err: rerun::RecordingStreamError| self.err(err);
-        let grey = rerun::Color::from_rgb(140, 140, 140);
-        let red = rerun::Color::from_rgb(220, 50, 50);
+        let (grey, red) = (rgb(TARGET_RGB), rgb(LIMIT_RGB));
         for (j, name) in self.joint_names.iter().enumerate() {
             let base = format!("joints/{name}");
             let c = joint_color(j);
@@ -331,10 +330,10 @@ impl RerunRecorder {
             };
             let styles = [
                 ("position", lines(&[format!("{name} angle (rad)"), format!("{name} target (rad)")], &[c, grey], &[2.0, 1.0])),
-                ("torque", lines(&[format!("{name} torque (N·m)"), format!("{name} τ_g (N·m)")], &[c, rerun::Color::from_rgb(90, 170, 90)], &[1.5, 1.0])),
+                ("torque", lines(&[format!("{name} torque (N·m)"), format!("{name} τ_g (N·m)")], &[c, rgb(GRAVITY_TORQUE_RGB)], &[1.5, 1.0])),
                 (
                     "status",
-                    lines(&[format!("{name} error (rad)"), format!("{name} saturated (0/1)"), format!("{name} chatter (0/1)")], &[c, red, rerun::Color::from_rgb(240, 160, 40)], &[1.5, 1.0, 1.0]),
+                    lines(&[format!("{name} error (rad)"), format!("{name} saturated (0/1)"), format!("{name} chatter (0/1)")], &[c, red, rgb(CHATTER_RGB)], &[1.5, 1.0, 1.0]),
                 ),
                 // "effort" is the URDF's constant; with --motors the limit falls with speed
                 ("torque_limit", {
@@ -362,7 +361,7 @@ impl RerunRecorder {
                 format!("{base}/saturated_torque"),
                 &rerun::SeriesPoints::new()
                     .with_names([format!("{name} saturated")])
-                    .with_colors([rerun::Color::from_rgb(230, 40, 40)])
+                    .with_colors([rgb(SATURATED_RGB)])
                     .with_markers([rerun::components::MarkerShape::Circle])
                     .with_marker_sizes([1.5]),
             )
@@ -665,27 +664,45 @@ fn mat3(pose: &Pose) -> rerun::components::TransformMat3x3 {
     rerun::components::TransformMat3x3::from(rerun::datatypes::Mat3x3(cols))
 }
 
-pub fn joint_color(j: usize) -> rerun::Color {
-    const PALETTE: [(u8, u8, u8); 16] = [
-        (31, 119, 180),
-        (255, 127, 14),
-        (44, 160, 44),
-        (214, 39, 40),
-        (148, 103, 189),
-        (140, 86, 75),
-        (227, 119, 194),
-        (23, 190, 207),
-        (188, 189, 34),
-        (127, 127, 127),
-        (174, 199, 232),
-        (255, 187, 120),
-        (152, 223, 138),
-        (255, 152, 150),
-        (197, 176, 213),
-        (219, 219, 141),
-    ];
-    let (r, g, b) = PALETTE[j % PALETTE.len()];
+/// The joints' colours, in order: matplotlib's tab10 and lighter shades from its tab20, without
+/// the colours the plots give a meaning (red: limits and saturation; grey: the target), so that a
+/// joint's series is never the colour of a line beside it in its plot.
+const JOINT_PALETTE: [(u8, u8, u8); 16] = [
+    (31, 119, 180),
+    (255, 127, 14),
+    (44, 160, 44),
+    (23, 190, 207),
+    (148, 103, 189),
+    (140, 86, 75),
+    (227, 119, 194),
+    (188, 189, 34),
+    (174, 199, 232),
+    (255, 187, 120),
+    (152, 223, 138),
+    (197, 176, 213),
+    (255, 152, 150),
+    (247, 182, 210),
+    (219, 219, 141),
+    (158, 218, 229),
+];
+
+/// The target in each angle plot.
+const TARGET_RGB: (u8, u8, u8) = (140, 140, 140);
+/// τ_g in each torque plot: near-white, which no joint's colour is.
+const GRAVITY_TORQUE_RGB: (u8, u8, u8) = (235, 235, 235);
+/// The ±limit lines, and the saturated flag in the status plot.
+const LIMIT_RGB: (u8, u8, u8) = (220, 50, 50);
+/// The saturated steps' markers in each torque plot.
+const SATURATED_RGB: (u8, u8, u8) = (230, 40, 40);
+/// The chatter flag in the status plot.
+const CHATTER_RGB: (u8, u8, u8) = (250, 210, 40);
+
+fn rgb((r, g, b): (u8, u8, u8)) -> rerun::Color {
     rerun::Color::from_rgb(r, g, b)
+}
+
+pub fn joint_color(j: usize) -> rerun::Color {
+    rgb(JOINT_PALETTE[j % JOINT_PALETTE.len()])
 }
 
 /// The layout the file opens to: the arm in 3D with the tool's position below it, and per joint
@@ -1005,6 +1022,30 @@ mod tests {
         let theirs = rerun_s.remove(0);
         assert_eq!(ours.descriptor, theirs.descriptor);
         assert_eq!(ours.list_array, theirs.list_array);
+    }
+
+    /// Every series in a joint's plot is told apart from the others by its colour, for any of the
+    /// 16 joint colours: at least 55 apart in RGB (Euclidean, 0–255 a channel). The colours this
+    /// replaced were 16 apart (the fourth joint's torque and its red ±limits and saturated markers),
+    /// 23 (the tenth joint's angle and its grey target), 45 (the second joint's error and the orange
+    /// chatter flag) and green τ_g beside the third joint's green torque.
+    #[test]
+    fn each_series_in_a_joint_plot_has_a_colour_of_its_own() {
+        use super::{CHATTER_RGB, GRAVITY_TORQUE_RGB, JOINT_PALETTE, LIMIT_RGB, SATURATED_RGB, TARGET_RGB};
+        let distance = |a: (u8, u8, u8), b: (u8, u8, u8)| (((a.0 as f64 - b.0 as f64).powi(2) + (a.1 as f64 - b.1 as f64).powi(2) + (a.2 as f64 - b.2 as f64).powi(2))).sqrt();
+        for (j, &joint) in JOINT_PALETTE.iter().enumerate() {
+            // angle vs target; torque, τ_g, ±limits and saturated markers; error, saturated, chatter
+            let plots = [("angle", vec![joint, TARGET_RGB]), ("torque", vec![joint, GRAVITY_TORQUE_RGB, LIMIT_RGB, SATURATED_RGB]), ("status", vec![joint, LIMIT_RGB, CHATTER_RGB])];
+            for (plot, colours) in plots {
+                for (a, &first) in colours.iter().enumerate() {
+                    // (the limits and the saturated markers are the same signal: red)
+                    for &second in colours[a + 1..].iter().filter(|&&c| !(first == LIMIT_RGB && c == SATURATED_RGB)) {
+                        let apart = distance(first, second);
+                        assert!(apart >= 55.0, "joint {j}'s {plot} plot: {first:?} and {second:?} are {apart:.0} apart");
+                    }
+                }
+            }
+        }
     }
 
     #[test]
