@@ -67,3 +67,34 @@ fn inertia_ratio_lowest_rms_and_the_bill_of_materials() {
     let mass = chosen["mass_kg"].as_f64().unwrap();
     assert!((report["drive_mass_kg"].as_f64().unwrap() - mass).abs() < 1e-12 && bom.contains(&format!("{mass:.3} kg in all")));
 }
+
+/// A simulated candidate's lost steps are counted, and reported, only where the joint was driven
+/// open loop as a stepper: a servo, or a stepper under PD (`--drive pd`), cannot lose steps, and the
+/// report no longer says of each that it lost none.
+#[test]
+fn lost_steps_are_reported_only_for_a_stepper_driven_open_loop() {
+    let dir = tempfile::tempdir().unwrap();
+    let stepped = |report: &Value| -> Vec<bool> { report["joints"][0]["simulated"].as_array().unwrap().iter().map(|s| s["stepped"].as_bool().unwrap()).collect() };
+    for (label, extra, open_loop) in [("servo", &["--candidates", "XM430-W350"][..], false), ("stepper", &["--candidates", "17HS4401"][..], true), ("stepper-pd", &["--candidates", "17HS4401", "--drive", "pd"][..], false)] {
+        let (report, md) = size(dir.path(), label, &[extra, &["--reductions", "DYD-14-051,NEMA17-PG27,GT2-belt,CricketDrive-MK2"]].concat());
+        let flags = stepped(&report);
+        assert!(!flags.is_empty() && flags.iter().all(|&s| s == open_loop), "{label}: {flags:?}");
+        assert_eq!(md.contains("0 lost steps"), open_loop, "{label}: {md}");
+        assert!(md.contains("% of its torque"), "{label}: the torque share is reported either way");
+    }
+}
+
+/// A sizing that finds no drive for a joint fails (non-zero exit) and its report still states the
+/// chosen drive trains' mass as 0.000 kg, not "-0.000" (an empty f64 sum is −0).
+#[test]
+fn a_sizing_with_nothing_chosen_reports_no_negative_mass() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("pendulum.urdf"), common::LEVEL_PENDULUM).unwrap();
+    let out = dir.path().join("none");
+    let urdf = dir.path().join("pendulum.urdf");
+    // a bare 17HS4401 on a belt cannot carry the level pendulum's 1.5 N·m
+    let args = ["armscope", "size", "--urdf", urdf.to_str().unwrap(), "--freq", "1", "--amp-deg", "20", "--duration", "10", "--parts-in-urdf", "--out", out.to_str().unwrap(), "--candidates", "17HS4401", "--reductions", "GT2-belt"];
+    assert_ne!(armscope::cli::main_with_args(args.iter().map(|s| s.to_string()).collect::<Vec<_>>()), 0);
+    let md = std::fs::read_to_string(out.join("size.md")).unwrap();
+    assert!(md.contains("the chosen drive trains 0.000 kg") && !md.contains("-0.000"), "{md}");
+}

@@ -33,7 +33,8 @@ impl JointSizing {
     /// The last simulation of candidate `c`, in words.
     fn simulation(&self, c: usize) -> Option<String> {
         self.simulated.iter().rev().find(|s| s.candidate == c).map(|s| match &s.note {
-            None => format!("0 lost steps, {:.0} % of its torque", 100.0 * s.peak_torque_share),
+            None if s.stepped => format!("0 lost steps, {:.0} % of its torque", 100.0 * s.peak_torque_share),
+            None => format!("{:.0} % of its torque", 100.0 * s.peak_torque_share),
             Some(note) => note.clone(),
         })
     }

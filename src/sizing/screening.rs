@@ -225,6 +225,9 @@ impl Candidate {
 #[derive(Clone, Debug, Serialize)]
 pub struct SimulatedCheck {
     pub candidate: usize,
+    /// Driven open loop as a stepper in the simulation: its lost steps were counted (a servo or a
+    /// closed-loop drive cannot lose any).
+    pub stepped: bool,
     pub lost_steps: u64,
     /// Largest share of the torque available at its speed that the joint used.
     pub peak_torque_share: f64,
@@ -815,7 +818,8 @@ pub fn size(request: &SizeRequest) -> Result<SizeReport, Error> {
     let simulated_contact = simulated_collisions.iter().any(|(_, c)| c.first_contact.is_some());
     let drive_mass_kg = {
         let set: Vec<Option<usize>> = joints.iter().map(|js| js.chosen).collect();
-        motor_set(request, &joints, &set)?.joints.iter().flatten().map(|d| d.mass()).sum()
+        // (a fold from +0: an empty f64 sum is −0, which the report printed as "-0.000 kg")
+        motor_set(request, &joints, &set)?.joints.iter().flatten().fold(0.0, |total, d| total + d.mass())
     };
     let mut report = SizeReport {
         model: model.name.clone(),
@@ -873,6 +877,8 @@ fn picked(joints: &[JointSizing], pick: &[usize]) -> Vec<Option<usize>> {
 /// One joint in the simulations of a set over every motion.
 #[derive(Clone, Debug, Default)]
 struct JointRun {
+    /// Driven open loop as a stepper in some motion.
+    stepped: bool,
     lost_steps: u64,
     peak_torque_share: f64,
     /// The divergence message, if a run diverged at this joint.
@@ -895,7 +901,7 @@ fn check(candidate: usize, run: &JointRun, margin: f64) -> SimulatedCheck {
     } else {
         None
     };
-    SimulatedCheck { candidate, lost_steps: run.lost_steps, peak_torque_share: run.peak_torque_share, passed: note.is_none(), note, peak_winding_temperature: run.peak_winding_temperature }
+    SimulatedCheck { candidate, stepped: run.stepped, lost_steps: run.lost_steps, peak_torque_share: run.peak_torque_share, passed: note.is_none(), note, peak_winding_temperature: run.peak_winding_temperature }
 }
 
 /// The motor set of per-joint candidates (None: the joint keeps its URDF effort).
@@ -925,7 +931,9 @@ fn simulate_set(request: &SizeRequest, joints: &[JointSizing], set: &[Option<usi
         let motors = motor_set(request, joints, set)?;
         let experiment = Experiment::with_motors(config.clone(), request.model.clone(), Some(motors))?;
         let summary = crate::sim::simulate(&experiment, &mut [], None)?;
+        let stepped = experiment.stepped_joints();
         for (j, run) in out.iter_mut().enumerate() {
+            run.stepped |= stepped.get(j).copied().unwrap_or(false);
             let lost = summary.lost_steps.get(j).copied().unwrap_or(0);
             let share = summary.peak_torque_share.get(j).copied().unwrap_or(0.0);
             let first_loss = lost > 0 && run.lost_steps == 0;
