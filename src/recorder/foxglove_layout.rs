@@ -6,6 +6,7 @@
 use crate::dynamics::{body_poses, frame_pose_in};
 use crate::model::Model;
 use crate::spatial::Pose;
+use super::plot_colours::{FRICTION_RGB, LIMIT_RGB, TARGET_RGB, hex, joint_rgb};
 use super::torque_axis::TorqueAxis;
 use serde_json::{Value, json};
 
@@ -26,6 +27,13 @@ fn plot(paths: Vec<Value>) -> Value {
 
 fn series(path: String, label: String) -> Value {
     json!({ "value": path, "enabled": true, "timestampMethod": "receiveTime", "label": label })
+}
+
+/// A series drawn in `colour` (the `.rrd`'s colours: a joint's own, the target grey, the limit red).
+fn coloured(path: String, label: String, colour: (u8, u8, u8)) -> Value {
+    let mut s = series(path, label);
+    s["color"] = json!(hex(colour));
+    s
 }
 
 /// Where the camera looks and from how far: the middle of the links at `q`, from 4× their spread
@@ -87,7 +95,7 @@ pub fn layout_for_run(model: &Model, q0: &[f64], plots: &RunPlots) -> Value {
     let angles = names
         .iter()
         .enumerate()
-        .flat_map(|(i, n)| [series(format!("/joint_states.joints[{i}].position"), format!("{n} angle")), series(format!("/controller.target[{i}]"), format!("{n} target"))])
+        .flat_map(|(i, n)| [coloured(format!("/joint_states.joints[{i}].position"), format!("{n} angle"), joint_rgb(i)), coloured(format!("/controller.target[{i}]"), format!("{n} target"), TARGET_RGB)])
         .collect();
     // one plot per joint: joints' torques differ by orders of magnitude, and each is read against
     // its own limit
@@ -95,9 +103,9 @@ pub fn layout_for_run(model: &Model, q0: &[f64], plots: &RunPlots) -> Value {
         .iter()
         .enumerate()
         .map(|(i, n)| {
-            let limit = motors.then(|| series(format!("/controller.torque_limit[{i}]"), format!("{n} limit")));
-            let friction = friction.then(|| series(format!("/controller.friction[{i}]"), format!("{n} friction")));
-            let paths = std::iter::once(series(format!("/controller.torque[{i}]"), format!("{n} torque"))).chain(limit).chain(friction).collect();
+            let limit = motors.then(|| coloured(format!("/controller.torque_limit[{i}]"), format!("{n} limit"), LIMIT_RGB));
+            let friction = friction.then(|| coloured(format!("/controller.friction[{i}]"), format!("{n} friction"), FRICTION_RGB));
+            let paths = std::iter::once(coloured(format!("/controller.torque[{i}]"), format!("{n} torque"), joint_rgb(i))).chain(limit).chain(friction).collect();
             let mut panel = plot(paths);
             if let Some(axis) = torque_axes.get(i) {
                 panel["minYValue"] = json!(-axis.half_range);
@@ -127,7 +135,7 @@ pub fn layout_for_run(model: &Model, q0: &[f64], plots: &RunPlots) -> Value {
         .iter()
         .enumerate()
         .filter(|(i, _)| heated.get(*i).copied().unwrap_or(false))
-        .map(|(i, n)| series(format!("/controller.winding_temperature[{i}]"), format!("{n} winding (°C)")))
+        .map(|(i, n)| coloured(format!("/controller.winding_temperature[{i}]"), format!("{n} winding (°C)"), joint_rgb(i)))
         .collect();
     let mut doc = json!({
         "configById": {
@@ -238,6 +246,11 @@ mod tests {
             assert_eq!(panel["minYValue"], json!(-axis.half_range));
             assert_eq!(panel["paths"][1]["value"], json!(format!("/controller.torque_limit[{i}]")));
             assert_eq!(panel["paths"][2]["value"], json!(format!("/controller.friction[{i}]")));
+            // drawn as the .rrd draws them: the joint's own colour, the limit red, friction magenta
+            let colours: Vec<&str> = panel["paths"].as_array().unwrap().iter().map(|p| p["color"].as_str().unwrap()).collect();
+            assert_eq!(colours, [hex(joint_rgb(i)), hex(LIMIT_RGB), hex(FRICTION_RGB)]);
+            let angles = &l["configById"]["Plot!angles"]["paths"];
+            assert_eq!((angles[2 * i]["color"].as_str().unwrap(), angles[2 * i + 1]["color"].as_str().unwrap()), (hex(joint_rgb(i)).as_str(), hex(TARGET_RGB).as_str()));
         }
         // the one motor with thermal data: its winding temperature
         assert_eq!(l["configById"]["Plot!temperatures"]["paths"].as_array().unwrap().len(), 1);

@@ -11,6 +11,7 @@ pub mod mcap_collisions;
 mod output_file;
 mod overview;
 mod pacer;
+mod plot_colours;
 pub mod rrd;
 mod robot_description;
 mod rrd_collisions;

@@ -18,6 +18,7 @@ use rerun::{RecordingStream, TimeColumn};
 use super::torque_axis::TorqueAxis;
 use super::rrd_collisions::{Recolour, RrdCollisions, log_geometry};
 use super::column_pool::ColumnPool;
+use super::plot_colours::{CHATTER_RGB, FRICTION_RGB, GRAVITY_TORQUE_RGB, LIMIT_RGB, SATURATED_RGB, STUCK_RGB, TARGET_RGB, joint_rgb};
 use rerun::external::arrow::buffer::{Buffer, OffsetBuffer};
 use std::collections::VecDeque;
 use std::path::PathBuf;
@@ -343,7 +344,7 @@ impl RerunRecorder {
                 ("load_angle", lines(&[format!("{name} load angle (electrical °; ±90 peak torque, ±180 slip)")], &[c], &[1.5])),
                 ("lost_steps", lines(&[format!("{name} lost steps (full)")], &[red], &[2.0])),
                 ("motor_speed", lines(&[format!("{name} motor speed (rev/s)")], &[c], &[1.5])),
-                ("friction", lines(&[format!("{name} friction (N·m)"), format!("{name} stuck (0/1)")], &[rerun::Color::from_rgb(150, 100, 200), rerun::Color::from_rgb(100, 100, 100)], &[1.0, 1.0])),
+                ("friction", lines(&[format!("{name} friction (N·m)"), format!("{name} stuck (0/1)")], &[rgb(FRICTION_RGB), rgb(STUCK_RGB)], &[1.0, 1.0])),
                 ("winding_temperature", lines(&[format!("{name} winding (°C)")], &[c], &[1.5])),
             ];
             let has_motor = self.motors.as_ref().is_some_and(|m| m.joints.get(j).is_some_and(Option::is_some));
@@ -664,45 +665,12 @@ fn mat3(pose: &Pose) -> rerun::components::TransformMat3x3 {
     rerun::components::TransformMat3x3::from(rerun::datatypes::Mat3x3(cols))
 }
 
-/// The joints' colours, in order: matplotlib's tab10 and lighter shades from its tab20, without
-/// the colours the plots give a meaning (red: limits and saturation; grey: the target), so that a
-/// joint's series is never the colour of a line beside it in its plot.
-const JOINT_PALETTE: [(u8, u8, u8); 16] = [
-    (31, 119, 180),
-    (255, 127, 14),
-    (44, 160, 44),
-    (23, 190, 207),
-    (148, 103, 189),
-    (140, 86, 75),
-    (227, 119, 194),
-    (188, 189, 34),
-    (174, 199, 232),
-    (255, 187, 120),
-    (152, 223, 138),
-    (197, 176, 213),
-    (255, 152, 150),
-    (247, 182, 210),
-    (219, 219, 141),
-    (158, 218, 229),
-];
-
-/// The target in each angle plot.
-const TARGET_RGB: (u8, u8, u8) = (140, 140, 140);
-/// τ_g in each torque plot: near-white, which no joint's colour is.
-const GRAVITY_TORQUE_RGB: (u8, u8, u8) = (235, 235, 235);
-/// The ±limit lines, and the saturated flag in the status plot.
-const LIMIT_RGB: (u8, u8, u8) = (220, 50, 50);
-/// The saturated steps' markers in each torque plot.
-const SATURATED_RGB: (u8, u8, u8) = (230, 40, 40);
-/// The chatter flag in the status plot.
-const CHATTER_RGB: (u8, u8, u8) = (250, 210, 40);
-
 fn rgb((r, g, b): (u8, u8, u8)) -> rerun::Color {
     rerun::Color::from_rgb(r, g, b)
 }
 
 pub fn joint_color(j: usize) -> rerun::Color {
-    rgb(JOINT_PALETTE[j % JOINT_PALETTE.len()])
+    rgb(joint_rgb(j))
 }
 
 /// The layout the file opens to: the arm in 3D with the tool's position below it, and per joint
@@ -1022,30 +990,6 @@ mod tests {
         let theirs = rerun_s.remove(0);
         assert_eq!(ours.descriptor, theirs.descriptor);
         assert_eq!(ours.list_array, theirs.list_array);
-    }
-
-    /// Every series in a joint's plot is told apart from the others by its colour, for any of the
-    /// 16 joint colours: at least 55 apart in RGB (Euclidean, 0–255 a channel). The colours this
-    /// replaced were 16 apart (the fourth joint's torque and its red ±limits and saturated markers),
-    /// 23 (the tenth joint's angle and its grey target), 45 (the second joint's error and the orange
-    /// chatter flag) and green τ_g beside the third joint's green torque.
-    #[test]
-    fn each_series_in_a_joint_plot_has_a_colour_of_its_own() {
-        use super::{CHATTER_RGB, GRAVITY_TORQUE_RGB, JOINT_PALETTE, LIMIT_RGB, SATURATED_RGB, TARGET_RGB};
-        let distance = |a: (u8, u8, u8), b: (u8, u8, u8)| (((a.0 as f64 - b.0 as f64).powi(2) + (a.1 as f64 - b.1 as f64).powi(2) + (a.2 as f64 - b.2 as f64).powi(2))).sqrt();
-        for (j, &joint) in JOINT_PALETTE.iter().enumerate() {
-            // angle vs target; torque, τ_g, ±limits and saturated markers; error, saturated, chatter
-            let plots = [("angle", vec![joint, TARGET_RGB]), ("torque", vec![joint, GRAVITY_TORQUE_RGB, LIMIT_RGB, SATURATED_RGB]), ("status", vec![joint, LIMIT_RGB, CHATTER_RGB])];
-            for (plot, colours) in plots {
-                for (a, &first) in colours.iter().enumerate() {
-                    // (the limits and the saturated markers are the same signal: red)
-                    for &second in colours[a + 1..].iter().filter(|&&c| !(first == LIMIT_RGB && c == SATURATED_RGB)) {
-                        let apart = distance(first, second);
-                        assert!(apart >= 55.0, "joint {j}'s {plot} plot: {first:?} and {second:?} are {apart:.0} apart");
-                    }
-                }
-            }
-        }
     }
 
     #[test]
