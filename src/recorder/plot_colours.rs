@@ -37,6 +37,8 @@ pub const CHATTER_RGB: (u8, u8, u8) = (250, 210, 40);
 pub const FRICTION_RGB: (u8, u8, u8) = (200, 0, 200);
 /// The stuck flag (0/1) in each torque plot.
 pub const STUCK_RGB: (u8, u8, u8) = (120, 120, 120);
+/// A motor's shaft speed in its joint's stepper plot, beside the load angle in the joint's colour.
+pub const MOTOR_SPEED_RGB: (u8, u8, u8) = (235, 235, 235);
 
 /// Joint `j`'s colour.
 pub fn joint_rgb(j: usize) -> (u8, u8, u8) {
@@ -56,15 +58,21 @@ mod tests {
     /// 16 joint colours: at least 55 apart in RGB (Euclidean, 0–255 a channel). The colours this
     /// replaced were 16 apart (the fourth joint's torque and its red ±limits and saturated markers),
     /// 23 (the tenth joint's angle and its grey target), 45 (the second joint's error and the orange
-    /// chatter flag), 12 (the fifth joint's torque and the purple friction) and green τ_g beside the
-    /// third joint's green torque.
+    /// chatter flag), 12 (the fifth joint's torque and the purple friction), 0 (a stepper's load
+    /// angle and its motor speed, both in the joint's colour) and green τ_g beside the third joint's
+    /// green torque.
     #[test]
     fn each_series_in_a_joint_plot_has_a_colour_of_its_own() {
         let distance = |a: (u8, u8, u8), b: (u8, u8, u8)| ((a.0 as f64 - b.0 as f64).powi(2) + (a.1 as f64 - b.1 as f64).powi(2) + (a.2 as f64 - b.2 as f64).powi(2)).sqrt();
         for (j, &joint) in JOINT_PALETTE.iter().enumerate() {
             // angle vs target; torque, τ_g, ±limits, saturated markers, friction and stuck; error,
-            // saturated, chatter
-            let plots = [("angle", vec![joint, TARGET_RGB]), ("torque", vec![joint, GRAVITY_TORQUE_RGB, LIMIT_RGB, SATURATED_RGB, FRICTION_RGB, STUCK_RGB]), ("status", vec![joint, LIMIT_RGB, CHATTER_RGB])];
+            // saturated, chatter; a stepper's load angle, lost steps (red) and motor speed
+            let plots = [
+                ("angle", vec![joint, TARGET_RGB]),
+                ("torque", vec![joint, GRAVITY_TORQUE_RGB, LIMIT_RGB, SATURATED_RGB, FRICTION_RGB, STUCK_RGB]),
+                ("status", vec![joint, LIMIT_RGB, CHATTER_RGB]),
+                ("stepper", vec![joint, LIMIT_RGB, MOTOR_SPEED_RGB]),
+            ];
             for (plot, colours) in plots {
                 for (a, &first) in colours.iter().enumerate() {
                     // (the limits and the saturated markers are the same signal: red)

@@ -18,7 +18,7 @@ use rerun::{RecordingStream, TimeColumn};
 use super::torque_axis::TorqueAxis;
 use super::rrd_collisions::{Recolour, RrdCollisions, log_geometry};
 use super::column_pool::ColumnPool;
-use super::plot_colours::{CHATTER_RGB, FRICTION_RGB, GRAVITY_TORQUE_RGB, LIMIT_RGB, SATURATED_RGB, STUCK_RGB, TARGET_RGB, joint_rgb};
+use super::plot_colours::{CHATTER_RGB, FRICTION_RGB, GRAVITY_TORQUE_RGB, LIMIT_RGB, MOTOR_SPEED_RGB, SATURATED_RGB, STUCK_RGB, TARGET_RGB, joint_rgb};
 use rerun::external::arrow::buffer::{Buffer, OffsetBuffer};
 use std::collections::VecDeque;
 use std::path::PathBuf;
@@ -343,7 +343,7 @@ impl RerunRecorder {
                 }),
                 ("load_angle", lines(&[format!("{name} load angle (electrical °; ±90 peak torque, ±180 slip)")], &[c], &[1.5])),
                 ("lost_steps", lines(&[format!("{name} lost steps (full)")], &[red], &[2.0])),
-                ("motor_speed", lines(&[format!("{name} motor speed (rev/s)")], &[c], &[1.5])),
+                ("motor_speed", lines(&[format!("{name} motor speed (rev/s)")], &[rgb(MOTOR_SPEED_RGB)], &[1.0])),
                 ("friction", lines(&[format!("{name} friction (N·m)"), format!("{name} stuck (0/1)")], &[rgb(FRICTION_RGB), rgb(STUCK_RGB)], &[1.0, 1.0])),
                 ("winding_temperature", lines(&[format!("{name} winding (°C)")], &[c], &[1.5])),
             ];
