@@ -27,7 +27,7 @@ pub const JOINT_PALETTE: [(u8, u8, u8); 16] = [
 pub const TARGET_RGB: (u8, u8, u8) = (140, 140, 140);
 /// τ_g in each torque plot: near-white, which no joint's colour is.
 pub const GRAVITY_TORQUE_RGB: (u8, u8, u8) = (235, 235, 235);
-/// The ±limit lines, and the saturated flag in the status plot.
+/// The ±limit lines, the saturated flag in the status plot and a stepper's lost steps in its plot.
 pub const LIMIT_RGB: (u8, u8, u8) = (220, 50, 50);
 /// The saturated steps' markers in each torque plot.
 pub const SATURATED_RGB: (u8, u8, u8) = (230, 40, 40);
