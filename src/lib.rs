@@ -17,6 +17,7 @@ pub mod dynamics;
 pub mod error;
 pub mod experiment;
 pub mod flags;
+pub mod identify;
 pub mod inspect;
 pub mod meshgen;
 pub mod model;
@@ -29,5 +30,6 @@ pub mod sim;
 pub mod sizing;
 pub mod spatial;
 pub mod summary;
+pub mod testbench;
 
 pub use error::Error;

@@ -4,6 +4,7 @@
 //! behind a gearbox (ratio, efficiency, rated output torque); a [`MotorSet`] assigns drive trains to
 //! a model's joints, from a motor file (`--motors FILE.toml`, see [`catalogue`]).
 
+pub mod bus_servo;
 pub mod carried;
 pub mod catalogue;
 mod lossy_gear;
@@ -13,6 +14,7 @@ mod servo;
 mod stepper;
 pub mod thermal;
 
+pub use bus_servo::BusServo;
 pub use carried::{Mount, PlacedPart};
 pub use catalogue::{Catalogue, load_motor_file};
 pub use lossy_gear::LossyGear;
@@ -41,6 +43,10 @@ pub trait Motor: Debug + Send + Sync {
     fn describe(&self) -> String;
     /// The stepper, if this is one (stepper mode needs its step geometry).
     fn as_stepper(&self) -> Option<&Stepper> {
+        None
+    }
+    /// The serial-bus servo, if this is one (its firmware drives the joint).
+    fn as_bus_servo(&self) -> Option<&BusServo> {
         None
     }
 }

@@ -5,9 +5,11 @@ mod batch;
 mod catalogue;
 mod compare;
 mod envelope;
+mod identify;
 mod model;
 mod run;
 mod size;
+mod testbench;
 mod trajectory;
 
 pub use analyze::{AnalyzeArgs, analyze};
@@ -15,10 +17,12 @@ pub use batch::{BatchAction, BatchArgs, batch};
 pub use catalogue::{CatalogueArgs, catalogue};
 pub use compare::{CompareArgs, compare};
 pub use envelope::{EnvelopeArgs, envelope};
+pub use identify::{IdentifyArgs, identify};
 pub use model::{ModelArgs, model};
 pub use crate::flags::{GainArgs, MotorArgs, RunArgs, WaveArgs};
 pub use run::{default_run_name, run};
 pub use size::{SizeArgs, parse_ratios, size};
+pub use testbench::{TestbenchArgs, read_logs, read_params, testbench};
 pub use trajectory::{TrajectoryArgs, trajectory};
 
 use crate::config::{IntegratorKind, RunConfig};
@@ -61,6 +65,10 @@ pub enum Command {
     Size(SizeArgs),
     /// The motors and reductions to choose from, each with its source; --check FILE validates yours.
     Catalogue(CatalogueArgs),
+    /// Replay servo bench logs (BAM's pendulum JSON) against a servo model: position error, PWM, where they part.
+    Testbench(TestbenchArgs),
+    /// Fit a servo's parameters (BAM's JSON) to bench logs, and check them on held-out logs.
+    Identify(IdentifyArgs),
 }
 
 /// Parse `args` and run; returns the process exit code. Errors are printed as one line.
@@ -103,6 +111,8 @@ fn run_command(command: Command) -> Result<i32, Error> {
         Command::Model(args) => model(&args),
         Command::Size(args) => size(&args),
         Command::Catalogue(args) => catalogue(&args),
+        Command::Testbench(args) => testbench(&args),
+        Command::Identify(args) => identify(&args),
     }
 }
 

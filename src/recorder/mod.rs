@@ -8,7 +8,7 @@ pub mod foxglove_layout;
 pub mod foxglove_live;
 mod mcap;
 pub mod mcap_collisions;
-mod output_file;
+pub(crate) mod output_file;
 mod overview;
 mod pacer;
 mod plot_colours;

@@ -1,0 +1,177 @@
+//! `armscope identify`: fit a servo's parameters to bench logs and check them on held-out logs.
+
+use super::*;
+use crate::actuator::bus_servo::{FrictionModel, firmware};
+use crate::identify::{FitOptions, Space, fit};
+use crate::testbench::{BenchLog, ReplayOptions, Step, Supply, mae};
+
+#[derive(Args, Debug)]
+pub struct IdentifyArgs {
+    /// Training logs (BAM's JSON, processed or raw).
+    #[arg(required = true, value_name = "LOG.json")]
+    pub logs: Vec<PathBuf>,
+    /// The servo: xl330, xl320, mx64, mx106, sts3215.
+    #[arg(long, value_name = "NAME")]
+    pub actuator: String,
+    /// The friction model to fit (BAM's M1–M6).
+    #[arg(long, value_enum, default_value_t = FrictionModel::M6)]
+    pub friction_model: FrictionModel,
+    /// Where to write the parameters (BAM's JSON; `armscope testbench --servo-params` reads it).
+    #[arg(long, value_name = "P.json")]
+    pub out: PathBuf,
+    /// Held-out logs: replayed with the fit, not fitted to.
+    #[arg(long, value_name = "LOG.json", num_args = 1..)]
+    pub validate: Vec<PathBuf>,
+    /// bam: BAM's explicit step (what BAM's files are fitted with); exact: armscope's.
+    #[arg(long, value_enum, default_value_t = Step::Bam)]
+    pub step: Step,
+    /// Exact steps per log row (--step exact).
+    #[arg(long, default_value_t = 5)]
+    pub substeps: usize,
+    /// nominal: the header's vin; measured: the logs' input_volts row by row.
+    #[arg(long, value_enum, default_value_t = Supply::Nominal)]
+    pub supply: Supply,
+    /// Also fit the supply's internal resistance (the voltage's sag under load; BAM assumes none).
+    #[arg(long)]
+    pub fit_supply_resistance: bool,
+    /// Also fit the largest voltage the servo puts across its motor (BAM assumes duty × supply).
+    #[arg(long)]
+    pub fit_motor_voltage_limit: bool,
+    /// Also start the refinement from these parameters (BAM's JSON).
+    #[arg(long, value_name = "P.json")]
+    pub start: Option<PathBuf>,
+    /// The grid a raw log is resampled to, s.
+    #[arg(long, value_name = "SECONDS", default_value_t = crate::testbench::log::DEFAULT_DT)]
+    pub dt: f64,
+    /// Particles of the global search.
+    #[arg(long, default_value_t = FitOptions::default().particles)]
+    pub particles: usize,
+    /// Iterations of the global search.
+    #[arg(long, default_value_t = FitOptions::default().swarm_iterations)]
+    pub iterations: u64,
+    /// Independent global searches; the best wins.
+    #[arg(long, default_value_t = FitOptions::default().searches)]
+    pub searches: usize,
+    /// The random seed of the global search (the same seed, logs and flags give the same fit).
+    #[arg(long, default_value_t = FitOptions::default().seed)]
+    pub seed: u64,
+    /// Write the fit's numbers (loss, per-log MAE, validation) as JSON.
+    #[arg(long, value_name = "PATH")]
+    pub summary_json: Option<PathBuf>,
+    /// No table on the console.
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+#[derive(serde::Serialize)]
+struct LogMae {
+    log: String,
+    mae_rad: f64,
+}
+
+#[derive(serde::Serialize)]
+struct IdentifySummary {
+    actuator: String,
+    model: String,
+    step: Step,
+    supply: Supply,
+    evaluations: usize,
+    seconds: f64,
+    train: Vec<LogMae>,
+    train_mean_mae_rad: f64,
+    validate: Vec<LogMae>,
+    validate_mean_mae_rad: Option<f64>,
+    params: serde_json::Value,
+}
+
+fn maes(logs: &[BenchLog], params: &crate::actuator::bus_servo::ServoParams, options: &ReplayOptions) -> Vec<LogMae> {
+    use rayon::prelude::*;
+    logs.par_iter().map(|l| LogMae { log: l.path.display().to_string(), mae_rad: mae(l, params, options) }).collect()
+}
+
+fn mean(list: &[LogMae]) -> f64 {
+    list.iter().map(|l| l.mae_rad).sum::<f64>() / list.len().max(1) as f64
+}
+
+/// `armscope identify`.
+pub fn identify(args: &IdentifyArgs) -> Result<i32, Error> {
+    let family = firmware::family(&args.actuator).ok_or_else(|| Error::flag("--actuator", format!("'{}' is not a servo armscope knows ({})", args.actuator, firmware::family_names())))?;
+    if args.substeps == 0 {
+        return Err(Error::flag("--substeps", "must be at least 1"));
+    }
+    if args.particles < 2 {
+        return Err(Error::flag("--particles", "must be at least 2"));
+    }
+    if !(args.dt.is_finite() && args.dt > 0.0) {
+        return Err(Error::flag("--dt", format!("must be a positive number of seconds (got {})", args.dt)));
+    }
+    let replay = ReplayOptions { step: args.step, substeps: args.substeps, supply: args.supply, reset_rows: None };
+    let train = read_logs(&args.logs, args.dt)?;
+    let validate = read_logs(&args.validate, args.dt)?;
+    for log in train.iter().chain(&validate) {
+        if firmware::family(&log.actuator).map(|f| f.name) != Some(family.name) {
+            return Err(Error::flag("LOG", format!("{}: field 'motor' is '{}', but --actuator is {}", log.path.display(), log.actuator, family.name)));
+        }
+    }
+    let start = match &args.start {
+        Some(path) => {
+            let mut p = read_params(path, "--start")?;
+            if p.family.name != family.name {
+                return Err(Error::flag("--start", format!("{}: a {} file, but --actuator is {}", path.display(), p.family.name, family.name)));
+            }
+            if !args.friction_model.contains(p.friction.model) {
+                return Err(Error::flag("--start", format!("{}: its {} friction is not part of {}: start from a file of a model {} contains", path.display(), p.friction.model.name(), args.friction_model.name(), args.friction_model.name())));
+            }
+            p.friction = p.friction.as_model(args.friction_model);
+            Some(p)
+        }
+        None => None,
+    };
+    let space = Space::new(family, args.friction_model, args.fit_supply_resistance, args.fit_motor_voltage_limit);
+    let options = FitOptions { searches: args.searches, particles: args.particles, swarm_iterations: args.iterations, seed: args.seed, start, ..Default::default() };
+    let started = std::time::Instant::now();
+    let found = fit(&space, &train, replay, &options).map_err(|m| Error::flag("identify", m))?;
+    let seconds = started.elapsed().as_secs_f64();
+    let train_maes = maes(&train, &found.params, &replay);
+    let validate_maes = maes(&validate, &found.params, &replay);
+    let mut json = found.params.to_json();
+    let file_json = json.clone();
+    crate::runner::create_parent(&args.out)?;
+    std::fs::write(&args.out, serde_json::to_string_pretty(&file_json).unwrap_or_default() + "\n").map_err(|e| Error::output(&args.out, e))?;
+    if !args.quiet {
+        println!("{} {} fitted to {} log(s) in {seconds:.1} s ({} replays of every log; the searches ended at {} mrad):", family.name, args.friction_model.name(), train.len(), found.evaluations, found.search_losses.iter().map(|l| format!("{:.2}", 1e3 * l)).collect::<Vec<_>>().join(", "));
+        let width = train.iter().chain(&validate).map(|l| l.name().chars().count()).max().unwrap_or(4);
+        for (log, m) in train.iter().zip(&train_maes) {
+            println!("  train     {:<width$} MAE {:>7.2} mrad", log.name(), 1e3 * m.mae_rad);
+        }
+        for (log, m) in validate.iter().zip(&validate_maes) {
+            println!("  held out  {:<width$} MAE {:>7.2} mrad", log.name(), 1e3 * m.mae_rad);
+        }
+        println!("  mean MAE: trained on {:.2} mrad{}", 1e3 * mean(&train_maes), if validate.is_empty() { String::new() } else { format!(", held out {:.2} mrad", 1e3 * mean(&validate_maes)) });
+        let p = &found.params;
+        println!("  k_t {:.4} N·m/A, R {:.3} Ω (stall at {} V: {:.3} N·m), armature {:.3e} kg·m², q_offset {:.4} rad{}", p.kt, p.resistance, train[0].vin, p.kt * train[0].vin * family.max_duty / (p.resistance + p.supply_resistance), p.armature, p.q_offset, if args.fit_supply_resistance { format!(", supply resistance {:.3} Ω", p.supply_resistance) } else { String::new() });
+        if args.fit_motor_voltage_limit {
+            println!("  motor voltage limit {:.3} V", p.motor_voltage_limit);
+        }
+        println!("wrote {}", args.out.display());
+    }
+    if let Some(path) = &args.summary_json {
+        json = file_json;
+        let summary = IdentifySummary {
+            actuator: family.name.into(),
+            model: args.friction_model.name().into(),
+            step: args.step,
+            supply: args.supply,
+            evaluations: found.evaluations,
+            seconds,
+            train_mean_mae_rad: mean(&train_maes),
+            validate_mean_mae_rad: (!validate_maes.is_empty()).then(|| mean(&validate_maes)),
+            train: train_maes,
+            validate: validate_maes,
+            params: json,
+        };
+        crate::runner::create_parent(path)?;
+        std::fs::write(path, serde_json::to_string_pretty(&summary).unwrap_or_default() + "\n").map_err(|e| Error::output(path, e))?;
+    }
+    Ok(0)
+}

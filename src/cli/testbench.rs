@@ -1,0 +1,136 @@
+//! `armscope testbench`: replay servo bench logs (BAM's JSON) against a servo model and say how
+//! far the simulation is from what the servo did.
+
+use super::*;
+use std::path::Path;
+use crate::actuator::bus_servo::ServoParams;
+use crate::testbench::{BenchLog, LogResult, ReplayOptions, Step, Summary, Supply, recording, rollout};
+
+#[derive(Args, Debug)]
+pub struct TestbenchArgs {
+    /// Bench logs in BAM's JSON: processed (with their dt) or raw (resampled to --dt).
+    #[arg(required = true, value_name = "LOG.json")]
+    pub logs: Vec<PathBuf>,
+    /// The servo's parameters in BAM's JSON (kt, R, armature, the friction model's keys, model,
+    /// actuator), e.g. a file of Rhoban/bam's params/ or one `armscope identify` wrote.
+    #[arg(long, value_name = "P.json")]
+    pub servo_params: PathBuf,
+    /// bam: BAM's explicit step at the log's dt, which BAM's files were identified with; exact:
+    /// armscope's exact stick–slip step, --substeps per row.
+    #[arg(long, value_enum, default_value_t = Step::Bam)]
+    pub step: Step,
+    /// Exact steps per log row (--step exact).
+    #[arg(long, default_value_t = 5)]
+    pub substeps: usize,
+    /// nominal: the header's vin (BAM's assumption); measured: the log's input_volts row by row.
+    #[arg(long, value_enum, default_value_t = Supply::Nominal)]
+    pub supply: Supply,
+    /// The grid a raw log is resampled to, s (BAM's `bam.process --dt`).
+    #[arg(long, value_name = "SECONDS", default_value_t = crate::testbench::log::DEFAULT_DT)]
+    pub dt: f64,
+    /// Write every log's result and the mean MAE as JSON.
+    #[arg(long, value_name = "PATH")]
+    pub summary_json: Option<PathBuf>,
+    /// Write one CSV per log here, named after the log (t,goal_position,position_measured,position_sim).
+    #[arg(long, value_name = "DIR")]
+    pub trace_dir: Option<PathBuf>,
+    /// Where to write the Rerun recording (default: recordings/testbench.rrd).
+    #[arg(long, value_name = "PATH")]
+    pub rrd: Option<PathBuf>,
+    /// Where to write the MCAP (default: recordings/testbench.mcap).
+    #[arg(long, value_name = "PATH")]
+    pub mcap: Option<PathBuf>,
+    /// No Rerun recording.
+    #[arg(long)]
+    pub no_rrd: bool,
+    /// No MCAP.
+    #[arg(long)]
+    pub no_mcap: bool,
+    /// No table on the console.
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+impl TestbenchArgs {
+    pub fn options(&self) -> Result<ReplayOptions, Error> {
+        if self.substeps == 0 {
+            return Err(Error::flag("--substeps", "must be at least 1"));
+        }
+        if !(self.dt.is_finite() && self.dt > 0.0) {
+            return Err(Error::flag("--dt", format!("must be a positive number of seconds (got {})", self.dt)));
+        }
+        Ok(ReplayOptions { step: self.step, substeps: self.substeps, supply: self.supply, reset_rows: None })
+    }
+}
+
+/// Read logs (each error naming its file and field).
+pub fn read_logs(paths: &[PathBuf], dt: f64) -> Result<Vec<BenchLog>, Error> {
+    paths.iter().map(|p| BenchLog::load(p, Some(dt)).map_err(|m| Error::flag("LOG", m))).collect()
+}
+
+/// Read a parameter file, its notices printed.
+pub fn read_params(path: &Path, flag: &str) -> Result<ServoParams, Error> {
+    let mut notices = Vec::new();
+    let params = ServoParams::load(path, &mut notices).map_err(|m| Error::flag(flag, m))?;
+    for n in notices {
+        eprintln!("armscope: notice: {n}");
+    }
+    Ok(params)
+}
+
+/// `armscope testbench`.
+pub fn testbench(args: &TestbenchArgs) -> Result<i32, Error> {
+    let options = args.options()?;
+    let params = read_params(&args.servo_params, "--servo-params")?;
+    let logs = read_logs(&args.logs, args.dt)?;
+    for log in &logs {
+        if crate::actuator::bus_servo::firmware::family(&log.actuator).map(|f| f.name) != Some(params.family.name) {
+            eprintln!("armscope: notice: {}: a {} log replayed with {}'s {} parameters", log.path.display(), log.actuator, args.servo_params.display(), params.family.name);
+        }
+    }
+    let rollouts: Vec<_> = {
+        use rayon::prelude::*;
+        logs.par_iter().map(|log| rollout(log, &params, &options)).collect()
+    };
+    let results: Vec<LogResult> = logs.iter().zip(&rollouts).map(|(log, r)| LogResult::of(log, r, params.family.max_duty)).collect();
+    let summary = Summary::new(args.servo_params.display().to_string(), &options, results);
+    if !args.quiet {
+        let step = match options.step {
+            Step::Bam => "BAM's explicit step".to_string(),
+            Step::Exact => format!("armscope's exact step ({} per row)", options.substeps),
+        };
+        let supply = match options.supply {
+            Supply::Nominal => "the nominal supply",
+            Supply::Measured => "the measured supply",
+        };
+        println!("{} {} on {} log(s), {step}, {supply}:", params.family.name, params.friction.model.name(), logs.len());
+        print!("{}", summary.table());
+    }
+    let runs: Vec<(&BenchLog, &crate::testbench::Rollout)> = logs.iter().zip(&rollouts).collect();
+    if let Some(path) = &args.summary_json {
+        crate::runner::create_parent(path)?;
+        let text = serde_json::to_string_pretty(&summary).unwrap_or_default();
+        std::fs::write(path, text + "\n").map_err(|e| Error::output(path, e))?;
+    }
+    if let Some(dir) = &args.trace_dir {
+        recording::write_traces(dir, &runs)?;
+    }
+    let recordings = PathBuf::from("recordings");
+    if !args.no_rrd {
+        let path = args.rrd.clone().unwrap_or_else(|| recordings.join("testbench.rrd"));
+        crate::runner::create_parent(&path)?;
+        recording::write_rrd(&path, &runs)?;
+        if !args.quiet {
+            println!("wrote {}", path.display());
+        }
+    }
+    if !args.no_mcap {
+        let path = args.mcap.clone().unwrap_or_else(|| recordings.join("testbench.mcap"));
+        crate::runner::create_parent(&path)?;
+        recording::write_mcap(&path, &runs)?;
+        if !args.quiet {
+            println!("wrote {}", path.display());
+        }
+    }
+    Ok(0)
+}

@@ -1,0 +1,189 @@
+//! Replaying a bench log: the log's goals and torque enables sent to a simulated servo on the
+//! log's pendulum, from the log's first measured state, never re-synchronised (BAM's
+//! `rollout_log` with the control simulated).
+//!
+//! Two steps, chosen by [`Step`]:
+//! - **BAM's** explicit step of Δt = the log's dt, which BAM's identified files were fitted with
+//!   (so it is part of those models): the friction budget B + K_v·|q̇| clips the torque that would
+//!   stop the joint within the step, then q̇' = q̇ + a·Δt (clipped at ±100 rad/s) and
+//!   q' = q + q̇'·Δt + ½·a·Δt².
+//! - **armscope's** exact step, as its discrete plant steps a joint: semi-implicit Euler with the
+//!   viscous friction K_v and nothing else implicit, the Coulomb budget B as a band the friction
+//!   impulse stays within, solved exactly (the joint sticks, q̇ = 0 exactly, when the rest of the
+//!   step's impulse is within ±h·B), `substeps` steps per log row, the firmware ticking at each.
+
+use super::log::BenchLog;
+use super::pendulum::Pendulum;
+use crate::actuator::bus_servo::{BusServo, FirmwareState, ServoParams};
+
+/// How the bench is stepped.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum Step {
+    /// BAM's explicit step at the log's dt (what BAM's files were identified with).
+    #[default]
+    Bam,
+    /// armscope's exact stick–slip step, `--substeps` per log row.
+    Exact,
+}
+
+/// Which supply voltage drives the servo.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum Supply {
+    /// The header's nominal `vin` (BAM's assumption).
+    #[default]
+    Nominal,
+    /// The log's measured `input_volts` at each row (the nominal where a row has none).
+    Measured,
+}
+
+/// How to replay.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ReplayOptions {
+    pub step: Step,
+    /// Exact steps per log row.
+    pub substeps: usize,
+    pub supply: Supply,
+    /// Every this many rows the simulation restarts from the measured state (None: never, BAM's
+    /// metric): short windows make a smoother loss for a fit's first stage.
+    pub reset_rows: Option<usize>,
+}
+
+impl Default for ReplayOptions {
+    fn default() -> Self {
+        Self { step: Step::Bam, substeps: 5, supply: Supply::Nominal, reset_rows: None }
+    }
+}
+
+/// The simulated bench at every log row (before the row's step: row 0 is the measured start).
+#[derive(Clone, Debug, Default)]
+pub struct Rollout {
+    pub position: Vec<f64>,
+    pub speed: Vec<f64>,
+    /// The firmware's duty over the row.
+    pub duty: Vec<f64>,
+    /// The motor's current and torque at the row's start.
+    pub current: Vec<f64>,
+    pub torque: Vec<f64>,
+    /// The supply at the servo, V.
+    pub supply: Vec<f64>,
+}
+
+impl Rollout {
+    /// Mean absolute error of the position against the log's, rad, over every row (BAM's metric).
+    pub fn mae(&self, log: &BenchLog) -> f64 {
+        mean_abs(self.position.iter().zip(&log.entries).map(|(s, e)| s - e.position))
+    }
+}
+
+fn mean_abs(errors: impl Iterator<Item = f64>) -> f64 {
+    let (mut sum, mut n) = (0.0, 0usize);
+    for e in errors {
+        sum += e.abs();
+        n += 1;
+    }
+    if n == 0 { 0.0 } else { sum / n as f64 }
+}
+
+/// The servo and bench of one log.
+struct Bench {
+    servo: BusServo,
+    pendulum: Pendulum,
+    q_offset: f64,
+    inertia: f64,
+}
+
+impl Bench {
+    fn new(log: &BenchLog, params: &ServoParams) -> Self {
+        let servo = BusServo::from_params(&log.actuator, params, log.kp, log.vin);
+        let pendulum = Pendulum::from_log(log);
+        Self { inertia: pendulum.inertia() + params.armature, servo, pendulum, q_offset: params.q_offset }
+    }
+
+    fn supply(&self, log: &BenchLog, row: usize, options: &ReplayOptions) -> f64 {
+        match options.supply {
+            Supply::Nominal => log.vin,
+            Supply::Measured => log.entries[row].volts.unwrap_or(log.vin),
+        }
+    }
+}
+
+/// Replay `log` with the servo of `params`; `record` gets each row's state before its step.
+fn replay(log: &BenchLog, params: &ServoParams, options: &ReplayOptions, mut record: impl FnMut(usize, f64, f64, &crate::actuator::bus_servo::ServoOutput)) {
+    let bench = Bench::new(log, params);
+    let dt = log.dt;
+    let first = &log.entries[0];
+    let (mut q, mut v) = (first.position, first.speed);
+    // a Feetech's internal target starts at 0 when a log is loaded (BAM's feetech/actuator.py)
+    let mut firmware = FirmwareState::default();
+    let friction = &bench.servo.friction;
+    for (row, entry) in log.entries.iter().enumerate() {
+        if options.reset_rows.is_some_and(|n| row > 0 && row % n == 0) {
+            (q, v) = (entry.position, entry.speed);
+        }
+        let supply = bench.supply(log, row, options);
+        match options.step {
+            Step::Bam => {
+                let out = bench.servo.tick(&mut firmware, entry.goal, q, v, dt, supply, entry.enabled);
+                record(row, q, v, &out);
+                let external = bench.pendulum.gravity_torque(q + bench.q_offset);
+                let budget = friction.budget(out.torque, external, v) + friction.viscous * v.abs();
+                let net = out.torque + external;
+                let stop = bench.inertia / dt * v + net;
+                let friction_torque = -signum(stop) * stop.abs().min(budget);
+                let acceleration = (net + friction_torque) / bench.inertia;
+                v = (v + acceleration * dt).clamp(-100.0, 100.0);
+                q += v * dt + 0.5 * acceleration * dt * dt;
+            }
+            Step::Exact => {
+                let h = dt / options.substeps as f64;
+                for s in 0..options.substeps {
+                    let out = bench.servo.tick(&mut firmware, entry.goal, q, v, h, supply, entry.enabled);
+                    if s == 0 {
+                        record(row, q, v, &out);
+                    }
+                    let external = bench.pendulum.gravity_torque(q + bench.q_offset);
+                    let band = h * friction.budget(out.torque, external, v);
+                    // (J + h·K_v)·v' = J·v + h·(τ_m + τ_e) + h·τ_f, |τ_f| ≤ B, τ_f against v'
+                    let impulse = bench.inertia * v + h * (out.torque + external);
+                    v = if impulse.abs() <= band { 0.0 } else { (impulse - signum(impulse) * band) / (bench.inertia + h * friction.viscous) };
+                    q += h * v;
+                }
+            }
+        }
+    }
+}
+
+/// NumPy's sign.
+fn signum(x: f64) -> f64 {
+    if x > 0.0 {
+        1.0
+    } else if x < 0.0 {
+        -1.0
+    } else {
+        0.0
+    }
+}
+
+/// The whole rollout.
+pub fn rollout(log: &BenchLog, params: &ServoParams, options: &ReplayOptions) -> Rollout {
+    let n = log.entries.len();
+    let mut out = Rollout { position: Vec::with_capacity(n), speed: Vec::with_capacity(n), duty: Vec::with_capacity(n), current: Vec::with_capacity(n), torque: Vec::with_capacity(n), supply: Vec::with_capacity(n) };
+    replay(log, params, options, |_, q, v, servo| {
+        out.position.push(q);
+        out.speed.push(v);
+        out.duty.push(servo.duty);
+        out.current.push(servo.current);
+        out.torque.push(servo.torque);
+        out.supply.push(servo.supply);
+    });
+    out
+}
+
+/// The position MAE alone, without keeping the rollout (for identification).
+pub fn mae(log: &BenchLog, params: &ServoParams, options: &ReplayOptions) -> f64 {
+    let mut sum = 0.0;
+    replay(log, params, options, |row, q, _, _| sum += (q - log.entries[row].position).abs());
+    sum / log.entries.len() as f64
+}
