@@ -11,13 +11,16 @@ pub enum IntegratorKind {
     Continuous,
 }
 
-/// How a joint whose motor is a stepper is driven.
+/// How a joint whose motor is a stepper or a serial-bus servo is driven.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum DriveMode {
-    /// Open loop, as the real SmallRobotArm runs: the command in microsteps, lost steps possible.
+    /// As the real arm runs them: steppers open loop (the command in microsteps, lost steps
+    /// possible, as the SmallRobotArm), servos with a firmware model by their own position loop.
     #[default]
-    Stepper,
+    #[value(alias = "stepper")]
+    #[serde(alias = "stepper")]
+    Native,
     /// The tutorial's PD controller on the motor's torque–speed limit.
     Pd,
 }
@@ -127,7 +130,7 @@ impl Default for RunConfig {
             friction_scale: 1.0,
             q0: None,
             motors: None,
-            drive: DriveMode::Stepper,
+            drive: DriveMode::Native,
             collisions: false,
             floor: None,
             srdf: None,

@@ -6,7 +6,7 @@ use crate::error::Error;
 use crate::control::gains::{Gains, TUTORIAL_KD, TUTORIAL_KP, auto_tune, is_tutorial_model};
 use crate::control::within_effort::{MOTION_LOAD, START_LOAD, carried_wave, holdable_pose, overloaded_by_weight};
 use crate::plant::{JointFriction, ContinuousPlant, DiscretePlant, Plant, Tolerances};
-use crate::actuator::{MotorSet, OpenLoopSteppers, load_motor_file};
+use crate::actuator::{FirmwareDrives, MotorSet, OpenLoopSteppers, load_motor_file};
 use crate::model::{LoadOptions, Model, load_urdf_with};
 use crate::control::sampled_loop::LoopPlant;
 use crate::control::trajectory::{Hold, JointSchedule, JointStep, JointWave, RampIn, Trajectory, Wave};
@@ -37,6 +37,10 @@ pub struct Experiment {
     /// energized where the command starts; `start` is that pose plus the sag at which each stepper
     /// carries its share of the weight. Each run drives a copy.
     pub steppers: Option<OpenLoopSteppers>,
+    /// Firmware mode (`--motors` with servos that have a firmware model, `--drive native`): the
+    /// joints their servos' position loops drive, at rest where the command starts, sagged under
+    /// the weight. Each run drives a copy.
+    pub servos: Option<FirmwareDrives>,
     /// The collision checks (`--collisions`, `--floor`, `--srdf`): the shapes and active pairs.
     pub collisions: Option<Arc<crate::collision::Collisions>>,
 }
@@ -105,7 +109,11 @@ impl Experiment {
         let motors = motors.map(Arc::new);
         let mut plant = plant_spec(&config)?;
         let steppers = match &motors {
-            Some(motors) if config.drive == DriveMode::Stepper && motors.has_steppers() => stepper_setup(&config, &mut model, motors, trajectory.as_ref(), &mut start, &mut plant),
+            Some(motors) if config.drive == DriveMode::Native && motors.has_steppers() => stepper_setup(&config, &mut model, motors, trajectory.as_ref(), &mut start, &mut plant),
+            _ => None,
+        };
+        let servos = match &motors {
+            Some(motors) if config.drive == DriveMode::Native => servo_setup(&config, &mut model, motors, &mut start, &mut plant)?,
             _ => None,
         };
         weight_notices(&mut model, &start);
@@ -131,7 +139,7 @@ impl Experiment {
         } else {
             None
         };
-        Ok(Self { config, model: Arc::new(model), gains, plant, trajectory, steps, start, motors, steppers, collisions })
+        Ok(Self { config, model: Arc::new(model), gains, plant, trajectory, steps, start, motors, steppers, servos, collisions })
     }
 
     pub fn controller(&self) -> PdGravityController {
@@ -150,7 +158,7 @@ impl Experiment {
     pub fn make_plant(&self) -> Box<dyn Plant> {
         let gears = self.gears();
         match self.plant {
-            PlantSpec::Discrete { time_step, substeps } => Box::new(DiscretePlant::with_gears(&self.model, time_step, substeps, &gears)),
+            PlantSpec::Discrete { time_step, substeps } => Box::new(DiscretePlant::with_friction(&self.model, time_step, substeps, self.joint_friction())),
             PlantSpec::Continuous { rtol, atol } => {
                 Box::new(ContinuousPlant::with_gears(&self.model, self.config.dt, Tolerances { rtol, atol }, &gears))
             }
@@ -168,10 +176,41 @@ impl Experiment {
         self.motors.as_ref().map_or_else(|| vec![None; self.model.dof()], |m| m.gears())
     }
 
-    /// Per coordinate: whether the joint has friction — the URDF's, or its gearbox's losses.
-    pub fn joint_has_friction(&self) -> Vec<bool> {
+    /// Each joint's friction: the URDF's, its gearbox's losses, its servo's (firmware mode).
+    pub fn joint_friction(&self) -> JointFriction {
         let friction = JointFriction::new(&self.model, &self.gears());
+        match &self.servos {
+            Some(s) => friction.with_servos(&s.frictions(self.model.dof())),
+            None => friction,
+        }
+    }
+
+    /// Per coordinate: whether the joint has friction — the URDF's, its gearbox's losses or its
+    /// servo's.
+    pub fn joint_has_friction(&self) -> Vec<bool> {
+        let friction = self.joint_friction();
         (0..self.model.dof()).map(|i| friction.has(i)).collect()
+    }
+
+    /// The firmware-driven servos for one run of this experiment (a fresh copy).
+    pub fn firmware_drives(&self) -> Option<FirmwareDrives> {
+        self.servos.clone()
+    }
+
+    /// Per joint driven by its servo's firmware, the servo's duty limit (None elsewhere).
+    pub fn servo_duty_limits(&self) -> Vec<Option<f64>> {
+        let mut out = vec![None; self.model.dof()];
+        if let Some(s) = &self.servos {
+            for (j, servo, _) in s.servos() {
+                out[j] = Some(servo.firmware.family.max_duty);
+            }
+        }
+        out
+    }
+
+    /// Per joint: driven by its servo's firmware.
+    pub fn firmware_joints(&self) -> Vec<bool> {
+        self.servos.as_ref().map_or_else(|| vec![false; self.model.dof()], |s| s.driven.clone())
     }
 
     /// Whether stepper joints run open loop.
@@ -477,6 +516,57 @@ fn install_drive_trains(model: &mut Model, set: &MotorSet) -> Result<(), Error> 
         model.notices.push(format!("motors without a published mass, not carried on the arm: {}", unweighed.join(", ")));
     }
     Ok(())
+}
+
+/// Firmware mode's set-up: the servo joints start at rest at the start pose, sagged by the error at
+/// which each position loop carries its weight there (the closed form, friction aside), their
+/// firmware's goal the start pose; the discrete plant only (the servos' friction budgets are its).
+/// None without such servos.
+fn servo_setup(config: &RunConfig, model: &mut Model, motors: &MotorSet, start: &mut [f64], plant: &mut PlantSpec) -> Result<Option<FirmwareDrives>, Error> {
+    let Some(drives) = FirmwareDrives::new(motors, start) else { return Ok(None) };
+    if matches!(plant, PlantSpec::Continuous { .. }) {
+        return Err(Error::flag("--time-step", format!("0 (the continuous plant): the joints driven by their servos' firmware ({}) need the discrete plant, which takes their friction budgets; --drive pd runs them on the continuous plant as torque sources", names(model, &drives.driven))));
+    }
+    let held = start.to_vec();
+    let mut data = crate::dynamics::Data::new(model);
+    let mut unheld = Vec::new();
+    for _ in 0..5 {
+        let tau_g = crate::dynamics::gravity_forces(model, &mut data, start).to_vec();
+        unheld.clear();
+        for (j, sag) in drives.rest_sag(&tau_g) {
+            match sag {
+                Some(sag) => start[j] = (held[j] + sag).clamp(model.joints[j].lower, model.joints[j].upper),
+                None => unheld.push(model.joints[j].name.clone()),
+            }
+        }
+    }
+    let sags: Vec<String> = drives.servos().map(|(j, servo, _)| format!("{} {:.2} mrad (P gain {})", model.joints[j].name, 1e3 * (start[j] - held[j]), servo.firmware.kp)).collect();
+    model.notices.push(format!("firmware mode: {} driven by their servos' position loops (not the PD controller), starting at rest at the start pose, sagged under the weight: {}", names(model, &drives.driven), sags.join(", ")));
+    if !unheld.is_empty() {
+        model.notices.push(format!("firmware mode: at full duty the servos of {} cannot hold the weight at the start", unheld.join(", ")));
+    }
+    if let PlantSpec::Discrete { substeps, .. } = *plant {
+        // the firmware ticks and the back-EMF is evaluated at each plant step's start: the step
+        // must resolve the position loop's oscillation and the back-EMF's damping (ω_n·h, h·c/I ≤ 0.2)
+        let inertia = inertia_diagonal(model, start);
+        let rate = drives.stiffness_and_damping().iter().map(|&(j, k, c)| (k / inertia[j]).sqrt().max(c / inertia[j])).fold(0.0, f64::max);
+        let needed = ((rate * config.dt / 0.2).ceil() as usize).max(1);
+        if needed > substeps {
+            let step_ms = config.dt / needed as f64 * 1e3;
+            match config.time_step {
+                Some(_) => model.notices.push(format!("firmware mode: --time-step {} ms is longer than the stiffest servo's loop allows ({step_ms:.4} ms for ω_n·h, h·c/I ≤ 0.2)", config.dt / substeps as f64 * 1e3)),
+                None => {
+                    *plant = PlantSpec::Discrete { time_step: config.dt / needed as f64, substeps: needed };
+                    model.notices.push(format!("firmware mode: plant step {step_ms:.4} ms ({needed} per control period), short enough for the stiffest servo's loop and back-EMF (ω_n·h, h·c/I ≤ 0.2); --time-step sets another"));
+                }
+            }
+        }
+    }
+    Ok(Some(drives))
+}
+
+fn names(model: &Model, which: &[bool]) -> String {
+    model.joints.iter().zip(which).filter(|(_, w)| **w).map(|(j, _)| j.name.as_str()).collect::<Vec<_>>().join(", ")
 }
 
 /// Stepper mode's set-up: the stepper joints start where the command starts (unless `--q0`), held at

@@ -41,6 +41,11 @@ pub struct Sample<'a> {
     /// Per joint, its motor's winding temperature, °C (NaN where the motor has no thermal data;
     /// empty when no motor of the run has).
     pub winding_temperature: &'a [f64],
+    /// Per joint driven by its servo's firmware: the PWM duty (−1 … 1), the motor's current (A)
+    /// and the supply at the servo (V); 0 elsewhere; all empty when no joint is.
+    pub duty: &'a [f64],
+    pub current: &'a [f64],
+    pub supply: &'a [f64],
     /// With collision checks: the pairs closer than 5 cm at this state, nearest first (distance ≤ 0:
     /// in contact); empty without checks.
     pub collisions: &'a [crate::collision::PairDistance],

@@ -41,6 +41,13 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
     // stepper mode: the open-loop steppers, their load angles and lost steps
     let mut steppers = experiment.open_loop_steppers();
     let (mut load_angle, mut lost_steps, mut lost_events) = (vec![0.0; n], vec![0i64; n], Vec::new());
+    // firmware mode: the servos driven by their own position loops, their duty, current and supply
+    let mut servos = experiment.firmware_drives();
+    let plant_step = match experiment.plant {
+        crate::experiment::PlantSpec::Discrete { time_step, .. } => time_step,
+        crate::experiment::PlantSpec::Continuous { .. } => dt,
+    };
+    let (mut duty, mut current, mut supply) = if servos.is_some() { (vec![0.0; n], vec![0.0; n], vec![0.0; n]) } else { (Vec::new(), Vec::new(), Vec::new()) };
     let (mut chatter, mut previous_u, mut previous_saturated) = (vec![false; n], vec![0.0; n], vec![false; n]);
     let mut at_limit = vec![false; n];
     // friction torque and stuck flags: recorded only when some joint has friction (its URDF's or
@@ -48,7 +55,10 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
     let has_friction = experiment.joint_has_friction().contains(&true);
     let (mut friction, mut stuck) = if has_friction { (vec![0.0; n], vec![false; n]) } else { (Vec::new(), Vec::new()) };
     let joint_names: Vec<String> = model.joints.iter().map(|j| j.name.clone()).collect();
-    let mut stats = SummaryBuilder::new(joint_names, controller.limits_at_rest(), dt, experiment.config.settle_time).with_stepped_joints(experiment.stepped_joints()).with_friction(has_friction);
+    let mut stats = SummaryBuilder::new(joint_names, controller.limits_at_rest(), dt, experiment.config.settle_time)
+        .with_stepped_joints(experiment.stepped_joints())
+        .with_friction(has_friction)
+        .with_servos(experiment.servo_duty_limits());
     let started = Instant::now();
     let mut status = RunStatus::Completed;
     let mut audit = EnergyAudit::new(experiment);
@@ -73,6 +83,15 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
             for j in (0..n).filter(|&j| s.stepped[j]) {
                 // past the peak of the torque–angle curve: the motor is giving all it can
                 saturated[j] = load_angle[j].abs() > 90.0;
+            }
+        }
+        if let Some(s) = servos.as_mut() {
+            // no PD on a servo joint: its firmware's position loop sets the duty toward the command
+            s.command(&cmd, &q, &v, plant_step, &mut u);
+            s.outputs(&mut duty, &mut current, &mut supply);
+            for j in (0..n).filter(|&j| s.driven[j]) {
+                saturated[j] = s.saturated(j);
+                torque_limit[j] = s.limit(j, u[j], v[j]);
             }
         }
         for i in 0..n {
@@ -111,6 +130,9 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
             friction: &friction,
             stuck: &stuck,
             winding_temperature: if heat.any() { &heat.winding_temperature } else { &no_temperatures },
+            duty: &duty,
+            current: &current,
+            supply: &supply,
             collisions: collision_check.as_ref().map_or(&[], |(_, state, _)| state.close.as_slice()),
             tool_position: frame_pose(model, &data, model.tool_frame).translation,
             tool_target: frame_pose_in(model, &command_poses, model.tool_frame).translation,
@@ -139,15 +161,19 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
                 break;
             }
         }
-        if steppers.is_none() && audit.is_none() {
+        if steppers.is_none() && servos.is_none() && audit.is_none() {
             plant.advance(model, &mut data, &u, &mut q, &mut v);
         } else {
-            // the stepper torque follows the rotor within the control period, and the audit books
-            // the work of every plant step: both see each plant step's start
+            // the stepper torque follows the rotor within the control period, a servo's follows
+            // its back-EMF, and the audit books the work of every plant step: all see each plant
+            // step's start
             let mut drive = |h: f64, q: &[f64], v: &[f64], u: &mut [f64]| {
                 if let Some(s) = steppers.as_mut() {
                     s.advance(h);
                     s.torques(q, v, u);
+                }
+                if let Some(s) = servos.as_mut() {
+                    s.plant_step(h, q, v, u);
                 }
                 if let Some(a) = audit.as_mut() {
                     a.plant_step(model, h, v, u);

@@ -52,6 +52,20 @@ pub struct DriveDuty {
     pub rated_average_torque: Option<f64>,
 }
 
+/// A joint driven by its servo's firmware, over a run: how often its duty was at the limit, and
+/// the current its motor drew.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct ServoDuty {
+    /// Share of control steps at full duty (the position loop asking for more than the PWM gives), %.
+    pub full_duty_percent: f64,
+    /// When it first reached full duty, s (null if never).
+    pub first_full_duty_time: Option<f64>,
+    pub peak_abs_duty: f64,
+    /// The motor's current, A: its largest and its RMS over the control steps.
+    pub peak_current: f64,
+    pub rms_current: f64,
+}
+
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Summary {
     pub status: RunStatus,
@@ -95,6 +109,9 @@ pub struct Summary {
     /// Self-collision and floor contacts, when the run checked them (`--collisions`, `--floor`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub collisions: Option<crate::collision::CollisionSummary>,
+    /// Per joint driven by its servo's firmware: its duty and current (empty when none is).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub servos: Vec<Option<ServoDuty>>,
     /// Per joint whose motor has thermal data: its winding over the run (empty when no motor has).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub winding: Vec<Option<crate::actuator::thermal::WindingSummary>>,
@@ -161,6 +178,14 @@ pub struct SummaryBuilder {
     lost_steps: Vec<u64>,
     first_lost: Vec<Option<f64>>,
     limit_hits: Vec<u64>,
+    /// Firmware mode: each driven joint's duty limit (None: not driven), steps at it, when first,
+    /// the peak duty and current and the current's sum of squares.
+    servo_max_duty: Vec<Option<f64>>,
+    full_duty_steps: Vec<u64>,
+    first_full_duty: Vec<Option<f64>>,
+    peak_duty: Vec<f64>,
+    peak_current: Vec<f64>,
+    sum_squared_current: Vec<f64>,
     tool_min: [f64; 3],
     tool_max: [f64; 3],
     last_t: f64,
@@ -194,6 +219,12 @@ impl SummaryBuilder {
             first_lost: vec![None; n],
             effort,
             limit_hits: vec![0; n],
+            servo_max_duty: Vec::new(),
+            full_duty_steps: vec![0; n],
+            first_full_duty: vec![None; n],
+            peak_duty: vec![0.0; n],
+            peak_current: vec![0.0; n],
+            sum_squared_current: vec![0.0; n],
             tool_min: [f64::INFINITY; 3],
             tool_max: [f64::NEG_INFINITY; 3],
             last_t: 0.0,
@@ -211,6 +242,14 @@ impl SummaryBuilder {
         let n = if has_friction { self.joints.len() } else { 0 };
         self.peak_friction = vec![0.0; n];
         self.stuck_steps = vec![0; n];
+        self
+    }
+
+    /// The joints driven by their servos' firmware, each with its duty limit (None elsewhere).
+    pub fn with_servos(mut self, max_duty: Vec<Option<f64>>) -> Self {
+        if max_duty.iter().any(Option::is_some) {
+            self.servo_max_duty = max_duty;
+        }
         self
     }
 
@@ -259,6 +298,19 @@ impl SummaryBuilder {
         for i in 0..n {
             self.limit_hits[i] += s.at_limit[i] as u64;
         }
+        if !self.servo_max_duty.is_empty() && !s.is_final {
+            for i in 0..n {
+                let Some(limit) = self.servo_max_duty[i] else { continue };
+                let full = s.duty[i].abs() >= limit;
+                self.full_duty_steps[i] += full as u64;
+                if full {
+                    self.first_full_duty[i].get_or_insert(s.t);
+                }
+                self.peak_duty[i] = self.peak_duty[i].max(s.duty[i].abs());
+                self.peak_current[i] = self.peak_current[i].max(s.current[i].abs());
+                self.sum_squared_current[i] += s.current[i] * s.current[i];
+            }
+        }
         if !self.stuck_steps.is_empty() && !s.is_final {
             for i in 0..n {
                 self.peak_friction[i] = self.peak_friction[i].max(s.friction[i].abs());
@@ -305,6 +357,20 @@ impl SummaryBuilder {
             rms_torque: self.sum_squared_torque.iter().map(|&s| if self.control_steps == 0 { 0.0 } else { (s / self.control_steps as f64).sqrt() }).collect(),
             cubic_mean_torque: self.sum_cubed_torque.iter().map(|&s| if self.control_steps == 0 { 0.0 } else { (s / self.control_steps as f64).cbrt() }).collect(),
             drive_duty: Vec::new(),
+            servos: self
+                .servo_max_duty
+                .iter()
+                .enumerate()
+                .map(|(i, limit)| {
+                    limit.map(|_| ServoDuty {
+                        full_duty_percent: share_of_control_steps(&self.full_duty_steps)[i],
+                        first_full_duty_time: self.first_full_duty[i],
+                        peak_abs_duty: self.peak_duty[i],
+                        peak_current: self.peak_current[i],
+                        rms_current: if self.control_steps == 0 { 0.0 } else { (self.sum_squared_current[i] / self.control_steps as f64).sqrt() },
+                    })
+                })
+                .collect(),
             collisions: None,
             winding: Vec::new(),
             peak_friction_torque: self.peak_friction.clone(),
@@ -335,6 +401,22 @@ impl Summary {
                     ));
                     continue;
                 }
+            }
+            if let Some(Some(servo)) = self.servos.get(j) {
+                // a servo's position loop: at full duty it gives what the supply allows, and its
+                // current is what heats it and trips the supply
+                if servo.full_duty_percent > 0.0 {
+                    out.push(format!(
+                        "{name}: its servo at full duty {:.1}% of the run (first at t = {:.3} s), drawing up to {:.2} A (RMS {:.2} A) — the position loop asks for more than the PWM gives there",
+                        servo.full_duty_percent,
+                        servo.first_full_duty_time.unwrap_or(0.0),
+                        servo.peak_current,
+                        servo.rms_current
+                    ));
+                } else if sat >= 2.0 {
+                    out.push(format!("{name}: its servo's torque at the datasheet's line {sat:.0}% of steps (duty at most {:.0} %), drawing up to {:.2} A (RMS {:.2} A)", 100.0 * servo.peak_abs_duty, servo.peak_current, servo.rms_current));
+                }
+                continue;
             }
             if sat < 2.0 {
                 continue;

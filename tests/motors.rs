@@ -214,19 +214,23 @@ fn the_motor_files_are_built_into_the_binary() {
 }
 
 /// The SO-100 (example-robot-data's URDF) with its Feetech STS3215 servos (`assets/motors/so100.toml`):
-/// servo motors run the PD loop on their torque–speed line; every joint is limited to the servo's
+/// each servo is driven by its own firmware (the catalogue's firmware model), or with `--drive pd`
+/// by the PD loop on its torque–speed line; either way every joint is limited to the servo's
 /// 2.94 N·m stall torque instead of the URDF's 35 N·m, and the run is stable (no chatter).
 #[test]
 fn the_so100_runs_on_its_sts3215_servos() {
     let urdf = common::repo().join("tests/fixtures/robots/so100.urdf");
-    let experiment = Experiment::prepare(RunConfig { urdf, motors: Some(motors_file("so100.toml")), duration: 5.0, ..RunConfig::default() }).unwrap();
-    assert!(!experiment.stepper_mode(), "servos are not steppers");
-    let summary = simulate(&experiment, &mut [], None).unwrap();
-    assert!(matches!(summary.status, armscope::summary::RunStatus::Completed));
-    for (j, limit) in summary.effort_limit.iter().enumerate() {
-        assert!((limit - 2.94).abs() < 1e-12, "{}: {limit}", summary.joints[j]);
-        assert!(summary.peak_abs_torque[j] <= 2.94 + 1e-12);
-        assert!(summary.chatter_percent[j] < 5.0, "{}: chatter {}", summary.joints[j], summary.chatter_percent[j]);
+    for drive in [armscope::config::DriveMode::Native, armscope::config::DriveMode::Pd] {
+        let experiment = Experiment::prepare(RunConfig { urdf: urdf.clone(), motors: Some(motors_file("so100.toml")), duration: 5.0, drive, ..RunConfig::default() }).unwrap();
+        assert!(!experiment.stepper_mode(), "servos are not steppers");
+        assert_eq!(experiment.servos.is_some(), drive == armscope::config::DriveMode::Native, "{drive:?}");
+        let summary = simulate(&experiment, &mut [], None).unwrap();
+        assert!(matches!(summary.status, armscope::summary::RunStatus::Completed));
+        for (j, limit) in summary.effort_limit.iter().enumerate() {
+            assert!((limit - 2.94).abs() < 1e-12, "{}: {limit}", summary.joints[j]);
+            assert!(summary.peak_abs_torque[j] <= 2.94 + 1e-12);
+            assert!(summary.chatter_percent[j] < 5.0, "{drive:?} {}: chatter {}", summary.joints[j], summary.chatter_percent[j]);
+        }
     }
 }
 

@@ -20,6 +20,19 @@
 //! # given), gearbox_breakaway_torque (N·m at its output), gearbox_viscous (N·m·s/rad at its output)
 //! ```
 //!
+//! A servo's entry can carry its firmware, motor and friction as identified (BAM's parameter
+//! file's keys, [`super::bus_servo::ServoParams`]), which then drive the joint in the default drive
+//! mode (`--drive pd`: the PD controller on the datasheet's line instead):
+//!
+//! ```toml
+//! [XL330-M288.firmware]
+//! source = "where the identification was read"
+//! family = "xl330"            # the firmware: xl330, xl320, mx64, mx106, sts3215
+//! kp = 400                    # its P gain register
+//! # supply_voltage = 7.4      # V; the entry's `voltage` when not given
+//! model = "m6"                # friction M1–M6 and its keys: kt, R, armature, friction_base, …
+//! ```
+//!
 //! Reductions ([`super::reduction`]): `kind` one of planetary, strain_wave, cycloidal, belt, spur;
 //! `ratios = [..]` (a belt: `driver_teeth` and `driven_teeth`); efficiency, backdrive_efficiency,
 //! backdriving_torque, rated_torque, repeated_peak_torque, momentary_torque (a number or one per
@@ -40,6 +53,10 @@
 //! viscous = 0.01                 # optional, N·m·s/rad at the joint
 //! rated_torque = 9               # N·m at the joint
 //! ```
+//!
+//! A joint whose servo has a firmware model (the catalogue's, or `servo_params = "fit.json"`, a
+//! BAM parameter file such as `armscope identify` writes, beside this file) may set its P gain
+//! register `kp` and the `supply_voltage`.
 //!
 //! The reduction's losses act as friction at the joint by the direction power flows
 //! ([`super::LossyGear`]).
@@ -179,6 +196,7 @@ fn drive_train_from(source: &Path, name: &str, t: &toml::Table) -> Result<DriveT
     let (gear_ratio, rated) = (fields.optional_positive("gearbox_ratio")?.unwrap_or(1.0), fields.optional_positive("gearbox_rated_torque")?.unwrap_or(f64::INFINITY));
     let gear = fields.gear("gearbox_")?;
     let heat = fields.heat()?;
+    let mut servo = None;
     let common = [&["kind", "gearbox_ratio", "gearbox_efficiency", "gearbox_backdrive_efficiency", "gearbox_breakaway_torque", "gearbox_viscous", "gearbox_rated_torque", "rotor_inertia", "source", "sources", "length"][..], &THERMAL_FIELDS[..]].concat();
     fields.sources()?;
     let motor: Box<dyn Motor> = match kind.as_str() {
@@ -207,15 +225,30 @@ fn drive_train_from(source: &Path, name: &str, t: &toml::Table) -> Result<DriveT
             })
         }
         // a bus servo (its gearbox inside: numbers at the horn) or a bare DC/BLDC motor: both a
-        // straight torque–speed line from the stall torque to the no-load speed
+        // straight torque–speed line from the stall torque to the no-load speed; a servo's firmware
+        // model where identified
         "servo" | "dc" => {
-            fields.known(&[&common[..], &["stall_torque", "no_load_speed", "mass", "voltage", "inductance", "continuous_torque"]].concat())?;
-            Box::new(DcServo { name: name.to_string(), stall_torque: fields.positive("stall_torque")?, no_load_speed: fields.positive("no_load_speed")?, rotor_inertia: fields.non_negative("rotor_inertia")? })
+            fields.known(&[&common[..], &["stall_torque", "no_load_speed", "mass", "voltage", "inductance", "continuous_torque", "firmware"]].concat())?;
+            let line = match (t.contains_key("stall_torque") || !t.contains_key("firmware"), kind.as_str()) {
+                (true, _) | (_, "dc") => Some(DcServo { name: name.to_string(), stall_torque: fields.positive("stall_torque")?, no_load_speed: fields.positive("no_load_speed")?, rotor_inertia: fields.non_negative("rotor_inertia")? }),
+                _ => None,
+            };
+            servo = match t.get("firmware") {
+                None => None,
+                Some(Value::Table(firmware)) if kind == "servo" => Some(firmware_from(source, name, firmware, fields.number("voltage")?, line.as_ref())?),
+                Some(_) => return Err(fields.err("firmware", "must be a table of the servo's identified parameters ([NAME.firmware])")),
+            };
+            match (line, &servo) {
+                (Some(line), _) => Box::new(line),
+                (None, Some(servo)) => Box::new(servo.clone()),
+                (None, None) => return Err(fields.err("stall_torque", "is missing")),
+            }
         }
         other => return Err(fail(source, format!("{what}: field 'kind' is '{other}', expected a motor ('stepper', 'servo', 'dc') or a reduction ({})", REDUCTION_KINDS.join(", ")))),
     };
     let continuous_torque = fields.optional_positive("continuous_torque")?;
     let mut drive = DriveTrain::with_gear(motor, gear_ratio, gear, rated);
+    drive.servo = servo;
     drive.heat = heat;
     drive.continuous_torque = continuous_torque;
     if let Some(mass) = fields.optional_positive("mass")? {
@@ -225,6 +258,81 @@ fn drive_train_from(source: &Path, name: &str, t: &toml::Table) -> Result<DriveT
         drive.parts.push(super::Part { name: name.to_string(), mass, cylinder });
     }
     Ok(drive)
+}
+
+/// A motor file joint's servo settings: `servo_params` (a BAM parameter file, beside the motor
+/// file) replaces the catalogue's firmware model, `kp` and `supply_voltage` set its P gain register
+/// and supply.
+fn servo_settings(fields: &Fields, path: &Path, motor: &str, drive: &mut DriveTrain) -> Result<(), Error> {
+    if let Some(value) = fields.table.get("servo_params") {
+        let Value::String(file) = value else { return Err(fields.err("servo_params", "must be the name of a BAM parameter file (JSON)")) };
+        let params_path = path.parent().unwrap_or(Path::new(".")).join(file);
+        let mut notices = Vec::new();
+        let params = super::bus_servo::ServoParams::load(&params_path, &mut notices).map_err(|m| fail(path, format!("{}: field 'servo_params': {m}", fields.what)))?;
+        for n in notices {
+            eprintln!("armscope: notice: {n}");
+        }
+        // the catalogue's datasheet line stays the envelope, and its supply the supply
+        let (envelope, supply, kp) = match &drive.servo {
+            Some(s) => (s.envelope, s.supply, s.firmware.kp),
+            None => (None, params.family.nominal_supply, params.family.default_kp),
+        };
+        let mut servo = super::BusServo::from_params(motor, &params, kp, supply);
+        servo.envelope = envelope;
+        drive.servo = Some(servo);
+    }
+    for key in ["kp", "supply_voltage"] {
+        let Some(x) = fields.optional_positive(key)? else { continue };
+        let Some(servo) = drive.servo.as_mut() else {
+            return Err(fields.err(key, &format!("sets a servo's firmware, but motor '{motor}' has no firmware model (give servo_params = \"P.json\", a BAM parameter file)")));
+        };
+        if key == "kp" {
+            servo.firmware.kp = x;
+        } else {
+            servo.supply = x;
+        }
+    }
+    Ok(())
+}
+
+/// A servo entry's `firmware` table as a servo model; `voltage` is the entry's rated supply, `line`
+/// its datasheet torque–speed line (the model's envelope) where given.
+fn firmware_from(source: &Path, name: &str, table: &toml::Table, voltage: Option<f64>, line: Option<&DcServo>) -> Result<super::BusServo, Error> {
+    let what = format!("motor '{name}'");
+    let fields = Fields { file: source, what: &what, table };
+    let family = fields.string("family").map_err(|_| fields.err("firmware.family", "is missing: the servo's firmware (xl330, xl320, mx64, mx106, sts3215)"))?;
+    let mut json = serde_json::Map::new();
+    for (key, value) in table {
+        match key.as_str() {
+            "family" | "kp" | "supply_voltage" | "source" | "sources" => {}
+            _ => {
+                let v = match value {
+                    Value::Float(x) => serde_json::json!(x),
+                    Value::Integer(i) => serde_json::json!(*i as f64),
+                    Value::String(s) => serde_json::json!(s),
+                    _ => return Err(fields.err(&format!("firmware.{key}"), "must be a number (or the friction model's name)")),
+                };
+                json.insert(key.clone(), v);
+            }
+        }
+    }
+    json.insert("actuator".into(), serde_json::json!(family));
+    let mut notices = Vec::new();
+    let params = super::bus_servo::ServoParams::from_json(&serde_json::Value::Object(json).to_string(), Path::new(&format!("{}: {what}: firmware", source.display())), &mut notices).map_err(|m| Error::flag("--motors", m))?;
+    if let Some(n) = notices.first() {
+        return Err(Error::flag("--motors", n.replace(": ignored", ": unknown here")));
+    }
+    if !table.get("source").and_then(Value::as_str).is_some_and(|s| !s.trim().is_empty()) {
+        return Err(fields.err("firmware.source", "is missing: where the identified parameters were read"));
+    }
+    let kp = fields.optional_positive("kp")?.unwrap_or(params.family.default_kp);
+    let supply = match (fields.optional_positive("supply_voltage")?, voltage) {
+        (Some(v), _) | (None, Some(v)) => v,
+        (None, None) => params.family.nominal_supply,
+    };
+    let mut servo = super::BusServo::from_params(name, &params, kp, supply);
+    servo.envelope = line.map(|l| (l.stall_torque, l.no_load_speed));
+    Ok(servo)
 }
 
 /// A catalogue reduction; errors name `source`, the entry and the field.
@@ -527,7 +635,7 @@ pub fn load_motor_file(path: &Path, model: &Model) -> Result<MotorSet, Error> {
         };
         let Value::Table(t) = value else { return Err(fail(path, format!("{what}: expected a table"))) };
         let fields = Fields { file: path, what: &what, table: t };
-        fields.known(&["motor", "reduction", "gear_ratio", "efficiency", "backdrive_efficiency", "breakaway_torque", "viscous", "rated_torque", "microsteps", "acceleration", "in_urdf", "mount_link", "mount_xyz"])?;
+        fields.known(&["motor", "reduction", "gear_ratio", "efficiency", "backdrive_efficiency", "breakaway_torque", "viscous", "rated_torque", "microsteps", "acceleration", "in_urdf", "mount_link", "mount_xyz", "servo_params", "kp", "supply_voltage"])?;
         set.acceleration[index] = fields.optional_positive("acceleration")?;
         set.mounts[index] = fields.mount(all_in_urdf)?;
         if let Some(m) = fields.optional_positive("microsteps")? {
@@ -537,7 +645,8 @@ pub fn load_motor_file(path: &Path, model: &Model) -> Result<MotorSet, Error> {
             set.microsteps[index] = Some(m as u32);
         }
         let motor_name = fields.string("motor")?;
-        let own = catalogue.drive_train(&motor_name).ok_or_else(|| fail(path, format!("{what}: no motor '{motor_name}' (known: {})", catalogue.names())))??;
+        let mut own = catalogue.drive_train(&motor_name).ok_or_else(|| fail(path, format!("{what}: no motor '{motor_name}' (known: {})", catalogue.names())))??;
+        servo_settings(&fields, path, &motor_name, &mut own)?;
         if let Some(value) = t.get("reduction") {
             // catalogue reductions, one or a list of stages from the motor out: their own losses and
             // ratings, each at one of its ratios

@@ -7,6 +7,7 @@
 pub mod bus_servo;
 pub mod carried;
 pub mod catalogue;
+mod firmware_drive;
 mod lossy_gear;
 mod open_loop;
 pub mod reduction;
@@ -17,6 +18,7 @@ pub mod thermal;
 pub use bus_servo::BusServo;
 pub use carried::{Mount, PlacedPart};
 pub use catalogue::{Catalogue, load_motor_file};
+pub use firmware_drive::FirmwareDrives;
 pub use lossy_gear::LossyGear;
 pub use open_loop::{LostSteps, OpenLoopSteppers};
 pub use reduction::{Reduction, Stage};
@@ -106,6 +108,9 @@ pub struct DriveTrain {
     pub reductions: Vec<String>,
     /// The parts whose mass is published: the motor, then its reductions.
     pub parts: Vec<Part>,
+    /// A serial-bus servo's firmware, motor and friction model, where known: in the default drive
+    /// mode its firmware's position loop drives the joint ([`FirmwareDrives`]).
+    pub servo: Option<BusServo>,
 }
 
 impl DriveTrain {
@@ -117,7 +122,7 @@ impl DriveTrain {
 
     /// A motor behind one gearbox of the given losses and peak rating, nothing else known of it.
     pub fn with_gear(motor: Box<dyn Motor>, gear_ratio: f64, gear: LossyGear, rated_torque: f64) -> Self {
-        Self { motor, gear_ratio, gear, rated_torque, heat: None, continuous_torque: None, input_inertia: 0.0, max_motor_speed: None, rated_average_torque: None, reductions: Vec::new(), parts: Vec::new() }
+        Self { motor, gear_ratio, gear, rated_torque, heat: None, continuous_torque: None, input_inertia: 0.0, max_motor_speed: None, rated_average_torque: None, reductions: Vec::new(), parts: Vec::new(), servo: None }
     }
 
     /// The gearbox's efficiency when the motor drives, η.
@@ -223,9 +228,10 @@ impl DriveTrain {
         self.parts.iter().map(|p| p.mass).sum()
     }
 
-    /// The inertia turning at the motor's speed: its rotor and the reductions' inputs, kg·m².
+    /// The inertia turning at the motor's speed: its rotor (a servo's identified armature where its
+    /// firmware model gives one) and the reductions' inputs, kg·m².
     pub fn shaft_inertia(&self) -> f64 {
-        self.motor.rotor_inertia() + self.input_inertia
+        self.servo.as_ref().map_or_else(|| self.motor.rotor_inertia(), |s| s.armature) + self.input_inertia
     }
 
     /// A stepper's detent torque at the joint, N·T_d(N·offset), with the joint `offset` (rad) from

@@ -105,7 +105,7 @@ pub fn identify(args: &IdentifyArgs) -> Result<i32, Error> {
     if !(args.dt.is_finite() && args.dt > 0.0) {
         return Err(Error::flag("--dt", format!("must be a positive number of seconds (got {})", args.dt)));
     }
-    let replay = ReplayOptions { step: args.step, substeps: args.substeps, supply: args.supply, reset_rows: None };
+    let replay = ReplayOptions { step: args.step, substeps: args.substeps, supply: args.supply, reset_rows: None, ..Default::default() };
     let train = read_logs(&args.logs, args.dt)?;
     let validate = read_logs(&args.validate, args.dt)?;
     for log in train.iter().chain(&validate) {

@@ -71,8 +71,9 @@ pub struct SizeArgs {
     /// Microsteps of the stepper drivers.
     #[arg(long, default_value_t = 32)]
     pub microsteps: u32,
-    /// Steppers open loop (default, as the real arm) or under PD in the verifying simulations.
-    #[arg(long, value_enum, default_value = "stepper")]
+    /// native: steppers open loop and servos by their firmware (default, as the real arm); pd: the
+    /// PD controller on their limits, in the verifying simulations.
+    #[arg(long, value_enum, default_value = "native")]
     pub drive: crate::config::DriveMode,
     /// Output folder: size.md, size.json, size.rrd, size_JOINT.png, motors.toml.
     #[arg(long, value_name = "DIR", default_value = "recordings/size")]

@@ -59,7 +59,7 @@ impl TestbenchArgs {
         if !(self.dt.is_finite() && self.dt > 0.0) {
             return Err(Error::flag("--dt", format!("must be a positive number of seconds (got {})", self.dt)));
         }
-        Ok(ReplayOptions { step: self.step, substeps: self.substeps, supply: self.supply, reset_rows: None })
+        Ok(ReplayOptions { step: self.step, substeps: self.substeps, supply: self.supply, reset_rows: None, ..Default::default() })
     }
 }
 

@@ -62,8 +62,10 @@ pub struct MotorArgs {
     /// with its speed, and the rotors' reflected inertia joins M. E.g. assets/motors/tutorial.toml.
     #[arg(long, value_name = "FILE")]
     pub motors: Option<PathBuf>,
-    /// Joints whose motor is a stepper: `stepper` drives them open loop (the command in microsteps;
-    /// steps can be lost), `pd` runs the tutorial's PD controller on their pull-out torque.
-    #[arg(long, value_enum, default_value = "stepper")]
+    /// Joints whose motor is a stepper or a servo with a firmware model: `native` drives each as the
+    /// real arm does (a stepper open loop, the command in microsteps, steps can be lost; a servo by
+    /// its own firmware's position loop), `pd` runs the tutorial's PD controller on their torque
+    /// limits. `stepper` is another name for `native`.
+    #[arg(long, value_enum, default_value = "native")]
     pub drive: crate::config::DriveMode,
 }

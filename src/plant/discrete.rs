@@ -52,11 +52,16 @@ impl DiscretePlant {
 
     /// The plant with the model's joint friction and the drive trains' gear losses (by coordinate).
     pub fn with_gears(model: &Model, time_step: f64, substeps: usize, gears: &[Option<LossyGear>]) -> Self {
+        Self::with_friction(model, time_step, substeps, JointFriction::new(model, gears))
+    }
+
+    /// The plant with the given joint friction (the URDF's, the gears', the servos').
+    pub fn with_friction(model: &Model, time_step: f64, substeps: usize, friction: JointFriction) -> Self {
         let n = model.dof();
         Self {
             time_step,
             substeps,
-            friction: JointFriction::new(model, gears),
+            friction,
             locked: vec![(false, false); n],
             damping_step: vec![0.0; n],
             rhs: vec![0.0; n],
@@ -88,6 +93,9 @@ impl DiscretePlant {
         }
         // each joint's h·D, velocity bounds (the limits reached at the step's end) and friction impulses
         if self.friction.any {
+            if self.friction.has_servos() {
+                self.friction.observe(&data.gravity, v);
+            }
             for (i, joint) in model.joints.iter().enumerate() {
                 self.damping_step[i] = h * (joint.damping + self.friction.viscous(i));
                 let (law, locked_up, locked_down) = self.friction.law(i, u[i], h, (joint.lower - q[i]) / h, (joint.upper - q[i]) / h);
@@ -189,7 +197,7 @@ impl Plant for DiscretePlant {
     fn describe(&self) -> String {
         format!(
             "discrete plant: semi-implicit Euler, implicit joint damping (Drake's update){}, h = {} ms{}",
-            if self.friction.has_gears() { ", exact Coulomb stick–slip with the gearboxes' losses" } else if self.friction.any { ", exact Coulomb stick–slip" } else { "" },
+            if self.friction.has_servos() { ", exact Coulomb stick–slip with the servos' friction budgets" } else if self.friction.has_gears() { ", exact Coulomb stick–slip with the gearboxes' losses" } else if self.friction.any { ", exact Coulomb stick–slip" } else { "" },
             self.time_step * 1e3,
             if self.substeps > 1 { format!(", {} steps per control period", self.substeps) } else { String::new() }
         )

@@ -1,10 +1,14 @@
 //! What resists each joint's motion besides its damping: the URDF's Coulomb friction and the drive
 //! train's gearbox losses ([`LossyGear`]: breakaway, viscous, and the load-dependent loss by the
-//! direction power flows), as one Coulomb band and one viscous coefficient per joint for a plant
-//! step with the motor's torque held.
+//! direction power flows), and a serial-bus servo's own friction (BAM's budget M1–M6, from the
+//! servo's torque, the joint's gravity torque and its speed at the step's start: `observe`), as one
+//! Coulomb band and one viscous coefficient per joint for a plant step with the motor's torque held.
+//! (BAM's external torque on a bench is gravity alone; on an arm it is the joint's gravity torque,
+//! the other joints' inertial coupling left out.)
 
 use super::stick_slip::JointLaw;
 use crate::actuator::LossyGear;
+use crate::actuator::bus_servo::ServoFriction;
 use crate::model::Model;
 
 /// Per joint: the URDF's friction F and the gear's losses (None: no drive train, or a lossless one).
@@ -12,6 +16,11 @@ use crate::model::Model;
 pub struct JointFriction {
     coulomb: Vec<f64>,
     gears: Vec<Option<LossyGear>>,
+    /// Per joint, its servo's friction and the ratio from the servo to the joint.
+    servos: Vec<Option<(ServoFriction, f64)>>,
+    /// The servos' inputs at the step's start: each joint's gravity torque and speed.
+    external: Vec<f64>,
+    speed: Vec<f64>,
     /// Whether any joint has friction or gear losses (without, the plants keep their plain update).
     pub any: bool,
 }
@@ -22,7 +31,28 @@ impl JointFriction {
         let coulomb: Vec<f64> = model.joints.iter().map(|j| j.friction).collect();
         let gears: Vec<Option<LossyGear>> = (0..model.dof()).map(|i| gears.get(i).copied().flatten().filter(|g| !g.is_lossless())).collect();
         let any = coulomb.iter().any(|&f| f > 0.0) || gears.iter().any(Option::is_some);
-        Self { coulomb, gears, any }
+        let n = coulomb.len();
+        Self { coulomb, gears, servos: vec![None; n], external: vec![0.0; n], speed: vec![0.0; n], any }
+    }
+
+    /// With the servos' friction (by coordinate, with the ratio from servo to joint).
+    pub fn with_servos(mut self, servos: &[Option<(ServoFriction, f64)>]) -> Self {
+        for (slot, servo) in self.servos.iter_mut().zip(servos) {
+            *slot = *servo;
+        }
+        self.any |= self.has_servos();
+        self
+    }
+
+    /// Whether some joint has a servo's friction.
+    pub fn has_servos(&self) -> bool {
+        self.servos.iter().any(Option::is_some)
+    }
+
+    /// The step's start: each joint's gravity torque and speed (what the servos' budgets depend on).
+    pub fn observe(&mut self, gravity: &[f64], speed: &[f64]) {
+        self.external.copy_from_slice(gravity);
+        self.speed.copy_from_slice(speed);
     }
 
     /// Whether some joint has a lossy gearbox.
@@ -32,13 +62,14 @@ impl JointFriction {
 
     /// Whether joint i has any friction (its friction torque and stuck flag mean something).
     pub fn has(&self, i: usize) -> bool {
-        self.coulomb[i] > 0.0 || self.gears[i].is_some()
+        self.coulomb[i] > 0.0 || self.gears[i].is_some() || self.servos[i].is_some()
     }
 
     /// (F⁺, F⁻) of joint i when the motor gives `u` at the joint: the friction against positive and
     /// against negative motion, infinite on a side a self-locking gear locks.
     pub fn bounds(&self, i: usize, u: f64) -> (f64, f64) {
-        let f = self.coulomb[i];
+        // a servo's budget at its output, ×N at the joint: its torque u/N, the load τ_e/N, speed N·q̇
+        let f = self.coulomb[i] + self.servos[i].map_or(0.0, |(servo, n)| n * servo.budget(u / n, self.external[i] / n, n * self.speed[i]));
         match &self.gears[i] {
             Some(gear) => {
                 let (up, down) = gear.friction_bounds(u);
@@ -50,7 +81,7 @@ impl JointFriction {
 
     /// The gear's viscous coefficient at joint i, N·m·s/rad (added to the joint's damping).
     pub fn viscous(&self, i: usize) -> f64 {
-        self.gears[i].map_or(0.0, |g| g.viscous)
+        self.gears[i].map_or(0.0, |g| g.viscous) + self.servos[i].map_or(0.0, |(servo, n)| n * n * servo.viscous)
     }
 
     /// The law for joint i with the bounds `scale`·(F⁺, F⁻) and the position bounds (lower, upper):

@@ -87,6 +87,13 @@ impl Console {
             let mode = if e.stepper_mode() { "; stepper joints driven open loop in microsteps (no PD; --drive pd for the PD controller)" } else { "" };
             writeln!(self.out, "  motors ({}): the torque limit falls with the joint's speed{mode}", motors.source.display()).map_err(io)?;
             write!(self.out, "{}", motors.table(&names)).map_err(io)?;
+            if let Some(servos) = &e.servos {
+                writeln!(self.out, "  servos driven by their own firmware (no PD; --drive pd for the PD controller on their datasheet line):").map_err(io)?;
+                for (j, servo, ratio) in servos.servos() {
+                    let behind = if ratio != 1.0 { format!(", behind a {ratio}:1 reduction") } else { String::new() };
+                    writeln!(self.out, "    {}: {}{behind}; duty saturates beyond {:.3} rad of error", m.joints[j].name, crate::actuator::Motor::describe(servo), servo.firmware.saturation_error() / ratio).map_err(io)?;
+                }
+            }
         }
         writeln!(self.out, "  command: {}", run.trajectory).map_err(io)?;
         writeln!(
@@ -193,6 +200,12 @@ pub fn write_summary(out: &mut dyn Write, s: &Summary) -> std::io::Result<()> {
         if c.pairs.len() > 8 {
             writeln!(out, "    … and {} more pairs closer than 5 cm (the summary JSON lists them)", c.pairs.len() - 8)?;
         }
+    }
+    if s.servos.iter().any(Option::is_some) {
+        let cell = |f: &dyn Fn(&crate::summary::ServoDuty) -> String| s.servos.iter().map(|d| d.as_ref().map_or("-".to_string(), f)).collect::<Vec<_>>();
+        writeln!(out, "{}   (the servo's PWM at its limit)", row("full duty (%)", cell(&|d| format!("{:.1}", d.full_duty_percent))))?;
+        writeln!(out, "{}", row("peak current (A)", cell(&|d| format!("{:.2}", d.peak_current))))?;
+        writeln!(out, "{}", row("RMS current (A)", cell(&|d| format!("{:.2}", d.rms_current))))?;
     }
     if !s.stuck_percent.is_empty() {
         writeln!(out, "{}", row("peak friction (N·m)", s.peak_friction_torque.iter().map(|p| format!("{p:.3}")).collect()))?;

@@ -654,6 +654,9 @@ impl Recorder for McapRecorder {
             friction: if has_friction { vec![0.0; n] } else { Vec::new() },
             stuck: if has_friction { vec![0; n] } else { Vec::new() },
             winding_temperature: Vec::new(),
+            duty: per_joint(e.servos.is_some()),
+            current: per_joint(e.servos.is_some()),
+            supply: per_joint(e.servos.is_some()),
         };
         self.motors = e.motors.clone();
         self.scene = scene_from_model(model).map_err(|(path, err)| Error::output(&path, err))?;
@@ -729,6 +732,11 @@ impl Recorder for McapRecorder {
         }
         tel.winding_temperature.clear();
         tel.winding_temperature.extend_from_slice(s.winding_temperature);
+        if !s.duty.is_empty() {
+            tel.duty.copy_from_slice(s.duty);
+            tel.current.copy_from_slice(s.current);
+            tel.supply.copy_from_slice(s.supply);
+        }
         if !s.friction.is_empty() {
             tel.friction.copy_from_slice(s.friction);
             for (flag, &stuck) in tel.stuck.iter_mut().zip(s.stuck) {

@@ -40,6 +40,9 @@ pub const STUCK_RGB: (u8, u8, u8) = (120, 120, 120);
 /// A motor's shaft speed in its joint's stepper plot, beside the load angle in the joint's colour.
 pub const MOTOR_SPEED_RGB: (u8, u8, u8) = (235, 235, 235);
 
+/// A servo motor's current in its joint's servo plot, beside the duty in the joint's colour.
+pub const CURRENT_RGB: (u8, u8, u8) = (235, 235, 235);
+
 /// Joint `j`'s colour.
 pub fn joint_rgb(j: usize) -> (u8, u8, u8) {
     JOINT_PALETTE[j % JOINT_PALETTE.len()]
@@ -66,12 +69,14 @@ mod tests {
         let distance = |a: (u8, u8, u8), b: (u8, u8, u8)| ((a.0 as f64 - b.0 as f64).powi(2) + (a.1 as f64 - b.1 as f64).powi(2) + (a.2 as f64 - b.2 as f64).powi(2)).sqrt();
         for (j, &joint) in JOINT_PALETTE.iter().enumerate() {
             // angle vs target; torque, τ_g, ±limits, saturated markers, friction and stuck; error,
-            // saturated, chatter; a stepper's load angle, lost steps (red) and motor speed
+            // saturated, chatter; a stepper's load angle, lost steps (red) and motor speed; a servo's
+            // duty and current
             let plots = [
                 ("angle", vec![joint, TARGET_RGB]),
                 ("torque", vec![joint, GRAVITY_TORQUE_RGB, LIMIT_RGB, SATURATED_RGB, FRICTION_RGB, STUCK_RGB]),
                 ("status", vec![joint, LIMIT_RGB, CHATTER_RGB]),
                 ("stepper", vec![joint, LIMIT_RGB, MOTOR_SPEED_RGB]),
+                ("servo", vec![joint, CURRENT_RGB]),
             ];
             for (plot, colours) in plots {
                 for (a, &first) in colours.iter().enumerate() {

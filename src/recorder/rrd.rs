@@ -18,7 +18,7 @@ use rerun::{RecordingStream, TimeColumn};
 use super::torque_axis::TorqueAxis;
 use super::rrd_collisions::{Recolour, RrdCollisions, log_geometry};
 use super::column_pool::ColumnPool;
-use super::plot_colours::{CHATTER_RGB, FRICTION_RGB, GRAVITY_TORQUE_RGB, LIMIT_RGB, MOTOR_SPEED_RGB, SATURATED_RGB, STUCK_RGB, TARGET_RGB, joint_rgb};
+use super::plot_colours::{CHATTER_RGB, CURRENT_RGB, FRICTION_RGB, GRAVITY_TORQUE_RGB, LIMIT_RGB, MOTOR_SPEED_RGB, SATURATED_RGB, STUCK_RGB, TARGET_RGB, joint_rgb};
 use rerun::external::arrow::buffer::{Buffer, OffsetBuffer};
 use std::collections::VecDeque;
 use std::path::PathBuf;
@@ -73,6 +73,8 @@ struct JointColumns {
     friction: Vec<f64>,
     /// A motor with thermal data: `joints/<joint>/winding_temperature`, °C per step.
     winding: Vec<f64>,
+    /// Firmware mode: `joints/<joint>/servo`, [PWM duty, motor current (A)] per step.
+    servo: Vec<f64>,
 }
 
 impl JointColumns {
@@ -90,11 +92,12 @@ impl JointColumns {
             motor_speed: Vec::new(),
             friction: Vec::new(),
             winding: Vec::new(),
+            servo: Vec::new(),
         }
     }
 
     fn clear(&mut self) {
-        for c in [&mut self.position, &mut self.torque, &mut self.status, &mut self.saturated_times, &mut self.saturated_torque, &mut self.limit, &mut self.load_angle, &mut self.lost_steps, &mut self.motor_speed, &mut self.friction, &mut self.winding] {
+        for c in [&mut self.position, &mut self.torque, &mut self.status, &mut self.saturated_times, &mut self.saturated_torque, &mut self.limit, &mut self.load_angle, &mut self.lost_steps, &mut self.motor_speed, &mut self.friction, &mut self.winding, &mut self.servo] {
             c.clear();
         }
     }
@@ -119,6 +122,8 @@ pub struct RerunRecorder {
     effort: Vec<f64>,
     /// Per joint: driven open loop (stepper mode): its load angle and lost steps are recorded.
     stepped: Vec<bool>,
+    /// Per joint: driven by its servo's firmware (its duty and current are recorded).
+    servo_driven: Vec<bool>,
     /// The motors of `--motors`: the torque limit falls with speed (recorded at every step), and
     /// each motor's shaft speed is recorded.
     motors: Option<Arc<crate::actuator::MotorSet>>,
@@ -179,6 +184,7 @@ impl RerunRecorder {
             joint_names: Vec::new(),
             effort: Vec::new(),
             stepped: Vec::new(),
+            servo_driven: Vec::new(),
             motors: None,
             times: Vec::new(),
             first_time: 0.0,
@@ -346,6 +352,7 @@ impl RerunRecorder {
                 ("motor_speed", lines(&[format!("{name} motor speed (rev/s)")], &[rgb(MOTOR_SPEED_RGB)], &[1.0])),
                 ("friction", lines(&[format!("{name} friction (N·m)"), format!("{name} stuck (0/1)")], &[rgb(FRICTION_RGB), rgb(STUCK_RGB)], &[1.0, 1.0])),
                 ("winding_temperature", lines(&[format!("{name} winding (°C)")], &[c], &[1.5])),
+                ("servo", lines(&[format!("{name} PWM duty (−1 … 1)"), format!("{name} current (A)")], &[c, rgb(CURRENT_RGB)], &[1.5, 1.0])),
             ];
             let has_motor = self.motors.as_ref().is_some_and(|m| m.joints.get(j).is_some_and(Option::is_some));
             let recorded = |leaf: &str| match leaf {
@@ -353,6 +360,7 @@ impl RerunRecorder {
                 "motor_speed" => has_motor,
                 "friction" => friction,
                 "winding_temperature" => self.heated[j],
+                "servo" => self.servo_driven[j],
                 _ => true,
             };
             for (leaf, style) in styles.into_iter().filter(|(leaf, _)| recorded(leaf)) {
@@ -421,6 +429,9 @@ impl RerunRecorder {
             }
             if !c.winding.is_empty() {
                 send(&format!("{base}/winding_temperature"), time.clone(), scalars(&c.winding, 1))?;
+            }
+            if self.servo_driven[j] {
+                send(&format!("{base}/servo"), time.clone(), scalars(&c.servo, 2))?;
             }
             if self.stepped[j] {
                 send(&format!("{base}/load_angle"), time.clone(), scalars(&c.load_angle, 1))?;
@@ -678,7 +689,7 @@ pub fn joint_color(j: usize) -> rerun::Color {
 /// With steppers driven open loop (`stepped`), a third row: each one's load angle and lost steps.
 /// Each torque view's y range is `torque_axes`' (the motion's own torque, the limit beside it where
 /// near; [`TorqueAxis`]): returned beside the blueprint as (view, half range), for [`send_blueprint`].
-pub fn blueprint(joint_names: &[String], stepped: &[bool], heated: &[bool], collisions: bool, torque_axes: &[TorqueAxis], prefix: &str) -> (Blueprint, Vec<(rerun::EntityPath, f64)>) {
+pub fn blueprint(joint_names: &[String], stepped: &[bool], servo_driven: &[bool], heated: &[bool], collisions: bool, torque_axes: &[TorqueAxis], prefix: &str) -> (Blueprint, Vec<(rerun::EntityPath, f64)>) {
     let angle_views = joint_names.iter().map(|j| {
         TimeSeriesView::new(format!("{j} angle vs target"))
             .with_origin(format!("{prefix}joints/{j}"))
@@ -731,12 +742,21 @@ pub fn blueprint(joint_names: &[String], stepped: &[bool], heated: &[bool], coll
         .filter(|(_, s)| **s)
         .map(|(j, _)| TimeSeriesView::new(format!("{j} stepper: load angle, lost steps, motor rev/s")).with_origin(format!("{prefix}joints/{j}")).with_contents(["$origin/load_angle", "$origin/lost_steps", "$origin/motor_speed"]).into())
         .collect();
+    let servo_views: Vec<_> = joint_names
+        .iter()
+        .zip(servo_driven.iter().chain(std::iter::repeat(&false)))
+        .filter(|(_, s)| **s)
+        .map(|(j, _)| TimeSeriesView::new(format!("{j} servo: PWM duty, current (A)")).with_origin(format!("{prefix}joints/{j}")).with_contents(["$origin/servo"]).into())
+        .collect();
     let mut rows = vec![
         Grid::new(angle_views).with_grid_columns(columns).with_name("joint angles").into(),
         Grid::new(torque_views).with_grid_columns(columns).with_name("joint torques").into(),
     ];
     if !stepper_views.is_empty() {
         rows.push(Grid::new(stepper_views).with_grid_columns(columns).with_name("steppers").into());
+    }
+    if !servo_views.is_empty() {
+        rows.push(Grid::new(servo_views).with_grid_columns(columns).with_name("servos").into());
     }
     let right = Vertical::new(rows);
     let blueprint = Blueprint::new(Horizontal::new([left.into(), right.into()]).with_column_shares([2.0, 3.0]))
@@ -828,6 +848,7 @@ impl Recorder for RerunRecorder {
         self.joint_names = model.joints.iter().map(|j| j.name.clone()).collect();
         self.effort = e.controller().effort;
         self.stepped = e.stepped_joints();
+        self.servo_driven = e.firmware_joints();
         self.heated = e.motor_heat().iter().map(Option::is_some).collect();
         self.motors = e.motors.clone();
         let cap = FILE_BLOCK_STEPS + 1;
@@ -850,7 +871,7 @@ impl Recorder for RerunRecorder {
         // the layout: a live viewer needs it now (scaled by the motion's torque); a file gets it at
         // the end, scaled by what the run did as well
         if self.live {
-            let (layout, torque_ranges) = blueprint(&self.joint_names, &self.stepped, &self.heated, self.collisions.is_some(), run.torque_axes(), "");
+            let (layout, torque_ranges) = blueprint(&self.joint_names, &self.stepped, &self.servo_driven, &self.heated, self.collisions.is_some(), run.torque_axes(), "");
             send_blueprint(&rec, &layout, &torque_ranges).map_err(|x| self.err(x))?;
         }
         self.log_static_scene(&rec, model)?;
@@ -906,6 +927,9 @@ impl Recorder for RerunRecorder {
             if self.heated[j] {
                 c.winding.push(s.winding_temperature[j]);
             }
+            if self.servo_driven[j] {
+                c.servo.extend_from_slice(&[s.duty[j], s.current[j]]);
+            }
             if s.saturated[j] {
                 c.saturated_times.push(s.t);
                 c.saturated_torque.push(s.u[j]);
@@ -954,7 +978,7 @@ impl Recorder for RerunRecorder {
         let settled = |i: usize| summary.peak_abs_torque_after_settle.get(i).copied().flatten();
         let axes: Vec<_> = run.torque_axes().iter().enumerate().map(|(i, axis)| axis.after_run(settled(i))).collect();
         if !self.live || axes != run.torque_axes() {
-            let (layout, torque_ranges) = blueprint(&self.joint_names, &self.stepped, &self.heated, self.collisions.is_some(), &axes, "");
+            let (layout, torque_ranges) = blueprint(&self.joint_names, &self.stepped, &self.servo_driven, &self.heated, self.collisions.is_some(), &axes, "");
             send_blueprint(&rec, &layout, &torque_ranges).map_err(|x| self.err(x))?;
         }
         if self.path.points().len() > 1 {

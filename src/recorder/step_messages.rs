@@ -189,6 +189,9 @@ pub fn controller_telemetry(message: &ControllerTelemetry, out: &mut Vec<u8>) {
     packed_doubles(14, &m.friction, out);
     packed_varints(15, m.stuck.iter().map(|&v| u64::from(v)), out);
     packed_doubles(16, &m.winding_temperature, out);
+    packed_doubles(17, &m.duty, out);
+    packed_doubles(18, &m.current, out);
+    packed_doubles(19, &m.supply, out);
 }
 
 #[cfg(test)]
@@ -289,6 +292,9 @@ mod tests {
                     friction: if shift % 2 == 0 { d(0) } else { vec![] },
                     stuck: if shift % 2 == 0 { flags(2) } else { vec![] },
                     winding_temperature: if shift % 3 == 0 { d(3) } else { vec![] },
+                    duty: if shift % 4 == 1 { d(4) } else { vec![] },
+                    current: if shift % 4 == 1 { d(5) } else { vec![] },
+                    supply: if shift % 4 == 1 { d(6) } else { vec![] },
                 };
                 let mut ours = vec![0xCD];
                 controller_telemetry(&message, &mut ours);

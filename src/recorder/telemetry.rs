@@ -66,6 +66,16 @@ pub struct ControllerTelemetry {
     /// when no motor of the run has).
     #[prost(double, repeated, tag = "16")]
     pub winding_temperature: Vec<f64>,
+    /// Firmware mode: each servo's PWM duty, −1 … 1 (0 where not a servo; empty when no joint is
+    /// driven by its servo's firmware).
+    #[prost(double, repeated, tag = "17")]
+    pub duty: Vec<f64>,
+    /// Firmware mode: each servo motor's current, A.
+    #[prost(double, repeated, tag = "18")]
+    pub current: Vec<f64>,
+    /// Firmware mode: the supply at each servo, V.
+    #[prost(double, repeated, tag = "19")]
+    pub supply: Vec<f64>,
 }
 
 /// The schema as MCAP's protobuf profile wants it: a serialized FileDescriptorSet. Kept next to
@@ -98,6 +108,9 @@ pub fn file_descriptor_set() -> Vec<u8> {
             field("friction", 14, true, Type::Double),
             field("stuck", 15, true, Type::Uint32),
             field("winding_temperature", 16, true, Type::Double),
+            field("duty", 17, true, Type::Double),
+            field("current", 18, true, Type::Double),
+            field("supply", 19, true, Type::Double),
         ],
         ..Default::default()
     };

@@ -49,6 +49,9 @@ struct SampleBlock {
     friction: Vec<f64>,
     stuck: Vec<bool>,
     winding_temperature: Vec<f64>,
+    duty: Vec<f64>,
+    current: Vec<f64>,
+    supply: Vec<f64>,
     /// Every sample's close pairs back to back, and where each sample's end.
     collisions: Vec<crate::collision::PairDistance>,
     collisions_end: Vec<usize>,
@@ -81,6 +84,9 @@ impl SampleBlock {
             friction: Vec::new(),
             stuck: Vec::new(),
             winding_temperature: Vec::new(),
+            duty: Vec::new(),
+            current: Vec::new(),
+            supply: Vec::new(),
             collisions: Vec::new(),
             collisions_end: Vec::with_capacity(capacity),
             tool: Vec::with_capacity(capacity),
@@ -112,6 +118,9 @@ impl SampleBlock {
         self.friction.extend_from_slice(s.friction);
         self.stuck.extend_from_slice(s.stuck);
         self.winding_temperature.extend_from_slice(s.winding_temperature);
+        self.duty.extend_from_slice(s.duty);
+        self.current.extend_from_slice(s.current);
+        self.supply.extend_from_slice(s.supply);
         self.collisions.extend_from_slice(s.collisions);
         self.collisions_end.push(self.collisions.len());
         self.tool.push(s.tool_position);
@@ -141,6 +150,9 @@ impl SampleBlock {
             friction: if self.friction.is_empty() { &[] } else { &self.friction[a..b] },
             stuck: if self.stuck.is_empty() { &[] } else { &self.stuck[a..b] },
             winding_temperature: if self.winding_temperature.is_empty() { &[] } else { &self.winding_temperature[a..b] },
+            duty: if self.duty.is_empty() { &[] } else { &self.duty[a..b] },
+            current: if self.current.is_empty() { &[] } else { &self.current[a..b] },
+            supply: if self.supply.is_empty() { &[] } else { &self.supply[a..b] },
             collisions: &self.collisions[if i == 0 { 0 } else { self.collisions_end[i - 1] }..self.collisions_end[i]],
             tool_position: self.tool[i],
             tool_target: self.tool_target[i],
@@ -154,7 +166,7 @@ impl Reusable for SampleBlock {
         self.k.clear();
         self.t.clear();
         self.is_final.clear();
-        for v in [&mut self.q, &mut self.v, &mut self.cmd, &mut self.cmd_dot, &mut self.u, &mut self.tau_g, &mut self.torque_limit, &mut self.load_angle, &mut self.winding_temperature] {
+        for v in [&mut self.q, &mut self.v, &mut self.cmd, &mut self.cmd_dot, &mut self.u, &mut self.tau_g, &mut self.torque_limit, &mut self.load_angle, &mut self.winding_temperature, &mut self.duty, &mut self.current, &mut self.supply] {
             v.clear();
         }
         self.lost_steps.clear();

@@ -93,6 +93,8 @@ impl SizeReport {
                     rms_motor_torque: c.rms_motor_torque,
                     rms_use: c.continuous_torque.map(|r| c.rms_motor_torque / r),
                     peak_winding_temperature: passed.and_then(|s| s.peak_winding_temperature),
+                    peak_current: passed.and_then(|s| s.peak_current),
+                    rms_current: passed.and_then(|s| s.rms_current),
                     inertia_ratio: c.inertia_ratio,
                     binding: js.binding(c).to_string(),
                 })
@@ -131,6 +133,10 @@ impl SizeReport {
             );
         }
         md += &format!("\nDrive trains: {total:.3} kg in all. To order: {}.\n", count.iter().map(|(p, n)| format!("{n} × {p}")).collect::<Vec<_>>().join(", "));
+        let currents: Vec<String> = self.bill_of_materials.iter().filter_map(|r| Some(format!("{} {:.2} A peak, {:.2} A RMS", r.joint, r.peak_current?, r.rms_current?))).collect();
+        if !currents.is_empty() {
+            md += &format!("\nServo currents in the full run, driven by their firmware (what the supply must give, and what heats them): {}; at once, the supply gives up to their sum.\n", currents.join(", "));
+        }
         let notes: Vec<String> = self
             .joints
             .iter()

@@ -237,6 +237,12 @@ pub struct SimulatedCheck {
     /// The motor's peak winding temperature in the run, °C (motors with thermal data).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub peak_winding_temperature: Option<f64>,
+    /// A servo driven by its firmware: its motor's peak and RMS current in the run, A (the largest
+    /// over the motions).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub peak_current: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rms_current: Option<f64>,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -326,6 +332,9 @@ pub struct BillRow {
     pub rms_use: Option<f64>,
     /// The motor's peak winding temperature in the full run, °C.
     pub peak_winding_temperature: Option<f64>,
+    /// A servo driven by its firmware: its motor's peak and RMS current in the full run, A.
+    pub peak_current: Option<f64>,
+    pub rms_current: Option<f64>,
     pub inertia_ratio: Option<f64>,
     /// The check that binds it.
     pub binding: String,
@@ -579,7 +588,7 @@ pub fn optimal_ratio(rms_load_torque: f64, rms_acceleration: f64, shaft_inertia:
 impl SizeRequest {
     /// Open-loop steppers: the motions run in stepper mode.
     pub fn open_loop(&self) -> bool {
-        self.motions.first().is_some_and(|(_, c)| c.drive == crate::config::DriveMode::Stepper)
+        self.motions.first().is_some_and(|(_, c)| c.drive == crate::config::DriveMode::Native)
     }
 
     /// The margin for a candidate of `motor`: `--margin`, else the vendors' for its kind.
@@ -887,6 +896,8 @@ struct JointRun {
     /// the one with the largest torque share.
     worst_experiment: Option<String>,
     peak_winding_temperature: Option<f64>,
+    peak_current: Option<f64>,
+    rms_current: Option<f64>,
 }
 
 fn check(candidate: usize, run: &JointRun, margin: f64) -> SimulatedCheck {
@@ -901,7 +912,7 @@ fn check(candidate: usize, run: &JointRun, margin: f64) -> SimulatedCheck {
     } else {
         None
     };
-    SimulatedCheck { candidate, stepped: run.stepped, lost_steps: run.lost_steps, peak_torque_share: run.peak_torque_share, passed: note.is_none(), note, peak_winding_temperature: run.peak_winding_temperature }
+    SimulatedCheck { candidate, stepped: run.stepped, lost_steps: run.lost_steps, peak_torque_share: run.peak_torque_share, passed: note.is_none(), note, peak_winding_temperature: run.peak_winding_temperature, peak_current: run.peak_current, rms_current: run.rms_current }
 }
 
 /// The motor set of per-joint candidates (None: the joint keeps its URDF effort).
@@ -944,6 +955,10 @@ fn simulate_set(request: &SizeRequest, joints: &[JointSizing], set: &[Option<usi
             run.peak_torque_share = run.peak_torque_share.max(share);
             if let Some(Some(w)) = summary.winding.get(j) {
                 run.peak_winding_temperature = Some(run.peak_winding_temperature.unwrap_or(f64::NEG_INFINITY).max(w.peak_temperature));
+            }
+            if let Some(Some(servo)) = summary.servos.get(j) {
+                run.peak_current = Some(run.peak_current.unwrap_or(0.0).max(servo.peak_current));
+                run.rms_current = Some(run.rms_current.unwrap_or(0.0).max(servo.rms_current));
             }
         }
         if let crate::summary::RunStatus::Diverged { joint, message, .. } = &summary.status {

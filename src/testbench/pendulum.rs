@@ -9,11 +9,13 @@ pub struct Pendulum {
     pub mass: f64,
     pub arm_mass: f64,
     pub length: f64,
+    /// g, m/s² (BAM's [`GRAVITY`]).
+    pub gravity: f64,
 }
 
 impl Pendulum {
-    pub fn from_log(log: &super::BenchLog) -> Self {
-        Self { mass: log.mass, arm_mass: log.arm_mass, length: log.length }
+    pub fn from_log(log: &super::BenchLog, gravity: f64) -> Self {
+        Self { mass: log.mass, arm_mass: log.arm_mass, length: log.length, gravity }
     }
 
     /// Its inertia about the pivot, m·l² + (m_a/3)·l², kg·m² (the servo's armature not included).
@@ -25,6 +27,6 @@ impl Pendulum {
     /// −(m + m_a/2)·g·l·sin q, N·m.
     pub fn gravity_torque(&self, q: f64) -> f64 {
         // BAM's product order: (m + m_a/2)·(−g)·l·sin q
-        (self.mass + self.arm_mass / 2.0) * -GRAVITY * self.length * q.sin()
+        (self.mass + self.arm_mass / 2.0) * -self.gravity * self.length * q.sin()
     }
 }

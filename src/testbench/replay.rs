@@ -48,11 +48,13 @@ pub struct ReplayOptions {
     /// Every this many rows the simulation restarts from the measured state (None: never, BAM's
     /// metric): short windows make a smoother loss for a fit's first stage.
     pub reset_rows: Option<usize>,
+    /// g on the bench, m/s² (BAM's 9.80665).
+    pub gravity: f64,
 }
 
 impl Default for ReplayOptions {
     fn default() -> Self {
-        Self { step: Step::Bam, substeps: 5, supply: Supply::Nominal, reset_rows: None }
+        Self { step: Step::Bam, substeps: 5, supply: Supply::Nominal, reset_rows: None, gravity: super::pendulum::GRAVITY }
     }
 }
 
@@ -95,9 +97,9 @@ struct Bench {
 }
 
 impl Bench {
-    fn new(log: &BenchLog, params: &ServoParams) -> Self {
+    fn new(log: &BenchLog, params: &ServoParams, gravity: f64) -> Self {
         let servo = BusServo::from_params(&log.actuator, params, log.kp, log.vin);
-        let pendulum = Pendulum::from_log(log);
+        let pendulum = Pendulum::from_log(log, gravity);
         Self { inertia: pendulum.inertia() + params.armature, servo, pendulum, q_offset: params.q_offset }
     }
 
@@ -111,7 +113,7 @@ impl Bench {
 
 /// Replay `log` with the servo of `params`; `record` gets each row's state before its step.
 fn replay(log: &BenchLog, params: &ServoParams, options: &ReplayOptions, mut record: impl FnMut(usize, f64, f64, &crate::actuator::bus_servo::ServoOutput)) {
-    let bench = Bench::new(log, params);
+    let bench = Bench::new(log, params, options.gravity);
     let dt = log.dt;
     let first = &log.entries[0];
     let (mut q, mut v) = (first.position, first.speed);

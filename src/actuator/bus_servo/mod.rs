@@ -10,6 +10,11 @@
 //!   τ_m = k_t·i  (0 with the torque off: no electrical braking)
 //! ```
 //!
+//! Where its datasheet gives a stall torque and a no-load speed, the torque stays within that
+//! torque–speed line (the `envelope`): an identification fitted where the loads were light
+//! extrapolates k_t·V/R past what the servo gives (BAM's 12 V STS3215 file says 8.3 N·m at full
+//! duty and rest, its datasheet 2.94 N·m).
+//!
 //! The supply V_s is the nominal voltage less the drop across the supply's own resistance R_s
 //! (cables, a battery, a bench supply's limit) for the current it gives, d·i: solving
 //! V_s = V₀ − R_s·d·i for V_s gives V_s = (V₀ + R_s·d·k_t·q̇/R)/(1 + R_s·d²/R). With R_s = 0 (BAM's
@@ -44,6 +49,9 @@ pub struct BusServo {
     pub supply_resistance: f64,
     /// The largest voltage the servo puts across its motor, V (infinite: none).
     pub motor_voltage_limit: f64,
+    /// The datasheet's stall torque (N·m) and no-load speed (rad/s) at the output, where given:
+    /// the torque stays within that line (with the motion; its stall torque braking).
+    pub envelope: Option<(f64, f64)>,
 }
 
 /// What the servo does at one instant.
@@ -57,6 +65,8 @@ pub struct ServoOutput {
     pub current: f64,
     /// The motor's torque at the output, N·m (0 with the torque off).
     pub torque: f64,
+    /// Whether the datasheet's line held the torque below what the duty would give.
+    pub limited: bool,
 }
 
 impl BusServo {
@@ -65,7 +75,7 @@ impl BusServo {
         let mut firmware = Firmware::new(params.family, kp);
         firmware.error_gain_ratio = params.error_gain_ratio;
         firmware.max_velocity = params.max_velocity;
-        Self { name: name.into(), firmware, kt: params.kt, resistance: params.resistance, armature: params.armature, friction: params.friction, supply, supply_resistance: params.supply_resistance, motor_voltage_limit: params.motor_voltage_limit }
+        Self { name: name.into(), firmware, kt: params.kt, resistance: params.resistance, armature: params.armature, friction: params.friction, supply, supply_resistance: params.supply_resistance, motor_voltage_limit: params.motor_voltage_limit, envelope: None }
     }
 
     /// The identified parameters back (q_offset 0: a bench's, not the servo's).
@@ -99,13 +109,20 @@ impl BusServo {
     pub fn drive(&self, duty: f64, speed: f64, supply: f64, enabled: bool) -> ServoOutput {
         if !enabled {
             // the bridge is off: no voltage across the motor, no current (the firmware still runs)
-            return ServoOutput { duty: 0.0, supply, current: 0.0, torque: 0.0 };
+            return ServoOutput { duty: 0.0, supply, current: 0.0, torque: 0.0, limited: false };
         }
         let supply = self.supply_at(supply, duty, speed);
         let volts = (supply * duty).clamp(-self.motor_voltage_limit, self.motor_voltage_limit);
         // τ = k_t·V/R − k_t²·q̇/R, as BAM writes it
-        let torque = self.kt * volts / self.resistance - self.kt * self.kt * speed / self.resistance;
-        ServoOutput { duty, supply, current: torque / self.kt, torque }
+        let mut torque = self.kt * volts / self.resistance - self.kt * self.kt * speed / self.resistance;
+        let mut limited = false;
+        if let Some((stall, no_load)) = self.envelope {
+            let with_motion = torque * speed >= 0.0;
+            let limit = if with_motion { (stall * (1.0 - speed.abs() / no_load)).max(0.0) } else { stall };
+            limited = torque.abs() > limit;
+            torque = torque.clamp(-limit, limit);
+        }
+        ServoOutput { duty, supply, current: torque / self.kt, torque, limited }
     }
 
     /// One firmware tick and the motor's answer: `goal` at position `q`, speed `speed`.
@@ -119,10 +136,11 @@ impl BusServo {
         self.drive(self.firmware.family.max_duty, 0.0, self.supply, true).torque
     }
 
-    /// The speed at which full duty gives no torque, rad/s.
+    /// The speed at which full duty gives no torque, rad/s (the datasheet's where it is lower).
     pub fn no_load_speed(&self) -> f64 {
         let d = self.firmware.family.max_duty;
-        self.supply_at(self.supply, d, 0.0) * d / self.kt
+        let model = self.supply_at(self.supply, d, 0.0) * d / self.kt;
+        self.envelope.map_or(model, |(_, no_load)| model.min(no_load))
     }
 
     /// Where a held joint settles against a steady torque `load` (N·m, the external torque the

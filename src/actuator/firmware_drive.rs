@@ -1,0 +1,152 @@
+//! Firmware mode: joints driven by their serial-bus servo's own position loop, as a LeRobot or
+//! Dynamixel arm runs (no PD of armscope's: the command is the servo's goal position).
+//!
+//! The command is the goal position, held over the control period. The firmware ticks at every
+//! plant step (a servo's loop runs at kilohertz rates, faster than a host sends goals): its duty
+//! from the goal and the position, in the servo's units ([`super::bus_servo::firmware`]), and the
+//! motor's torque at the joint's speed through its back-EMF, both at the plant step's start. Behind a further reduction of
+//! ratio N (a belt after the servo) the servo turns N times the joint: its goal and position are N
+//! times the joint's, its torque reaches the joint ×N (the reduction's losses are the plant's
+//! friction, as for every drive train). The servo's own friction (its model M1–M6) is the plant's
+//! too ([`crate::plant::JointFriction`]).
+
+use super::bus_servo::{BusServo, FirmwareState, ServoFriction, ServoOutput};
+use super::MotorSet;
+
+/// One joint's servo.
+#[derive(Clone, Debug)]
+struct ServoJoint {
+    joint: usize,
+    servo: BusServo,
+    gear_ratio: f64,
+    state: FirmwareState,
+    /// The goal at the servo (N × the command).
+    goal: f64,
+    /// The motor at the last plant step's start.
+    out: ServoOutput,
+}
+
+/// The joints a motor file drives through their servos' firmware.
+#[derive(Clone, Debug)]
+pub struct FirmwareDrives {
+    joints: Vec<ServoJoint>,
+    /// The firmware ticked at the control step's state: the first plant step is that state.
+    ticked: bool,
+    /// Per coordinate: driven by its servo's firmware here.
+    pub driven: Vec<bool>,
+}
+
+impl FirmwareDrives {
+    /// The joints of `motors` whose servo has a firmware model; None when there are none. `start`
+    /// is where each firmware's internal target starts (a Feetech's walks from there).
+    pub fn new(motors: &MotorSet, start: &[f64]) -> Option<Self> {
+        let joints: Vec<ServoJoint> = motors
+            .joints
+            .iter()
+            .enumerate()
+            .filter_map(|(j, d)| {
+                let d = d.as_ref()?;
+                let servo = d.servo.clone()?;
+                Some(ServoJoint { joint: j, servo, gear_ratio: d.gear_ratio, state: FirmwareState { target: d.gear_ratio * start[j] }, goal: d.gear_ratio * start[j], out: ServoOutput::default() })
+            })
+            .collect();
+        if joints.is_empty() {
+            return None;
+        }
+        let mut driven = vec![false; start.len()];
+        for s in &joints {
+            driven[s.joint] = true;
+        }
+        Some(Self { joints, ticked: false, driven })
+    }
+
+    /// A control step: the goals `cmd` for the period, and the firmware's tick at the joint's state
+    /// (q, q̇) for the period's first plant step of `h` s; each servo's torque at the joint into `u`
+    /// (other joints untouched).
+    pub fn command(&mut self, cmd: &[f64], q: &[f64], v: &[f64], h: f64, u: &mut [f64]) {
+        for s in &mut self.joints {
+            s.goal = s.gear_ratio * cmd[s.joint];
+        }
+        self.tick(h, q, v, u);
+        self.ticked = true;
+    }
+
+    /// A plant step of `h` s from (q, q̇): the firmware's tick (the control step's, for the first)
+    /// and each servo's torque at the joint into `u`.
+    pub fn plant_step(&mut self, h: f64, q: &[f64], v: &[f64], u: &mut [f64]) {
+        if std::mem::take(&mut self.ticked) {
+            return;
+        }
+        self.tick(h, q, v, u);
+    }
+
+    fn tick(&mut self, h: f64, q: &[f64], v: &[f64], u: &mut [f64]) {
+        for s in &mut self.joints {
+            let n = s.gear_ratio;
+            s.out = s.servo.tick(&mut s.state, s.goal, n * q[s.joint], n * v[s.joint], h, s.servo.supply, true);
+            u[s.joint] = n * s.out.torque;
+        }
+    }
+
+    /// Per coordinate, the duty, the motor's current (A) and the supply at the servo (V), as the
+    /// last [`Self::torques`] left them; other joints untouched.
+    pub fn outputs(&self, duty: &mut [f64], current: &mut [f64], supply: &mut [f64]) {
+        for s in &self.joints {
+            duty[s.joint] = s.out.duty;
+            current[s.joint] = s.out.current;
+            supply[s.joint] = s.out.supply;
+        }
+    }
+
+    /// Whether joint `j`'s servo is at its duty limit or its torque at the datasheet's line.
+    pub fn saturated(&self, j: usize) -> bool {
+        self.joints.iter().find(|s| s.joint == j).is_some_and(|s| {
+            s.out.duty.abs() >= s.servo.firmware.family.max_duty || s.out.limited
+        })
+    }
+
+    /// The torque joint `j`'s servo gives at full duty at joint speed `speed` in the direction of
+    /// `torque` (its limit at this step, at the joint).
+    pub fn limit(&self, j: usize, torque: f64, speed: f64) -> f64 {
+        self.joints.iter().find(|s| s.joint == j).map_or(0.0, |s| {
+            let d = s.servo.firmware.family.max_duty * if torque >= 0.0 { 1.0 } else { -1.0 };
+            s.gear_ratio * s.servo.drive(d, s.gear_ratio * speed, s.servo.supply, true).torque.abs()
+        })
+    }
+
+    /// Each driven joint's servo friction and gear ratio (the servo's friction acts at its
+    /// output: ×N at the joint), for the plant.
+    pub fn frictions(&self, dof: usize) -> Vec<Option<(ServoFriction, f64)>> {
+        let mut out = vec![None; dof];
+        for s in &self.joints {
+            out[s.joint] = Some((s.servo.friction, s.gear_ratio));
+        }
+        out
+    }
+
+    /// The sag at which each servo holds `load` (the torque gravity asks of its joint, N·m) with
+    /// its loop's error, friction aside (None: more than its duty gives): the closed form
+    /// k_t·V·e_g·k_p·N²·e/R = load at rest.
+    pub fn rest_sag(&self, load: &[f64]) -> Vec<(usize, Option<f64>)> {
+        self.joints.iter().map(|s| (s.joint, s.servo.static_error(-load[s.joint] / s.gear_ratio).map(|e| -e / s.gear_ratio))).collect()
+    }
+
+    /// Per driven joint, the stiffness of its position loop (N·m/rad at the joint, at rest, the
+    /// duty below its limit) and its back-EMF's damping (N·m·s/rad at the joint): what the plant
+    /// step must resolve.
+    pub fn stiffness_and_damping(&self) -> Vec<(usize, f64, f64)> {
+        self.joints
+            .iter()
+            .map(|s| {
+                let n2 = s.gear_ratio * s.gear_ratio;
+                let per_volt = s.servo.kt / s.servo.resistance;
+                (s.joint, n2 * per_volt * s.servo.supply * s.servo.firmware.duty_per_rad(), n2 * per_volt * s.servo.kt)
+            })
+            .collect()
+    }
+
+    /// The servos, by joint.
+    pub fn servos(&self) -> impl Iterator<Item = (usize, &BusServo, f64)> {
+        self.joints.iter().map(|s| (s.joint, &s.servo, s.gear_ratio))
+    }
+}

@@ -1,0 +1,147 @@
+//! Serial-bus servos on an arm, driven by their own firmware: the SO-101 on its STS3215s holding
+//! against gravity as the position loop's closed form says, the joints whose duty saturates under a
+//! payload and the current they draw, and a one-joint arm against the testbench's exact step.
+
+mod common;
+
+use armscope::actuator::bus_servo::firmware::XL330;
+use armscope::actuator::bus_servo::{FrictionModel, ServoFriction, ServoParams};
+use armscope::config::RunConfig;
+use armscope::experiment::Experiment;
+use armscope::testbench::synthetic::{Bench, Trajectory, record};
+use armscope::testbench::{ReplayOptions, Step, rollout};
+use std::process::Command;
+
+fn so101() -> std::path::PathBuf {
+    common::repo().join("tests/fixtures/robots/so101.urdf")
+}
+
+fn so101_motors() -> std::path::PathBuf {
+    common::repo().join("assets/motors/so101.toml")
+}
+
+fn run(args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_armscope")).args(args).output().unwrap();
+    (out.status.code().unwrap_or(-1), String::from_utf8_lossy(&out.stdout).to_string(), String::from_utf8_lossy(&out.stderr).to_string())
+}
+
+#[test]
+fn a_held_servo_sags_as_its_position_loops_closed_form_says() {
+    // At rest a servo's loop gives k_t·V·e_g·k_p·e/R for an error e; held still, that and gravity
+    // differ by no more than the friction the servo's model can give at rest (M1: K_c, the STS3215's
+    // 0.196 N·m). The SO-101 with 0.3 kg at the tool, every joint held at 0 for 2 s.
+    let config = RunConfig { urdf: so101(), motors: Some(so101_motors()), payload: 0.3, hold: true, duration: 2.0, ..RunConfig::default() };
+    let experiment = Experiment::prepare(config).unwrap();
+    let servos = experiment.servos.as_ref().expect("firmware mode");
+    let dir = tempfile::tempdir().unwrap();
+    let trace = dir.path().join("trace.csv");
+    let mut recorder = armscope::recorder::Trace::new(trace.clone());
+    let summary = armscope::sim::simulate(&experiment, &mut [&mut recorder], None).unwrap();
+    assert_eq!(summary.status, armscope::summary::RunStatus::Completed);
+    let table = common::read_csv(&trace);
+    let last = table.rows.last().unwrap();
+    let n = experiment.model.dof();
+    let mut checked = 0;
+    for (j, servo, ratio) in servos.servos() {
+        assert_eq!(ratio, 1.0);
+        let (q, v, tau_g) = (last[1 + j], last[1 + n + j], last[1 + 5 * n + j]);
+        assert_eq!(v, 0.0, "{}: held still by friction", experiment.model.joints[j].name);
+        let error = 0.0 - q;
+        let loop_torque = servo.kt * servo.supply * servo.firmware.duty_per_rad() * error / servo.resistance;
+        let band = servo.friction.base;
+        assert!((loop_torque + tau_g).abs() <= band + 1e-9, "{}: loop {loop_torque} vs gravity {tau_g}, band {band}", experiment.model.joints[j].name);
+        if tau_g.abs() > 2.0 * band {
+            // a loaded joint's sag is the closed form's within the band's share of it
+            let closed_form = -tau_g * servo.resistance / (servo.kt * servo.supply * servo.firmware.duty_per_rad());
+            let slack = band * servo.resistance / (servo.kt * servo.supply * servo.firmware.duty_per_rad());
+            assert!((error - closed_form).abs() <= slack + 1e-12, "{}: error {error} vs {closed_form} ± {slack}", experiment.model.joints[j].name);
+            checked += 1;
+        }
+    }
+    assert!(checked >= 2, "the shoulder and the elbow carry the payload");
+}
+
+#[test]
+fn the_summary_names_the_servos_at_full_duty_and_their_current() {
+    // the SO-101 lifting 0.3 kg: shoulder_lift stepped 1.2 rad, beyond the 0.37 rad its P gain of 16
+    // turns into full duty
+    let dir = tempfile::tempdir().unwrap();
+    let json = dir.path().join("summary.json");
+    let (code, stdout, stderr) = run(&[
+        "run", "--urdf", so101().to_str().unwrap(), "--motors", so101_motors().to_str().unwrap(), "--payload", "0.3", "--test-joint", "shoulder_lift",
+        "--test-angle", "1.2", "--duration", "3", "--no-rrd", "--no-mcap", "--summary-json", json.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(stderr.contains("firmware mode: shoulder_pan, shoulder_lift, elbow_flex, wrist_flex, wrist_roll, gripper driven by their servos' position loops"), "{stderr}");
+    let summary: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let servos = summary["summary"]["servos"].as_array().unwrap();
+    let full: Vec<f64> = servos.iter().map(|s| s["full_duty_percent"].as_f64().unwrap()).collect();
+    assert!(full[1] > 0.0 && full.iter().enumerate().all(|(j, &f)| j == 1 || f == 0.0), "only shoulder_lift at full duty: {full:?}");
+    let lift = &servos[1];
+    let (peak, rms) = (lift["peak_current"].as_f64().unwrap(), lift["rms_current"].as_f64().unwrap());
+    // at full duty from rest the current is the supply over the resistance, within the datasheet's
+    // line: 2.94 N·m / k_t
+    let servo = armscope::actuator::Catalogue::load(std::path::Path::new(armscope::builtin::DEFAULT_CATALOGUE)).unwrap().drive_train("STS3215-C018").unwrap().unwrap().servo.unwrap();
+    assert!(peak <= 2.94 / servo.kt + 1e-9 && peak > 0.5 * 2.94 / servo.kt, "peak {peak} A");
+    assert!(rms > 0.0 && rms < peak);
+    let line = stdout.lines().find(|l| l.contains("shoulder_lift: its servo at full duty")).unwrap_or_else(|| panic!("{stdout}"));
+    assert!(line.contains(&format!("drawing up to {peak:.2} A")), "{line}");
+}
+
+#[test]
+fn a_one_joint_arm_steps_as_the_testbench_does() {
+    // The arm's discrete plant with a servo on a pendulum and the testbench's exact step integrate
+    // the same law (the firmware ticking each plant step, the back-EMF explicit, the Coulomb budget
+    // a band solved exactly, the viscous part implicit): the same trajectory to rounding.
+    let friction = ServoFriction { model: FrictionModel::M3, base: 0.01, viscous: 0.006, load: 0.2, ..Default::default() };
+    let params = ServoParams { family: XL330, kt: 0.35, resistance: 2.8, armature: 0.002, q_offset: 0.0, friction, error_gain_ratio: 1.0, max_velocity: f64::INFINITY, supply_resistance: 0.0, motor_voltage_limit: f64::INFINITY };
+    let dir = tempfile::tempdir().unwrap();
+    // a 0.49 kg point 0.1 m down the pendulum (a tiny rotational inertia about its centre for the
+    // loader), hanging at q = 0 from a horizontal axis
+    let urdf = dir.path().join("pendulum.urdf");
+    std::fs::write(&urdf, r#"<robot name="bench"><link name="world"/>
+  <link name="arm"><inertial><origin xyz="0 0 -0.1"/><mass value="0.49"/><inertia ixx="1e-12" iyy="1e-12" izz="1e-12" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <joint name="servo" type="revolute"><parent link="world"/><child link="arm"/><axis xyz="0 1 0"/><limit lower="-3.1" upper="3.1" effort="10" velocity="10"/></joint></robot>"#).unwrap();
+    // the servo as a motor of the file's own: its firmware model only, no datasheet line to clip it
+    let mut toml = String::from("in_urdf = true\n[joints.servo]\nmotor = \"BENCH\"\n[motors.BENCH]\nkind = \"servo\"\n[motors.BENCH.firmware]\n");
+    toml += "source = \"the test's known servo\"\nfamily = \"xl330\"\nkp = 400\nsupply_voltage = 7.4\n";
+    for (key, value) in params.to_json().as_object().unwrap() {
+        if key != "actuator" {
+            toml += &format!("{key} = {value}\n");
+        }
+    }
+    let motors = dir.path().join("motors.toml");
+    std::fs::write(&motors, toml).unwrap();
+    let trace = dir.path().join("trace.csv");
+    let (code, _, stderr) = run(&["run", "--urdf", urdf.to_str().unwrap(), "--motors", motors.to_str().unwrap(), "--test-joint", "servo", "--test-angle", "1.0", "--duration", "2", "--trace", trace.to_str().unwrap(), "--no-rrd", "--no-mcap", "--quiet"]);
+    assert_eq!(code, 0, "{stderr}");
+    let arm = common::read_csv(&trace);
+    // the same goal and bench as a log at the arm's 1 ms, stepped once a row, on the arm's gravity
+    let mut log = record(&params, &Bench { dt: 0.001, duration: 2.0, vin: 7.4, ..Default::default() }, Trajectory::SinSin, &ReplayOptions::default());
+    for e in &mut log.entries {
+        (e.goal, e.enabled, e.position, e.speed) = (1.0, true, 0.0, 0.0);
+    }
+    let options = ReplayOptions { step: Step::Exact, substeps: 1, gravity: 9.81, ..Default::default() };
+    let bench = rollout(&log, &params, &options);
+    let worst = arm.rows.iter().zip(&bench.position).map(|(row, q)| (row[1] - q).abs()).fold(0.0, f64::max);
+    assert!(worst < 1e-9, "largest gap {worst} rad");
+}
+
+#[test]
+fn servos_need_the_discrete_plant_and_their_settings_a_firmware() {
+    let (code, _, stderr) = run(&["run", "--urdf", so101().to_str().unwrap(), "--motors", so101_motors().to_str().unwrap(), "--time-step", "0", "--duration", "0.1", "--no-rrd", "--no-mcap"]);
+    assert_eq!(code, 2);
+    let lines: Vec<&str> = stderr.lines().filter(|l| !l.contains("notice:")).collect();
+    assert_eq!(lines.len(), 1, "{stderr}");
+    assert!(lines[0].contains("--time-step: 0 (the continuous plant)") && lines[0].contains("need the discrete plant"), "{}", lines[0]);
+    let dir = tempfile::tempdir().unwrap();
+    let motors = dir.path().join("m.toml");
+    std::fs::write(&motors, "in_urdf = true\n[joints.shoulder_lift]\nmotor = \"STS3250\"\nkp = 16\n").unwrap();
+    let (code, _, stderr) = run(&["run", "--urdf", so101().to_str().unwrap(), "--motors", motors.to_str().unwrap(), "--duration", "0.1", "--no-rrd", "--no-mcap"]);
+    assert_eq!(code, 2);
+    assert!(stderr.contains("joint 'shoulder_lift': field 'kp' sets a servo's firmware, but motor 'STS3250' has no firmware model") && stderr.lines().count() == 1, "{stderr}");
+    // --drive pd: the same servos as torque sources under the PD controller, on any plant
+    let (code, _, stderr) = run(&["run", "--urdf", so101().to_str().unwrap(), "--motors", so101_motors().to_str().unwrap(), "--drive", "pd", "--time-step", "0", "--duration", "0.1", "--no-rrd", "--no-mcap", "--quiet"]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(!stderr.contains("firmware mode"));
+}
