@@ -36,6 +36,8 @@ pub struct DiscretePlant {
     v_next: Vec<f64>,
     residual: Vec<f64>,
     laws: Vec<JointLaw>,
+    /// Each joint's friction bounds (F⁺, F⁻) of the last step (its law's, and its friction's after).
+    bounds: Vec<(f64, f64)>,
     solver: StickSlipSolver,
     limit_active: Vec<bool>,
     friction_torque: Vec<f64>,
@@ -68,6 +70,7 @@ impl DiscretePlant {
             v_next: vec![0.0; n],
             residual: vec![0.0; n],
             laws: vec![JointLaw::FREE; n],
+            bounds: vec![(0.0, 0.0); n],
             solver: StickSlipSolver::new(n, branched_tree(model)),
             limit_active: vec![false; n],
             friction_torque: vec![0.0; n],
@@ -98,7 +101,8 @@ impl DiscretePlant {
             }
             for (i, joint) in model.joints.iter().enumerate() {
                 self.damping_step[i] = h * (joint.damping + self.friction.viscous(i));
-                let (law, locked_up, locked_down) = self.friction.law(i, u[i], h, (joint.lower - q[i]) / h, (joint.upper - q[i]) / h);
+                self.bounds[i] = self.friction.bounds(i, u[i]);
+                let (law, locked_up, locked_down) = JointFriction::law_of(self.bounds[i], h, (joint.lower - q[i]) / h, (joint.upper - q[i]) / h);
                 self.laws[i] = law;
                 self.locked[i] = (locked_up, locked_down);
             }
@@ -133,7 +137,7 @@ impl DiscretePlant {
             // torques and damping (a limit's inelastic stop is not booked: it only takes energy)
             let mean = 0.5 * (v_before + v[i]);
             if self.friction.has(i) {
-                let torque = self.friction_on(i, u[i], side, v[i]);
+                let torque = self.friction_on(i, side, v[i]);
                 self.friction_torque[i] = torque;
                 self.stuck[i] = v[i] == 0.0;
                 // the gear's viscous friction is booked here too (the audit books the URDF's damping)
@@ -144,10 +148,10 @@ impl DiscretePlant {
 
     /// The Coulomb friction torque on joint i after a step: −g/h within its band; at rest on a
     /// limit the limit takes what pushes into it, the friction only what pulls away.
-    fn friction_on(&self, i: usize, u: f64, side: i8, v: f64) -> f64 {
+    fn friction_on(&self, i: usize, side: i8, v: f64) -> f64 {
         let g = self.residual[i] / self.time_step;
         let g = if side != 0 && v == 0.0 { if side > 0 { g.min(0.0) } else { g.max(0.0) } } else { g };
-        let (up, down) = self.friction.bounds(i, u);
+        let (up, down) = self.bounds[i];
         (-g).clamp(-up, down)
     }
 

@@ -88,7 +88,11 @@ impl JointFriction {
     /// a side with infinite friction becomes a bound at 0 (the joint cannot move that way). Returns
     /// the law and whether its upper / lower bound is such a lock rather than the given one.
     pub fn law(&self, i: usize, u: f64, scale: f64, lower: f64, upper: f64) -> (JointLaw, bool, bool) {
-        let (up, down) = self.bounds(i, u);
+        Self::law_of(self.bounds(i, u), scale, lower, upper)
+    }
+
+    /// [`Self::law`] from the joint's bounds (F⁺, F⁻) already worked out.
+    pub fn law_of((up, down): (f64, f64), scale: f64, lower: f64, upper: f64) -> (JointLaw, bool, bool) {
         let mut law = JointLaw { lower, upper, below: -scale * down, above: scale * up };
         let (mut locked_up, mut locked_down) = (false, false);
         if up.is_infinite() {

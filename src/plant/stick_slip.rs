@@ -112,6 +112,9 @@ pub struct StickSlipSolver {
     /// Each joint's parent joint when A has a branched tree's sparsity (LᵀDL), else dense LDLᵀ.
     tree_parents: Option<Vec<Option<usize>>>,
     violated: Vec<usize>,
+    /// Whether `factor` holds A + diag factored, as this solve loaded it: while every joint is on a
+    /// segment the system is A + diag whatever the segments, and only its right-hand side changes.
+    factored_whole: bool,
     /// Solves that needed the fallback (coordinate descent) because pivoting did not finish.
     pub fallbacks: u64,
 }
@@ -122,7 +125,7 @@ pub struct NotPositiveDefinite;
 
 impl StickSlipSolver {
     pub fn new(n: usize, tree_parents: Option<Vec<Option<usize>>>) -> Self {
-        Self { n, factor: DMatrix::zeros(n, n), rhs: vec![0.0; n], piece: vec![0; n], points: vec![([0.0; 3], 0); n], tree_parents, violated: Vec::with_capacity(n), fallbacks: 0 }
+        Self { n, factor: DMatrix::zeros(n, n), rhs: vec![0.0; n], piece: vec![0; n], points: vec![([0.0; 3], 0); n], tree_parents, violated: Vec::with_capacity(n), factored_whole: false, fallbacks: 0 }
     }
 
     /// Whether joint i ended the last solve of `laws` on a limit (lower: −1, upper: +1, else 0). A
@@ -149,6 +152,7 @@ impl StickSlipSolver {
     /// Starts from the pieces of the last solve.
     pub fn solve(&mut self, a: &[f64], diagonal: &[f64], b: &[f64], laws: &[JointLaw], x: &mut [f64], g: &mut [f64]) -> Result<(), NotPositiveDefinite> {
         let n = self.n;
+        self.factored_whole = false;
         if self.solve_free(a, diagonal, b, laws, x, g)? {
             return Ok(());
         }
@@ -156,6 +160,9 @@ impl StickSlipSolver {
             *points = law.breakpoints();
             let (first, last) = law.piece_range(points.1);
             *p = (*p).clamp(first, last);
+        }
+        if self.solve_sliding(a, diagonal, b, laws, x, g)? {
+            return Ok(());
         }
         let mut fewest = usize::MAX;
         let mut stalled = 0;
@@ -182,7 +189,17 @@ impl StickSlipSolver {
             let moves = if block { count } else { 1 };
             for idx in 0..moves {
                 let (i, up) = decode(self.violated[idx]);
-                self.piece[i] = if up { self.piece[i] + 1 } else { self.piece[i] - 1 };
+                let piece = self.piece[i];
+                // a block move takes a sliding joint whose x left its segment straight to the piece
+                // x is on (a joint chattering at a kink reverses: across it, not onto it first);
+                // one piece at a time otherwise, and always in Murty's single moves
+                self.piece[i] = if block && piece % 2 == 0 {
+                    laws[i].piece_of(x[i])
+                } else if up {
+                    piece + 1
+                } else {
+                    piece - 1
+                };
             }
         }
         self.fallbacks += 1;
@@ -199,8 +216,10 @@ impl StickSlipSolver {
             return Ok(false);
         }
         self.load_matrix(a, diagonal);
+        self.factor()?;
+        self.factored_whole = true;
         x.copy_from_slice(b);
-        self.factor_and_substitute(x)?;
+        self.substitute(x);
         // strictly within: on a bound the pivoting decides whether the joint rests on it
         if !x.iter().zip(laws).all(|(xi, l)| l.lower < *xi && *xi < l.upper) {
             return Ok(false);
@@ -213,11 +232,37 @@ impl StickSlipSolver {
         Ok(true)
     }
 
+    /// Every joint on a segment and staying strictly inside it (sliding on as it slid, or within
+    /// its range): the first solve from those pieces is the solution, found by the same arithmetic
+    /// as the pivoting's first solve, so bit for bit the same — without its bookkeeping (the
+    /// residual's rows, the search for violations), most of a step with gearbox friction whose
+    /// joints slide. Returns false when some joint sits on a breakpoint or leaves its segment
+    /// (x is then that first solve, the factorization kept for the pivoting).
+    fn solve_sliding(&mut self, a: &[f64], diagonal: &[f64], b: &[f64], laws: &[JointLaw], x: &mut [f64], g: &mut [f64]) -> Result<bool, NotPositiveDefinite> {
+        if self.piece.iter().any(|p| p % 2 == 1) {
+            return Ok(false);
+        }
+        self.solve_on_pieces(a, diagonal, b, laws, x)?;
+        for (i, law) in laws.iter().enumerate() {
+            let ((points, m), k) = (self.points[i], self.piece[i] / 2);
+            let below = if k >= 1 { points[k - 1] } else { f64::NEG_INFINITY };
+            let above = if k < m { points[k] } else { f64::INFINITY };
+            if !(below < x[i] && x[i] < above) {
+                return Ok(false);
+            }
+            g[i] = law.segment_slope(&points, m, k);
+        }
+        Ok(true)
+    }
+
     /// The linear system for the current pieces: x_i fixed on a breakpoint, g_i = the slope on a
     /// segment.
     fn solve_on_pieces(&mut self, a: &[f64], diagonal: &[f64], b: &[f64], laws: &[JointLaw], x: &mut [f64]) -> Result<(), NotPositiveDefinite> {
         let n = self.n;
-        self.load_matrix(a, diagonal);
+        let on_segments = self.piece.iter().all(|p| p % 2 == 0);
+        if !(on_segments && self.factored_whole) {
+            self.load_matrix(a, diagonal);
+        }
         self.rhs.copy_from_slice(b);
         for (j, law) in laws.iter().enumerate() {
             let piece = self.piece[j];
@@ -244,7 +289,20 @@ impl StickSlipSolver {
             self.rhs[j] = fixed;
         }
         x.copy_from_slice(&self.rhs);
-        self.factor_and_substitute(x)
+        if on_segments {
+            // the same matrix for any segments (a joint sliding either way, or the other): factored
+            // once a solve, only the right-hand side substituted again (a chattering joint
+            // reverses every step: two solves of a step, one factorization)
+            if !self.factored_whole {
+                self.factor()?;
+                self.factored_whole = true;
+            }
+        } else {
+            self.factor()?;
+            self.factored_whole = false;
+        }
+        self.substitute(x);
+        Ok(())
     }
 
     /// A + diag into the factor's workspace.
@@ -255,21 +313,21 @@ impl StickSlipSolver {
         }
     }
 
-    /// Factor the workspace's matrix (along the tree, or dense LDLᵀ) and solve for `x`, which
-    /// holds the right-hand side on entry.
-    fn factor_and_substitute(&mut self, x: &mut [f64]) -> Result<(), NotPositiveDefinite> {
+    /// Factor the workspace's matrix (along the tree, or dense LDLᵀ).
+    fn factor(&mut self) -> Result<(), NotPositiveDefinite> {
         let factored = match &self.tree_parents {
             Some(parents) => ltdl_in_place(&mut self.factor, parents),
             None => ldlt_in_place(&mut self.factor),
         };
-        if !factored {
-            return Err(NotPositiveDefinite);
-        }
+        if factored { Ok(()) } else { Err(NotPositiveDefinite) }
+    }
+
+    /// Solve with the factored workspace for `x`, which holds the right-hand side on entry.
+    fn substitute(&self, x: &mut [f64]) {
         match &self.tree_parents {
             Some(parents) => ltdl_solve_in_place(&self.factor, parents, x),
             None => ldlt_solve_in_place(&self.factor, x),
         }
-        Ok(())
     }
 
     /// Each joint whose x leaves its segment or whose g leaves its breakpoint's subdifferential,
