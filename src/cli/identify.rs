@@ -31,7 +31,8 @@ pub struct IdentifyArgs {
     /// nominal: the header's vin; measured: the logs' input_volts row by row.
     #[arg(long, value_enum, default_value_t = Supply::Nominal)]
     pub supply: Supply,
-    /// Also fit the supply's internal resistance (the voltage's sag under load; BAM assumes none).
+    /// Also fit a resistance on the bridge's supply side (a loss growing with the duty squared; BAM
+    /// assumes an ideal supply).
     #[arg(long)]
     pub fit_supply_resistance: bool,
     /// Also fit the largest voltage the servo puts across its motor (BAM assumes duty × supply).

@@ -149,9 +149,17 @@ impl BenchLog {
         let family = crate::actuator::bus_servo::firmware::family(&actuator).map(|f| f.name).unwrap_or("");
         let register = family == "xl330" && raw.iter().filter_map(|r| r.load).any(|l| l.abs() > 1.5);
         let logged_pwm = family != "sts3215" && raw.iter().any(|r| r.load.is_some_and(|l| l != 0.0));
-        let to_duty = |load: f64| if register { (if load > 32767.0 { load - 65536.0 } else { load }) / 885.0 } else { load };
+        // (a processed log interpolated the register across its wrap where the duty changed sign:
+        // a value no register holds, left out)
+        let to_duty = |load: f64| {
+            if !register {
+                return Some(load);
+            }
+            let signed = if load > 32767.0 { load - 65536.0 } else { load };
+            (signed.abs() <= 885.0).then_some(signed / 885.0)
+        };
         for r in &mut raw {
-            r.load = r.load.filter(|_| logged_pwm).map(to_duty);
+            r.load = r.load.filter(|_| logged_pwm).and_then(to_duty);
         }
         let logged_dt = number("dt")?;
         let (dt, entries, resampled) = match logged_dt {

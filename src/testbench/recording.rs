@@ -18,25 +18,25 @@ use std::path::Path;
 /// The timeline: seconds from the log's first row.
 pub const TIMELINE: &str = "log_time";
 
-/// The series of one log, each (leaf, values, colour): a missing measured series is left out.
-fn series<'a>(log: &'a BenchLog, rollout: &'a Rollout) -> Vec<(&'static str, Vec<f64>, [u8; 3])> {
+/// The series of one log, each (leaf, the rows' times and values, colour): a measured series only
+/// at the rows that have it, none where no row has.
+fn series(log: &BenchLog, rollout: &Rollout) -> Vec<(&'static str, Vec<(f64, f64)>, [u8; 3])> {
     const MEASURED: [u8; 3] = [230, 230, 230];
     const SIMULATED: [u8; 3] = [31, 119, 180];
     const GOAL: [u8; 3] = [140, 140, 140];
+    let every = |values: &[f64]| log.entries.iter().zip(values).map(|(e, v)| (e.time, *v)).collect::<Vec<_>>();
+    let measured = |of: fn(&super::log::Entry) -> Option<f64>| log.entries.iter().filter_map(|e| of(e).map(|v| (e.time, v))).collect::<Vec<_>>();
     let mut out = vec![
-        ("position/goal", log.entries.iter().map(|e| e.goal).collect(), GOAL),
-        ("position/measured", log.entries.iter().map(|e| e.position).collect(), MEASURED),
-        ("position/simulated", rollout.position.clone(), SIMULATED),
-        ("duty/simulated", rollout.duty.clone(), SIMULATED),
-        ("supply/model", rollout.supply.clone(), SIMULATED),
-        ("current/simulated", rollout.current.clone(), SIMULATED),
+        ("position/goal", log.entries.iter().map(|e| (e.time, e.goal)).collect(), GOAL),
+        ("position/measured", log.entries.iter().map(|e| (e.time, e.position)).collect(), MEASURED),
+        ("position/simulated", every(&rollout.position), SIMULATED),
+        ("duty/simulated", every(&rollout.duty), SIMULATED),
+        ("supply/model", every(&rollout.supply), SIMULATED),
+        ("current/simulated", every(&rollout.current), SIMULATED),
+        ("duty/measured", measured(|e| e.duty), MEASURED),
+        ("supply/measured", measured(|e| e.volts), MEASURED),
     ];
-    if log.entries.iter().all(|e| e.duty.is_some()) {
-        out.push(("duty/measured", log.entries.iter().map(|e| e.duty.unwrap_or(0.0)).collect(), MEASURED));
-    }
-    if log.entries.iter().all(|e| e.volts.is_some()) {
-        out.push(("supply/measured", log.entries.iter().map(|e| e.volts.unwrap_or(0.0)).collect(), MEASURED));
-    }
+    out.retain(|(_, rows, _)| !rows.is_empty());
     out
 }
 
@@ -48,11 +48,12 @@ pub fn write_rrd(path: &Path, runs: &[(&BenchLog, &Rollout)]) -> Result<(), Erro
     let mut rows = Vec::new();
     for (log, rollout) in runs {
         let name = crate::runner::file_safe(&log.name());
-        for (leaf, values, colour) in series(log, rollout) {
+        for (leaf, rows, colour) in series(log, rollout) {
             let entity = format!("{name}/{leaf}");
             let label = leaf.rsplit('/').next().unwrap_or(leaf);
             rec.log_static(entity.as_str(), &rerun::SeriesLines::new().with_names([label]).with_colors([rerun::Color::from_rgb(colour[0], colour[1], colour[2])])).map_err(|e| err(e.to_string()))?;
-            let time = TimeColumn::new_duration_secs(TIMELINE, log.entries.iter().map(|e| e.time));
+            let time = TimeColumn::new_duration_secs(TIMELINE, rows.iter().map(|(t, _)| *t));
+            let values: Vec<f64> = rows.iter().map(|(_, v)| *v).collect();
             rrd::send_in_order(&rec, &entity, time, [rrd::scalar_column(&values, 1)]).map_err(|e| err(e.to_string()))?;
         }
         let view = |leaf: &str, title: String| TimeSeriesView::new(title).with_origin(format!("/{name}/{leaf}")).into();

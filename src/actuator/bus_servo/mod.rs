@@ -15,10 +15,12 @@
 //! extrapolates k_t·V/R past what the servo gives (BAM's 12 V STS3215 file says 8.3 N·m at full
 //! duty and rest, its datasheet 2.94 N·m).
 //!
-//! The supply V_s is the nominal voltage less the drop across the supply's own resistance R_s
-//! (cables, a battery, a bench supply's limit) for the current it gives, d·i: solving
-//! V_s = V₀ − R_s·d·i for V_s gives V_s = (V₀ + R_s·d·k_t·q̇/R)/(1 + R_s·d²/R). With R_s = 0 (BAM's
-//! assumption) V_s = V₀.
+//! The bridge's supply V_s is the nominal voltage less the drop across the resistance R_s on its
+//! supply side (a battery's, the cables', and inside the servo what lies before its bridge) for
+//! the current it draws, d·i: solving V_s = V₀ − R_s·d·i for V_s gives
+//! V_s = (V₀ + R_s·d·k_t·q̇/R)/(1 + R_s·d²/R), a loss that grows with the duty squared. With R_s = 0
+//! (BAM's assumption) V_s = V₀. The motor's voltage may also be capped (`motor_voltage_limit`), a
+//! loss that starts at a duty.
 
 pub mod firmware;
 pub mod friction;
@@ -45,7 +47,7 @@ pub struct BusServo {
     pub friction: ServoFriction,
     /// V₀, the supply's open-circuit voltage, V.
     pub supply: f64,
-    /// R_s, Ω.
+    /// R_s, Ω: on the bridge's supply side.
     pub supply_resistance: f64,
     /// The largest voltage the servo puts across its motor, V (infinite: none).
     pub motor_voltage_limit: f64,

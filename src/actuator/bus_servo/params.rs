@@ -26,7 +26,8 @@ pub struct ServoParams {
     pub error_gain_ratio: f64,
     /// The goal speed bound, rad/s (Feetech; the family's default when not identified).
     pub max_velocity: f64,
-    /// The supply's internal resistance, Ω (armscope's; 0: an ideal supply, as BAM assumes).
+    /// The resistance on the bridge's supply side, Ω (armscope's; 0: an ideal supply, as BAM
+    /// assumes).
     pub supply_resistance: f64,
     /// The largest voltage the servo puts across its motor, V (armscope's; infinite: the duty
     /// times the supply, as BAM assumes).
