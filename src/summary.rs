@@ -414,7 +414,7 @@ impl Summary {
                         servo.rms_current
                     ));
                 } else if sat >= 2.0 {
-                    out.push(format!("{name}: its servo's torque at the datasheet's line {sat:.0}% of steps (duty at most {:.0} %), drawing up to {:.2} A (RMS {:.2} A)", 100.0 * servo.peak_abs_duty, servo.peak_current, servo.rms_current));
+                    out.push(format!("{name}: its servo at its current limit or its torque at the datasheet's line {sat:.0}% of steps (duty at most {:.0} %), drawing up to {:.2} A (RMS {:.2} A)", 100.0 * servo.peak_abs_duty, servo.peak_current, servo.rms_current));
                 }
                 continue;
             }

@@ -145,3 +145,23 @@ fn servos_need_the_discrete_plant_and_their_settings_a_firmware() {
     assert_eq!(code, 0, "{stderr}");
     assert!(!stderr.contains("firmware mode"));
 }
+
+#[test]
+fn a_firmware_current_limit_holds_the_current_and_says_so() {
+    // the motor file's current_limit narrows the duty so that |i| ≤ 0.5 A (BAM's limiter): the
+    // shoulder lifting 0.3 kg draws 0.5 A at most, and the run says the servo is at its limit
+    let dir = tempfile::tempdir().unwrap();
+    let motors = dir.path().join("m.toml");
+    std::fs::write(&motors, "in_urdf = true\n[joints.shoulder_lift]\nmotor = \"STS3215-C018\"\nkp = 16\ncurrent_limit = 0.5\n").unwrap();
+    let json = dir.path().join("s.json");
+    let (code, stdout, stderr) = run(&[
+        "run", "--urdf", so101().to_str().unwrap(), "--motors", motors.to_str().unwrap(), "--payload", "0.3", "--test-joint", "shoulder_lift", "--test-angle", "1.2",
+        "--duration", "3", "--no-rrd", "--no-mcap", "--summary-json", json.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    let summary: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let lift = &summary["summary"]["servos"][1];
+    assert!(lift["peak_current"].as_f64().unwrap() <= 0.5 + 1e-9, "{lift}");
+    assert!(summary["summary"]["saturation_percent"][1].as_f64().unwrap() > 50.0);
+    assert!(stdout.contains("shoulder_lift: its servo at its current limit"), "{stdout}");
+}

@@ -56,7 +56,8 @@
 //!
 //! A joint whose servo has a firmware model (the catalogue's, or `servo_params = "fit.json"`, a
 //! BAM parameter file such as `armscope identify` writes, beside this file) may set its P gain
-//! register `kp` and the `supply_voltage`.
+//! register `kp`, the `supply_voltage`, and a firmware `current_limit` (A: the duty narrowed to
+//! keep the current within it, as an XL330's Current Limit(38) in its current-based position mode).
 //!
 //! The reduction's losses act as friction at the joint by the direction power flows
 //! ([`super::LossyGear`]).
@@ -281,15 +282,15 @@ fn servo_settings(fields: &Fields, path: &Path, motor: &str, drive: &mut DriveTr
         servo.envelope = envelope;
         drive.servo = Some(servo);
     }
-    for key in ["kp", "supply_voltage"] {
+    for key in ["kp", "supply_voltage", "current_limit"] {
         let Some(x) = fields.optional_positive(key)? else { continue };
         let Some(servo) = drive.servo.as_mut() else {
             return Err(fields.err(key, &format!("sets a servo's firmware, but motor '{motor}' has no firmware model (give servo_params = \"P.json\", a BAM parameter file)")));
         };
-        if key == "kp" {
-            servo.firmware.kp = x;
-        } else {
-            servo.supply = x;
+        match key {
+            "kp" => servo.firmware.kp = x,
+            "supply_voltage" => servo.supply = x,
+            _ => servo.firmware.current_limit = Some(x),
         }
     }
     Ok(())
@@ -635,7 +636,7 @@ pub fn load_motor_file(path: &Path, model: &Model) -> Result<MotorSet, Error> {
         };
         let Value::Table(t) = value else { return Err(fail(path, format!("{what}: expected a table"))) };
         let fields = Fields { file: path, what: &what, table: t };
-        fields.known(&["motor", "reduction", "gear_ratio", "efficiency", "backdrive_efficiency", "breakaway_torque", "viscous", "rated_torque", "microsteps", "acceleration", "in_urdf", "mount_link", "mount_xyz", "servo_params", "kp", "supply_voltage"])?;
+        fields.known(&["motor", "reduction", "gear_ratio", "efficiency", "backdrive_efficiency", "breakaway_torque", "viscous", "rated_torque", "microsteps", "acceleration", "in_urdf", "mount_link", "mount_xyz", "servo_params", "kp", "supply_voltage", "current_limit"])?;
         set.acceleration[index] = fields.optional_positive("acceleration")?;
         set.mounts[index] = fields.mount(all_in_urdf)?;
         if let Some(m) = fields.optional_positive("microsteps")? {

@@ -98,10 +98,12 @@ impl FirmwareDrives {
         }
     }
 
-    /// Whether joint `j`'s servo is at its duty limit or its torque at the datasheet's line.
+    /// Whether joint `j`'s servo is at its duty limit, at its firmware's current limit, or its
+    /// torque at the datasheet's line.
     pub fn saturated(&self, j: usize) -> bool {
         self.joints.iter().find(|s| s.joint == j).is_some_and(|s| {
-            s.out.duty.abs() >= s.servo.firmware.family.max_duty || s.out.limited
+            let at_current_limit = s.servo.firmware.current_limit.is_some_and(|limit| s.out.current.abs() >= limit * (1.0 - 1e-9));
+            s.out.duty.abs() >= s.servo.firmware.family.max_duty || s.out.limited || at_current_limit
         })
     }
 
