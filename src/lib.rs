@@ -24,6 +24,7 @@ pub mod model;
 pub mod npy;
 pub mod plant;
 pub mod recorder;
+pub mod ros2;
 pub mod runner;
 pub mod sample;
 pub mod sim;

@@ -3,7 +3,7 @@
 
 use crate::error::Error;
 use crate::experiment::Experiment;
-use crate::recorder::{Console, LiveViewer, McapOptions, McapRecorder, Pacer, Recorder, RerunOptions, RerunRecorder, SummaryJson, Threaded, Trace, TutorialCsv};
+use crate::recorder::{Console, LiveViewer, McapEncoding, McapOptions, McapRecorder, Pacer, Recorder, RerunOptions, RerunRecorder, Ros2McapRecorder, SummaryJson, Threaded, Trace, TutorialCsv};
 use crate::sim::simulate;
 use crate::summary::Summary;
 use std::io::Write;
@@ -33,6 +33,8 @@ pub struct Outputs {
     pub notice: Option<fn(&str)>,
     /// Compress the recordings' chunks (`--compress`): smaller files, more CPU.
     pub compress: bool,
+    /// The MCAP's encoding (`--mcap-encoding`).
+    pub mcap_encoding: crate::recorder::McapEncoding,
     /// Further recorders, run after the others (a batch's comparison series).
     pub recorders: Vec<Box<dyn Recorder>>,
 }
@@ -73,11 +75,23 @@ pub fn run_experiment(experiment: &Experiment, outputs: Outputs, stop: Option<&A
         if let Some(path) = &outputs.mcap {
             create_parent(path)?;
         }
-        let mut mcap = McapRecorder::new(McapOptions { file: outputs.mcap.clone(), live: outputs.foxglove.clone(), compress: outputs.compress });
-        if let Some(notice) = outputs.notice {
-            mcap.on_notice(notice);
+        let options = McapOptions { file: outputs.mcap.clone(), live: outputs.foxglove.clone(), compress: outputs.compress };
+        match outputs.mcap_encoding {
+            McapEncoding::Foxglove => {
+                let mut mcap = McapRecorder::new(options);
+                if let Some(notice) = outputs.notice {
+                    mcap.on_notice(notice);
+                }
+                threaded = threaded.with(mcap);
+            }
+            McapEncoding::Ros2 => {
+                let mut mcap = Ros2McapRecorder::new(options);
+                if let Some(notice) = outputs.notice {
+                    mcap.on_notice(notice);
+                }
+                threaded = threaded.with(mcap);
+            }
         }
-        threaded = threaded.with(mcap);
     }
     if !threaded.is_empty() {
         recorders.push(Box::new(threaded));

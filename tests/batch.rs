@@ -266,3 +266,38 @@ fn batch_compress_applies_to_every_experiment_or_to_one() {
     assert_eq!(compression(&all, "plain"), ["zstd"]);
     assert_eq!(compression(&all, "packed"), ["zstd"]);
 }
+
+/// `--mcap-encoding ros2` on the batch gives every experiment a ROS 2 MCAP, the manifest's
+/// `mcap_encoding = "ros2"` one experiment; the comparison recording reads both encodings, and
+/// `compare` overlays a ROS 2 run with a Foxglove one.
+#[test]
+fn batch_mcap_encoding_applies_to_every_experiment_or_to_one_and_compares() {
+    let dir = tempfile::tempdir().unwrap();
+    let manifest = dir.path().join("two.toml");
+    std::fs::write(&manifest, "name = \"two\"\n[defaults]\nduration = 0.3\n[[experiment]]\nname = \"fox\"\n[[experiment]]\nname = \"bag\"\nmcap_encoding = \"ros2\"\n").unwrap();
+    let encoding = |out: &Path, name: &str| {
+        let bytes = std::fs::read(out.join(format!("{name}.mcap"))).unwrap();
+        let summary = mcap::Summary::read(&bytes).unwrap().expect("summary section");
+        let joint_states = summary.channels.values().find(|c| c.topic == "/joint_states").unwrap();
+        joint_states.message_encoding.clone()
+    };
+    let each = dir.path().join("each");
+    assert_eq!(armscope(&["batch", manifest.to_str().unwrap(), "--out", each.to_str().unwrap()]), 0);
+    assert_eq!((encoding(&each, "fox").as_str(), encoding(&each, "bag").as_str()), ("protobuf", "cdr"));
+    let rrd = common::rrd::Rrd::open(&each.join("comparison.rrd"));
+    let entities = rrd.entities();
+    for entity in ["/fox/joints/J2/angle", "/bag/joints/J2/angle"] {
+        assert_eq!(entities.get(entity).map(|e| e.rows), Some(302), "{entity} in {:?}", entities.keys());
+    }
+    let all = dir.path().join("all");
+    assert_eq!(armscope(&["batch", manifest.to_str().unwrap(), "--out", all.to_str().unwrap(), "--no-compare", "--mcap-encoding", "ros2"]), 0);
+    assert_eq!((encoding(&all, "fox").as_str(), encoding(&all, "bag").as_str()), ("cdr", "cdr"));
+    // compare reads a ROS 2 run's angles as a Foxglove run's: the same values
+    let out = dir.path().join("cmp.rrd");
+    assert_eq!(armscope(&["compare", each.join("fox.mcap").to_str().unwrap(), all.join("fox.mcap").to_str().unwrap(), "--out", out.to_str().unwrap()]), 0);
+    let rrd = common::rrd::Rrd::open(&out);
+    // two runs named fox.mcap are told apart by their folders, not overlaid into one series
+    let series: Vec<_> = rrd.entities().keys().filter(|e| e.ends_with("/joints/J3/angle")).cloned().collect();
+    assert_eq!(series, ["/all_fox/joints/J3/angle", "/each_fox/joints/J3/angle"], "{series:?}");
+    assert_eq!(rrd.component(&series[0], "Scalars:scalars").iter().map(|r| r.1.clone()).collect::<Vec<_>>(), rrd.component(&series[1], "Scalars:scalars").iter().map(|r| r.1.clone()).collect::<Vec<_>>());
+}

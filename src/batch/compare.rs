@@ -43,10 +43,11 @@ fn read_run(run: &ComparedRun) -> Result<RunSeries, Error> {
         let message = message.map_err(|e| fail(e.to_string()))?;
         match message.channel.topic.as_str() {
             TOPIC_CONTROLLER => {
-                if message.channel.message_encoding != "protobuf" {
-                    return Err(fail(format!("{TOPIC_CONTROLLER} is {}-encoded: recorded by an older armscope, record it again", message.channel.message_encoding)));
-                }
-                let t = ControllerTelemetry::decode(&message.data[..]).map_err(|e| fail(e.to_string()))?;
+                let t = match message.channel.message_encoding.as_str() {
+                    "protobuf" => ControllerTelemetry::decode(&message.data[..]).map_err(|e| fail(e.to_string()))?,
+                    "cdr" => crate::recorder::decode_controller_telemetry(&message.data).map_err(|e| fail(format!("{TOPIC_CONTROLLER}: {e}")))?,
+                    other => return Err(fail(format!("{TOPIC_CONTROLLER} is {other}-encoded: recorded by an older armscope, record it again"))),
+                };
                 if series.error.is_empty() {
                     series.error = vec![Vec::new(); t.error.len()];
                     series.torque = vec![Vec::new(); t.torque.len()];
@@ -58,13 +59,20 @@ fn read_run(run: &ComparedRun) -> Result<RunSeries, Error> {
                 }
             }
             TOPIC_JOINT_STATES => {
-                let js = JointStates::decode(&message.data[..]).map_err(|e| fail(e.to_string()))?;
+                let (names, positions): (Vec<String>, Vec<f64>) = if message.channel.message_encoding == "cdr" {
+                    use crate::ros2::Message as _;
+                    let js = crate::ros2::messages::JointState::decode(&message.data).map_err(|e| fail(format!("{TOPIC_JOINT_STATES}: {e}")))?;
+                    (js.name, js.position)
+                } else {
+                    let js = JointStates::decode(&message.data[..]).map_err(|e| fail(e.to_string()))?;
+                    js.joints.iter().map(|j| (j.name.clone(), j.position.unwrap_or(f64::NAN))).unzip()
+                };
                 if series.joints.is_empty() {
-                    series.joints = js.joints.iter().map(|j| j.name.clone()).collect();
-                    series.angle = vec![Vec::new(); js.joints.len()];
+                    series.angle = vec![Vec::new(); names.len()];
+                    series.joints = names;
                 }
-                for (j, state) in js.joints.iter().enumerate().take(series.angle.len()) {
-                    series.angle[j].push(state.position.unwrap_or(f64::NAN));
+                for (j, position) in positions.iter().enumerate().take(series.angle.len()) {
+                    series.angle[j].push(*position);
                 }
             }
             _ => {}

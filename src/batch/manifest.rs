@@ -121,10 +121,12 @@ fn plain(v: &Value) -> String {
     }
 }
 
-/// `key = value` → `--key value`; `true` → `--key`; `false` → nothing; lists → comma lists.
+/// `key = value` → `--key value` (`_` in a key is `-`: `mcap_encoding` is `--mcap-encoding`);
+/// `true` → `--key`; `false` → nothing; lists → comma lists.
 fn to_args(flags: &Table, base: &Path) -> Result<Vec<String>, String> {
     let mut args = Vec::new();
     for (key, value) in flags {
+        let key = &key.replace('_', "-");
         if RESERVED.contains(&key.as_str()) {
             return Err(format!("'{key}' is set by the batch itself"));
         }

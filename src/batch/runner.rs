@@ -27,6 +27,8 @@ pub struct BatchOptions {
     pub compare: bool,
     /// Compress every experiment's recordings (or an experiment's own `--compress`).
     pub compress: bool,
+    /// Every experiment's MCAP encoding (unless an experiment sets its own).
+    pub mcap_encoding: crate::recorder::McapEncoding,
     pub progress: bool,
 }
 
@@ -40,10 +42,10 @@ struct RunFlags {
 
 /// One experiment; with a comparison, its series are added to it when it has a summary (whatever
 /// its status, as the comparison built from the `.mcap` files after the runs included it).
-fn run_one(e: &PlannedExperiment, dir: &Path, compress: bool, stop: Option<&AtomicBool>, comparison: Option<&Comparison>) -> (ExperimentOutcome, Result<(), Error>) {
+fn run_one(e: &PlannedExperiment, dir: &Path, compress: bool, encoding: crate::recorder::McapEncoding, stop: Option<&AtomicBool>, comparison: Option<&Comparison>) -> (ExperimentOutcome, Result<(), Error>) {
     let started = std::time::Instant::now();
     let (recorder, finished) = comparison.map(|_| SeriesRecorder::new()).unzip();
-    let mut outcome = run_timed(e, dir, compress, stop, recorder.map(|r| Box::new(r) as Box<dyn crate::recorder::Recorder>));
+    let mut outcome = run_timed(e, dir, compress, encoding, stop, recorder.map(|r| Box::new(r) as Box<dyn crate::recorder::Recorder>));
     outcome.wall_time = started.elapsed().as_secs_f64();
     let mut added = Ok(());
     if let (Some(comparison), Some(finished), Some(_)) = (comparison, finished, &outcome.summary) {
@@ -64,7 +66,7 @@ pub fn run_args(e: &PlannedExperiment) -> Result<RunArgs, String> {
     })
 }
 
-fn run_timed(e: &PlannedExperiment, dir: &Path, compress: bool, stop: Option<&AtomicBool>, series: Option<Box<dyn crate::recorder::Recorder>>) -> ExperimentOutcome {
+fn run_timed(e: &PlannedExperiment, dir: &Path, compress: bool, encoding: crate::recorder::McapEncoding, stop: Option<&AtomicBool>, series: Option<Box<dyn crate::recorder::Recorder>>) -> ExperimentOutcome {
     let failed = |error: String| ExperimentOutcome { index: e.index, name: e.name.clone(), args: e.args.clone(), status: "failed".into(), summary: None, error: Some(error), wall_time: 0.0 };
     let flags = match run_args(e) {
         Ok(args) => args,
@@ -82,6 +84,7 @@ fn run_timed(e: &PlannedExperiment, dir: &Path, compress: bool, stop: Option<&At
             csv: Some(dir.join(format!("{}.csv", e.name))),
             summary_json: Some(dir.join(format!("{}.json", e.name))),
             compress: compress || flags.compress,
+            mcap_encoding: if flags.mcap_encoding == crate::recorder::McapEncoding::Foxglove { encoding } else { flags.mcap_encoding },
             recorders: series.into_iter().collect(),
             ..Outputs::default()
         };
@@ -127,7 +130,7 @@ pub fn run_batch(options: &BatchOptions, stop: Option<&AtomicBool>) -> Result<(B
         planned
             .par_iter()
             .map(|e| {
-                let result = run_one(e, &dir, options.compress, stop, comparison.as_ref());
+                let result = run_one(e, &dir, options.compress, options.mcap_encoding, stop, comparison.as_ref());
                 bar.set_message(format!("{} {}", result.0.name, result.0.status));
                 bar.inc(1);
                 result

@@ -25,6 +25,10 @@ pub struct BatchArgs {
     /// Compress every experiment's recordings (as `run --compress`): smaller files, more CPU.
     #[arg(long)]
     pub compress: bool,
+    /// Every experiment's MCAP encoding (as `run --mcap-encoding`; an experiment's own
+    /// `mcap_encoding` wins).
+    #[arg(long, value_enum, default_value_t = crate::recorder::McapEncoding::Foxglove)]
+    pub mcap_encoding: crate::recorder::McapEncoding,
 }
 
 #[derive(Subcommand, Debug)]
@@ -61,6 +65,7 @@ pub fn batch(args: &BatchArgs) -> Result<i32, Error> {
                 out: args.out.clone(),
                 compare: !args.no_compare,
                 compress: args.compress,
+                mcap_encoding: args.mcap_encoding,
                 progress: true,
             };
             if options.jobs == 0 {

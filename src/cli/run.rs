@@ -87,6 +87,7 @@ pub fn run(args: &RunArgs) -> Result<i32, Error> {
         trace: args.trace.clone(),
         summary_json: args.summary_json.clone(),
         compress: args.compress,
+        mcap_encoding: args.mcap_encoding,
         notice: Some(|n| eprintln!("armscope: notice: {n}")),
         recorders: Vec::new(),
     };

@@ -134,6 +134,10 @@ pub struct RunArgs {
     /// No MCAP file.
     #[arg(long)]
     pub no_mcap: bool,
+    /// foxglove: Foxglove's protobuf schemas; ros2: ROS 2's CDR with ros2msg schemas, as rosbag2
+    /// writes a bag (`ros2 bag play`, RViz, PlotJuggler, rosbags, Rerun's MCAP importer).
+    #[arg(long, value_enum, default_value_t = crate::recorder::McapEncoding::Foxglove)]
+    pub mcap_encoding: crate::recorder::McapEncoding,
     /// Smaller recordings for more CPU: LZ4 in the .rrd, zstd in the .mcap (the 30 s run's 34 and
     /// 21 MB become 18 and 13 MB; as readable). Without it the chunks are stored as they are, fastest.
     #[arg(long)]

@@ -7,11 +7,11 @@
 //! thread of its own (see `Out`).
 
 use super::foxglove_live::FoxgloveLive;
+use super::mcap_out::{Out, Sinks, Topic, ZSTD_LEVEL, zstd_level};
 use super::overview::Overview;
 use super::robot_description::RobotDescription;
 use super::step_messages::JointStatesLayout;
 use super::telemetry::ControllerTelemetry;
-use super::worker::{BatchWorker, Reusable};
 use super::{Recorder, RunInfo};
 use crate::error::Error;
 use crate::model::{Geometry, JointKind, Model};
@@ -23,13 +23,9 @@ use foxglove::messages::{
     Color, CubePrimitive, CylinderPrimitive, FrameTransform, FrameTransforms, JointState, JointStates, LinePrimitive, ModelPrimitive,
     Point3, PoseInFrame, Quaternion, SceneEntity, SceneUpdate, SpherePrimitive, Timestamp, Vector3,
 };
-use foxglove::Encode;
-use mcap::records::MessageHeader;
 use std::collections::BTreeMap;
-use std::fs::File;
 use std::io::BufWriter;
 use std::path::PathBuf;
-use std::marker::PhantomData;
 
 pub const TOPIC_TF: &str = "/tf";
 pub const TOPIC_SCENE: &str = "/robot/geometry";
@@ -40,183 +36,6 @@ pub const TOPIC_TOOL_PATH: &str = "/tool/path";
 pub const TOPIC_COMMANDED_PATH: &str = "/tool/commanded_path";
 pub const TOPIC_ROBOT_DESCRIPTION: &str = "/robot_description";
 
-
-/// A channel of messages of type T.
-struct Topic<T> {
-    id: u16,
-    sequence: u32,
-    _message: PhantomData<T>,
-}
-
-type McapWriter = mcap::Writer<BufWriter<File>>;
-
-/// Encoded messages on their way to the writer thread: payloads back to back, and per message its
-/// header and where its payload ends.
-#[derive(Default)]
-struct Batch {
-    bytes: Vec<u8>,
-    messages: Vec<(MessageHeader, usize)>,
-}
-
-impl Batch {
-    /// An empty batch with room for a full one of the box model's messages (~400 kB): grown from
-    /// nothing, it was copied along the way.
-    fn sized() -> Self {
-        Self { bytes: Vec::with_capacity(BATCH_MESSAGES * 512), messages: Vec::with_capacity(BATCH_MESSAGES + 1) }
-    }
-}
-
-impl Reusable for Batch {
-    fn clear(&mut self) {
-        self.bytes.clear();
-        self.messages.clear();
-    }
-}
-
-/// Messages per batch: ~250 control steps.
-const BATCH_MESSAGES: usize = 1000;
-
-/// Where the encoded messages go: the file, the live Foxglove clients, or both (the same bytes).
-struct Sinks {
-    file: Option<McapWriter>,
-    live: Option<FoxgloveLive>,
-}
-
-impl Sinks {
-    fn write(&mut self, batch: &Batch) -> Result<(), String> {
-        let mut start = 0;
-        for (header, end) in &batch.messages {
-            let bytes = &batch.bytes[start..*end];
-            if let Some(file) = &mut self.file {
-                file.write_to_known_channel(header, bytes).map_err(|e| e.to_string())?;
-            }
-            if let Some(live) = &self.live {
-                live.log(header.channel_id, bytes, header.log_time);
-            }
-            start = *end;
-        }
-        Ok(())
-    }
-}
-
-/// The MCAP output, written on a thread of its own: this (recorder) thread encodes the messages,
-/// the writer thread frames and writes them (and with `--compress` zstds them, then the larger half
-/// of the work), so the two halves run on both cores instead of one.
-struct Out {
-    /// The sinks while schemas, channels and metadata are added (before `spawn`, after `close`).
-    sinks: Option<Sinks>,
-    batch: Batch,
-    worker: Option<BatchWorker<Sinks, Batch, String>>,
-    /// The next channel id when there is no file to hand them out.
-    next_channel: u16,
-}
-
-impl Out {
-    fn new(sinks: Sinks) -> Self {
-        Self { sinks: Some(sinks), batch: Batch::default(), worker: None, next_channel: 1 }
-    }
-
-    fn sinks(&mut self) -> &mut Sinks {
-        self.sinks.as_mut().expect("the sinks are here before spawn and after close")
-    }
-
-    /// A channel in both sinks; `latched`: a late live client gets its last message.
-    fn channel<T: Encode>(&mut self, topic: &str, metadata: BTreeMap<String, String>, latched: bool) -> Result<Topic<T>, String> {
-        let schema = T::get_schema();
-        let encoding = T::get_message_encoding();
-        let next = self.next_channel;
-        let sinks = self.sinks();
-        let id = match &mut sinks.file {
-            Some(file) => {
-                let schema_id = match &schema {
-                    Some(s) => file.add_schema(&s.name, &s.encoding, &s.data).map_err(|e| e.to_string())?,
-                    None => 0,
-                };
-                file.add_channel(schema_id, topic, &encoding, &metadata).map_err(|e| e.to_string())?
-            }
-            None => next,
-        };
-        if let Some(live) = &mut sinks.live {
-            live.add_channel(id, topic, &encoding, schema, metadata, latched)?;
-        }
-        self.next_channel = id + 1;
-        Ok(Topic { id, sequence: 0, _message: PhantomData })
-    }
-
-    fn write_metadata(&mut self, name: &str, metadata: BTreeMap<String, String>) -> mcap::McapResult<()> {
-        match &mut self.sinks().file {
-            Some(file) => file.write_metadata(&mcap::records::Metadata { name: name.into(), metadata }),
-            None => Ok(()),
-        }
-    }
-
-    fn log<T: Encode>(&mut self, topic: &mut Topic<T>, msg: &T, time_ns: u64) -> Result<(), String> {
-        msg.encode(&mut self.batch.bytes).map_err(|e| e.to_string())?;
-        self.logged(topic, time_ns)
-    }
-
-    /// A message of `topic` that `encode` appends to the batch's bytes (see `step_messages`).
-    fn log_encoded<T>(&mut self, topic: &mut Topic<T>, encode: impl FnOnce(&mut Vec<u8>), time_ns: u64) -> Result<(), String> {
-        encode(&mut self.batch.bytes);
-        self.logged(topic, time_ns)
-    }
-
-    /// The message whose bytes end the batch's.
-    fn logged<T>(&mut self, topic: &mut Topic<T>, time_ns: u64) -> Result<(), String> {
-        let header = MessageHeader { channel_id: topic.id, sequence: topic.sequence, log_time: time_ns, publish_time: time_ns };
-        topic.sequence += 1;
-        self.batch.messages.push((header, self.batch.bytes.len()));
-        if self.batch.messages.len() >= BATCH_MESSAGES { self.send() } else { Ok(()) }
-    }
-
-    /// Moves the sinks to their thread; messages logged from now on are written there.
-    fn spawn(&mut self) -> Result<(), String> {
-        let sinks = self.sinks.take().expect("spawned once");
-        let worker = BatchWorker::spawn("McapWriter", sinks, |sinks: &mut Sinks, batch: &Batch| sinks.write(batch));
-        self.worker = Some(worker.map_err(|e| e.to_string())?);
-        Ok(())
-    }
-
-    fn send(&mut self) -> Result<(), String> {
-        let Some(worker) = &self.worker else { return Ok(()) };
-        if !worker.hand_over(&mut self.batch, Batch::sized) {
-            // the writer stopped on an error: report it
-            return self.join();
-        }
-        Ok(())
-    }
-
-    /// Writes what is left and takes the sinks back.
-    fn join(&mut self) -> Result<(), String> {
-        match self.worker.as_mut().and_then(BatchWorker::join) {
-            Some(joined) => {
-                let (sinks, result) = joined.map_err(|_| "the MCAP writer thread panicked".to_string())?;
-                self.sinks = Some(sinks);
-                result
-            }
-            None => Ok(()),
-        }
-    }
-
-    fn close(&mut self) -> Result<(), String> {
-        self.send()?;
-        self.join()
-    }
-}
-
-/// zstd's fast level −3, with `--compress`: compressing was ~2/3 of this recorder's work at level
-/// 1; −3 costs ~40 % less for a file ~8 % larger. Without `--compress` the chunks are stored as
-/// they are: the mcap crate hands zstd each record field by field (seven streaming calls a message),
-/// and compressing was a quarter of the whole run's instructions (the 30 s run's file 13.2 → 20.7 MB,
-/// as readable: every MCAP reader takes uncompressed chunks; `mcap compress` makes a smaller copy).
-const ZSTD_LEVEL: i32 = -3;
-
-/// The mcap crate takes the level as `u32` and hands it to zstd as `level as i32` (mcap 0.26,
-/// `ChunkWriter::zstd_encoder`), so zstd's negative (fast) levels pass through as their two's
-/// complement. The test `negative_zstd_levels_reach_zstd_through_mcap` pins that down.
-fn zstd_level(level: i32) -> u32 {
-    level as u32
-}
 
 struct Channels {
     tf: Topic<FrameTransforms>,
@@ -229,6 +48,18 @@ struct Channels {
     robot_description: Topic<RobotDescription>,
     /// With collision checks: each step's state, and the links and objects in contact.
     collisions: Option<(Topic<super::mcap_collisions::CollisionState>, Topic<SceneUpdate>)>,
+}
+
+/// How the MCAP's messages are encoded.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum McapEncoding {
+    /// Foxglove's well-known protobuf schemas (Foxglove's 3D, plot and URDF panels as they are).
+    #[default]
+    Foxglove,
+    /// ROS 2's: CDR with ros2msg schemas, the ros2 profile, rosbag2's QoS (`ros2 bag play`, RViz,
+    /// PlotJuggler, rosbags, Rerun's MCAP importer).
+    Ros2,
 }
 
 /// Where the MCAP recorder's messages go: a file, live Foxglove clients, or both.
@@ -285,7 +116,7 @@ const PATH_OVERVIEW_POINTS: usize = 512;
 /// of everything so far thinned to at most `PATH_OVERVIEW_POINTS` (one entity, replaced), which is
 /// what a viewer shows after seeking (it shows a topic's latest message). So the topic's size grows
 /// linearly with the duration.
-struct ToolPath {
+pub(super) struct ToolPath {
     /// The points since the last piece, starting with the last piece's last point (no gap).
     piece: Vec<Point3>,
     pieces: usize,
@@ -299,18 +130,18 @@ impl Default for ToolPath {
 }
 
 impl ToolPath {
-    fn push(&mut self, p: Point3) {
+    pub(super) fn push(&mut self, p: Point3) {
         self.overview.push(p.clone());
         self.piece.push(p);
     }
 
     /// Whether a piece is due (`PATH_PIECE_POINTS` new points).
-    fn piece_full(&self) -> bool {
+    pub(super) fn piece_full(&self) -> bool {
         self.piece.len() > PATH_PIECE_POINTS
     }
 
     /// The message with the new piece and the overview; starts the next piece.
-    fn take_update(&mut self, timestamp: Timestamp) -> Option<SceneUpdate> {
+    pub(super) fn take_update(&mut self, timestamp: Timestamp) -> Option<SceneUpdate> {
         if self.piece.len() < 2 {
             return None;
         }
@@ -393,14 +224,44 @@ impl McapRecorder {
 /// takes the parent link to the joint frame and `after` the joint's body to the child link.
 /// Built from the URDF's own origins rather than from world poses, so what the URDF has exactly
 /// (zero offsets, an axis along z) stays exact: protobuf then leaves the zeros out, a third of /tf.
-struct JointTransform {
-    joint: usize,
+pub(super) struct JointTransform {
+    pub(super) joint: usize,
     before: Pose,
     after: Pose,
 }
 
+/// Every link in its parent link ("world" → the root when the root is not "world"), by (parent,
+/// child) name: those a moving joint turns, and the fixed ones with their constant pose.
+pub(super) struct LinkTransforms {
+    pub(super) moving: Vec<((String, String), JointTransform)>,
+    pub(super) fixed: Vec<((String, String), Pose)>,
+}
+
+impl LinkTransforms {
+    pub(super) fn of(model: &Model) -> Self {
+        let pairs = model.frames.iter().enumerate().filter(|(_, f)| f.parent_frame.is_some() || f.name != "world");
+        // a link moves relative to its parent when its joint is a moving joint (the child's body's joint)
+        let (moving, fixed): (Vec<_>, Vec<_>) = pairs.partition(|(_, f)| f.parent_frame.is_some_and(|p| model.frames[p].body != f.body));
+        let name_of = |f: Option<usize>| f.map_or("world".to_string(), |i| model.frames[i].name.clone());
+        // a parent link's placement on its body (the world's: identity)
+        let placement_of = |f: Option<usize>| f.map_or(Pose::identity(), |p| model.frames[p].placement);
+        let names = |parent: Option<usize>, child: usize| (name_of(parent), name_of(Some(child)));
+        Self {
+            moving: moving
+                .iter()
+                .map(|(c, f)| {
+                    let joint = f.body.expect("a moving link has a body");
+                    (names(f.parent_frame, *c), JointTransform { joint, before: placement_of(f.parent_frame).inverse().compose(&model.bodies[joint].placement), after: f.placement })
+                })
+                .collect(),
+            // links on the same body (or on the world) keep their relative pose: P_parent⁻¹ ∘ P_child
+            fixed: fixed.iter().map(|(c, f)| (names(f.parent_frame, *c), placement_of(f.parent_frame).inverse().compose(&f.placement))).collect(),
+        }
+    }
+}
+
 impl JointTransform {
-    fn pose(&self, model_joint: &crate::model::Joint, q: f64) -> Pose {
+    pub(super) fn pose(&self, model_joint: &crate::model::Joint, q: f64) -> Pose {
         let motion = match model_joint.kind {
             JointKind::Revolute | JointKind::Continuous => Pose::new(rotation_about_axis(&model_joint.axis, q), nalgebra::Vector3::zeros()),
             JointKind::Prismatic => Pose::new(nalgebra::Matrix3::identity(), model_joint.axis * q),
@@ -415,12 +276,12 @@ fn set_transform(m: &mut FrameTransform, pose: &Pose, ts: Option<Timestamp>) {
     m.rotation = Some(quaternion(pose));
 }
 
-fn color(c: [f32; 4]) -> Color {
+pub(super) fn color(c: [f32; 4]) -> Color {
     Color { r: c[0] as f64, g: c[1] as f64, b: c[2] as f64, a: c[3] as f64 }
 }
 
 /// A line strip `thickness` pixels wide at any zoom.
-fn line(points: Vec<Point3>, color: Color, thickness: f64) -> LinePrimitive {
+pub(super) fn line(points: Vec<Point3>, color: Color, thickness: f64) -> LinePrimitive {
     LinePrimitive { r#type: 0, thickness, scale_invariant: true, points, color: Some(color), ..Default::default() }
 }
 
@@ -450,7 +311,7 @@ fn media_type(path: &std::path::Path) -> &'static str {
 /// How often the geometry is republished: once a simulated second, but at most
 /// [`SCENE_BYTES_PER_SECOND`] on average — a robot drawn from meshes (a Panda's are 7 MB) is
 /// republished every few minutes instead of every second, which would have been most of its file.
-fn scene_interval_s(scene_bytes: usize) -> i64 {
+pub(super) fn scene_interval_s(scene_bytes: usize) -> i64 {
     (scene_bytes as f64 / SCENE_BYTES_PER_SECOND).ceil().max(1.0) as i64
 }
 
@@ -514,44 +375,9 @@ impl Recorder for McapRecorder {
     fn start(&mut self, run: &RunInfo) -> Result<(), Error> {
         let e = run.experiment;
         let model = &*e.model;
-        let file = match &self.options.file {
-            Some(path) => {
-                let (file, replaced) = super::output_file::create_replacing(path).map_err(|err| self.err(err))?;
-                self.replaced = Some(replaced);
-                Some(file)
-            }
-            None => None,
-        };
-        // zstd (with --compress) on the writer thread (`Out`): zstd's own worker threads cost more
-        // than they save here
-        let options = mcap::WriteOptions::new()
-            .compression(self.options.compress.then_some(mcap::Compression::Zstd))
-            .compression_level(zstd_level(ZSTD_LEVEL))
-            .compression_threads(0)
-            // within zstd's window at this level, so no block takes its slower "external
-            // dictionary" path (−5 % of the writer's work at the same size)
-            .chunk_size(Some(512 * 1024))
-            // CRCs with --compress only: the crate checksums every record field by field as it
-            // writes it, twice (5 % of the run's instructions), and the data section's CRC needs
-            // the chunks' (the default is rosbag2's "fastwrite": chunks as they are, no CRCs;
-            // readers skip a zero CRC)
-            .calculate_chunk_crcs(self.options.compress)
-            .calculate_data_section_crc(self.options.compress)
-            .library(format!("armscope {} (foxglove-sdk schemas, mcap-rust)", env!("CARGO_PKG_VERSION")));
-        // zstd hands its output over in pieces of up to 128 KiB: gathered here, a chunk (~200 KiB
-        // compressed) takes a write call or two
-        let file = file.map(|file| options.create(BufWriter::with_capacity(1 << 20, file))).transpose().map_err(|err| self.err(err))?;
-        let live = match &self.options.live {
-            Some(address) => {
-                let live = FoxgloveLive::start(address).map_err(|err| Error::flag("--foxglove", err))?;
-                if let Some(notice) = self.notice {
-                    notice(&format!("Foxglove live at ws://{} (Foxglove: Open connection → Foxglove WebSocket)", live.address()));
-                }
-                Some(live)
-            }
-            None => None,
-        };
-        let mut out = Out::new(Sinks { file, live });
+        let (sinks, replaced) = open_sinks(&self.options, "", &self.path, self.notice)?;
+        self.replaced = replaced;
+        let mut out = Out::new(sinks);
         let now = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).unwrap_or_default();
         self.start_ns = now.as_nanos() as u64;
         // the configuration first: written later, it would close a chunk holding only schemas and
@@ -596,29 +422,17 @@ impl Recorder for McapRecorder {
         self.steps_per_tool_pose = steps_per(0.02);
         self.steps_per_tf = super::steps_per_pose(e.config.dt);
 
-        // transforms: every link from its parent link; "world" → root when the root is not "world"
-        let pairs = model.frames.iter().enumerate().filter(|(_, f)| f.parent_frame.is_some() || f.name != "world");
-        // a link moves relative to its parent when its joint is a moving joint (the child's body's joint)
-        let (moving, fixed): (Vec<_>, Vec<_>) = pairs.partition(|(_, f)| f.parent_frame.is_some_and(|p| model.frames[p].body != f.body));
-        let name_of = |f: Option<usize>| f.map_or("world".to_string(), |i| model.frames[i].name.clone());
-        // a parent link's placement on its body (the world's: identity)
-        let placement_of = |f: Option<usize>| f.map_or(Pose::identity(), |p| model.frames[p].placement);
-        let transform = |p: Option<usize>, c: usize| FrameTransform { timestamp: None, parent_frame_id: name_of(p), child_frame_id: name_of(Some(c)), translation: None, rotation: None };
-        self.tf_msg = FrameTransforms { transforms: moving.iter().map(|(c, f)| transform(f.parent_frame, *c)).collect() };
-        self.joint_tfs = moving
-            .iter()
-            .map(|(_, f)| {
-                let joint = f.body.expect("a moving link has a body");
-                JointTransform { joint, before: placement_of(f.parent_frame).inverse().compose(&model.bodies[joint].placement), after: f.placement }
-            })
-            .collect();
-        // links on the same body (or on the world) keep their relative pose: P_parent⁻¹ ∘ P_child
+        let links = LinkTransforms::of(model);
+        let transform = |(parent, child): &(String, String)| FrameTransform { timestamp: None, parent_frame_id: parent.clone(), child_frame_id: child.clone(), translation: None, rotation: None };
+        self.tf_msg = FrameTransforms { transforms: links.moving.iter().map(|(names, _)| transform(names)).collect() };
+        self.joint_tfs = links.moving.into_iter().map(|(_, tf)| tf).collect();
         self.fixed_tf_msg = FrameTransforms {
-            transforms: fixed
+            transforms: links
+                .fixed
                 .iter()
-                .map(|(c, f)| {
-                    let mut m = transform(f.parent_frame, *c);
-                    set_transform(&mut m, &placement_of(f.parent_frame).inverse().compose(&f.placement), None);
+                .map(|(names, pose)| {
+                    let mut m = transform(names);
+                    set_transform(&mut m, pose, None);
                     m
                 })
                 .collect(),
@@ -817,6 +631,52 @@ impl Recorder for McapRecorder {
     }
 }
 
+/// The sinks of a recording: its file (the last one at its path freed meanwhile, see
+/// `create_replacing`), written with `profile` in the MCAP header ("": none; "ros2"), and the live
+/// Foxglove server, with `notice` told where it listens. Errors name `path_for_errors`.
+pub(super) fn open_sinks(options: &McapOptions, profile: &str, path_for_errors: &std::path::Path, notice: Option<fn(&str)>) -> Result<(Sinks, Option<super::output_file::Replaced>), Error> {
+    let mut replaced = None;
+    let file = match &options.file {
+        Some(path) => {
+            let (file, old) = super::output_file::create_replacing(path).map_err(|err| Error::output(path_for_errors, err))?;
+            replaced = Some(old);
+            Some(file)
+        }
+        None => None,
+    };
+    // zstd (with --compress) on the writer thread (`Out`): zstd's own worker threads cost more
+    // than they save here
+    let write_options = mcap::WriteOptions::new()
+        .compression(options.compress.then_some(mcap::Compression::Zstd))
+        .compression_level(zstd_level(ZSTD_LEVEL))
+        .compression_threads(0)
+        // within zstd's window at this level, so no block takes its slower "external
+        // dictionary" path (−5 % of the writer's work at the same size)
+        .chunk_size(Some(512 * 1024))
+        // CRCs with --compress only: the crate checksums every record field by field as it
+        // writes it, twice (5 % of the run's instructions), and the data section's CRC needs
+        // the chunks' (the default is rosbag2's "fastwrite": chunks as they are, no CRCs;
+        // readers skip a zero CRC)
+        .calculate_chunk_crcs(options.compress)
+        .calculate_data_section_crc(options.compress)
+        .profile(profile)
+        .library(if profile == "ros2" { format!("armscope {} (ROS 2 CDR, mcap-rust)", env!("CARGO_PKG_VERSION")) } else { format!("armscope {} (foxglove-sdk schemas, mcap-rust)", env!("CARGO_PKG_VERSION")) });
+    // zstd hands its output over in pieces of up to 128 KiB: gathered here, a chunk (~200 KiB
+    // compressed) takes a write call or two
+    let file = file.map(|file| write_options.create(BufWriter::with_capacity(1 << 20, file))).transpose().map_err(|err| Error::output(path_for_errors, err))?;
+    let live = match &options.live {
+        Some(address) => {
+            let live = FoxgloveLive::start(address).map_err(|err| Error::flag("--foxglove", err))?;
+            if let Some(notice) = notice {
+                notice(&format!("Foxglove live at ws://{} (Foxglove: Open connection → Foxglove WebSocket)", live.address()));
+            }
+            Some(live)
+        }
+        None => None,
+    };
+    Ok((Sinks { file, live }, replaced))
+}
+
 /// The Foxglove layout for the run, beside its recording `mcap`.
 fn write_layout(run: &RunInfo, mcap: &std::path::Path, torque_axes: &[super::torque_axis::TorqueAxis]) -> Result<(), Error> {
     let e = run.experiment;
@@ -831,6 +691,7 @@ fn write_layout(run: &RunInfo, mcap: &std::path::Path, torque_axes: &[super::tor
 #[cfg(test)]
 mod tests {
     use super::*;
+    use mcap::records::MessageHeader;
 
     /// Primitive shapes (a few kB) once a simulated second; a 7 MB mesh scene (a Panda) every 350 s,
     /// so the geometry stays at most 20 kB per simulated second of the file.

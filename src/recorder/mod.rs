@@ -7,6 +7,8 @@ mod contacts;
 pub mod foxglove_layout;
 pub mod foxglove_live;
 mod mcap;
+mod mcap_out;
+mod mcap_ros2;
 pub mod mcap_collisions;
 pub(crate) mod output_file;
 mod overview;
@@ -26,7 +28,8 @@ mod trace;
 mod tutorial_csv;
 
 pub use console::Console;
-pub use mcap::{McapOptions, McapRecorder, TOPIC_CONTROLLER, TOPIC_JOINT_STATES};
+pub use mcap::{McapEncoding, McapOptions, McapRecorder, TOPIC_CONTROLLER, TOPIC_JOINT_STATES};
+pub use mcap_ros2::{Ros2McapRecorder, decode_controller_telemetry};
 pub use robot_description::{RobotDescription, decode as decode_robot_description};
 pub use telemetry::ControllerTelemetry;
 pub use pacer::Pacer;

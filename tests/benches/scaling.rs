@@ -5,6 +5,7 @@
 //!
 //!     cargo bench --bench scaling                 # 30 s, 600 s, 3600 s
 //!     cargo bench --bench scaling -- 30 300       # other durations
+//!     cargo bench --bench scaling -- ros2 30 300  # the MCAP in ROS 2's encoding
 
 use armscope::runner::{Outputs, run_experiment};
 use armscope::config::RunConfig;
@@ -24,14 +25,15 @@ fn peak_memory_mb() -> f64 {
 }
 
 /// One run, in this process: prints `seconds wall rrd_bytes mcap_bytes peak_mb`.
-fn one(seconds: f64) {
+fn one(seconds: f64, ros2: bool) {
     armscope::allocator::return_freed_memory_soon();
     let dir = tempfile::tempdir().unwrap();
     let urdf = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/smallrobot_arm.urdf");
     let experiment = Experiment::prepare(RunConfig { urdf, duration: seconds, ..RunConfig::default() }).unwrap();
     let (rrd, mcap) = (dir.path().join("run.rrd"), dir.path().join("run.mcap"));
     let started = Instant::now();
-    let outputs = Outputs { name: "scaling".into(), rrd: Some(rrd.clone()), mcap: Some(mcap.clone()), ..Outputs::default() };
+    let mcap_encoding = if ros2 { armscope::recorder::McapEncoding::Ros2 } else { armscope::recorder::McapEncoding::Foxglove };
+    let outputs = Outputs { name: "scaling".into(), rrd: Some(rrd.clone()), mcap: Some(mcap.clone()), mcap_encoding, ..Outputs::default() };
     run_experiment(&experiment, outputs, None).unwrap();
     let wall = started.elapsed().as_secs_f64();
     let size = |p: &Path| std::fs::metadata(p).unwrap().len();
@@ -39,10 +41,14 @@ fn one(seconds: f64) {
 }
 
 fn main() {
-    let args: Vec<String> = std::env::args().skip(1).filter(|a| a != "--bench").collect();
+    let mut args: Vec<String> = std::env::args().skip(1).filter(|a| a != "--bench").collect();
+    let ros2 = args.first().is_some_and(|a| a == "ros2");
+    if ros2 {
+        args.remove(0);
+    }
     if let [flag, seconds] = &args[..] {
         if flag == "--one" {
-            one(seconds.parse().unwrap());
+            one(seconds.parse().unwrap(), ros2);
             return;
         }
     }
@@ -50,7 +56,11 @@ fn main() {
     println!("| simulated | wall | wall per simulated s | .rrd | .rrd per simulated s | .mcap | .mcap per simulated s | peak memory |");
     println!("|---|---|---|---|---|---|---|---|");
     for seconds in durations {
-        let out = Command::new(std::env::current_exe().unwrap()).args(["--one", &seconds.to_string()]).output().unwrap();
+        let mut command = Command::new(std::env::current_exe().unwrap());
+        if ros2 {
+            command.arg("ros2");
+        }
+        let out = command.args(["--one", &seconds.to_string()]).output().unwrap();
         assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
         let text = String::from_utf8_lossy(&out.stdout);
         let v: Vec<f64> = text.split_whitespace().map(|x| x.parse().unwrap()).collect();
