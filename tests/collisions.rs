@@ -18,37 +18,171 @@ use serde_json::Value;
 fn distances_are_coals_on_the_same_shapes_and_pairs() {
     // (the mesh model's links never touch at these states: its contact cases are left to the CI check)
     for (file, tolerance, min_contacts) in [("box_model.json", 1e-6, 1), ("smallrobotarm_meshes.json", 1e-5, 0)] {
-        let fixture: Value = serde_json::from_str(&std::fs::read_to_string(common::repo().join("tests/fixtures/collisions").join(file)).unwrap()).unwrap();
+        let fixture = collision_fixture(file);
         let model = load_urdf(&common::repo().join(fixture["urdf"].as_str().unwrap())).unwrap();
-        let c = Collisions::new(&model, None, &Default::default()).unwrap();
-        let pairs: Vec<(String, String)> = c.pairs.iter().map(|&(a, b)| (model.frames[a].name.clone(), model.frames[b].name.clone())).collect();
-        let expected: Vec<(String, String)> = fixture["pairs"].as_array().unwrap().iter().map(|p| (p[0].as_str().unwrap().to_string(), p[1].as_str().unwrap().to_string())).collect();
-        assert_eq!(pairs, expected, "{file}: the active pairs");
-        let (mut compared, mut contacts) = (0, 0);
-        for state in fixture["states"].as_array().unwrap() {
-            let q: Vec<f64> = model.joints.iter().map(|j| state["q"][&j.name].as_f64().unwrap()).collect();
-            let ours = c.at(&model, &q, 0.05);
-            for ((a, b), coal) in expected.iter().zip(state["distances"].as_array().unwrap()) {
-                let coal = coal.as_f64().unwrap();
-                let mine = ours.iter().find(|(x, y, _)| x == a && y == b).map(|p| p.2);
-                if coal.abs() < 1e-3 || mine.is_some_and(|m| m.abs() < 1e-3) {
-                    continue;
+        assert_matches_coal(&model, &fixture, file, tolerance, min_contacts);
+    }
+}
+
+/// The SmallRobotArm's meshes written as COLLADA — in millimetres (`<unit meter="0.001">`), Y up,
+/// each placed by a node transform nested under a turned parent node — are the same surfaces as the
+/// STL files: the same distances as coal's on the STL model, within the same 1e-5 m (the file's
+/// single-precision millimetres are 3e-8 m apart at the arm's reach).
+#[test]
+fn collada_meshes_with_units_up_axis_and_nodes_give_coals_distances() {
+    let dir = tempfile::tempdir().unwrap();
+    let urdf_path = collada_smallrobotarm(dir.path());
+    let package = urdf_path.parent().unwrap();
+    let model = load_urdf(&urdf_path).unwrap();
+    // every link's shapes were read: none left out
+    let collisions = armscope::collision::geometry::CollisionModel::new(&model);
+    assert!(collisions.left_out.is_empty(), "{:?}", collisions.left_out);
+    // and the turn is said, once per file
+    let turned: Vec<_> = model.notices.iter().filter(|n| n.contains("Y_UP")).collect();
+    assert_eq!(turned.len(), std::fs::read_dir(package.join("meshes")).unwrap().count(), "{:?}", model.notices);
+    assert!(turned[0].starts_with("link '") && turned[0].contains(".dae"), "{}", turned[0]);
+    assert_matches_coal(&model, &collision_fixture("smallrobotarm_meshes.json"), "COLLADA SmallRobotArm", 1e-5, 0);
+}
+
+/// The SmallRobotArm mesh model with each STL mesh written as COLLADA ([`collada_mm_y_up`]) in
+/// `dir/smallrobotarm`, with its SRDF; returns the URDF's path.
+fn collada_smallrobotarm(dir: &std::path::Path) -> std::path::PathBuf {
+    let package = dir.join("smallrobotarm");
+    std::fs::create_dir_all(package.join("meshes")).unwrap();
+    let assets = common::repo().join("assets/smallrobotarm");
+    for entry in std::fs::read_dir(assets.join("meshes")).unwrap() {
+        let path = entry.unwrap().path();
+        let mesh = armscope::model::mesh_file::read_mesh(&path).unwrap();
+        let (vertices, triangles) = mesh.welded([1.0; 3]);
+        let name = path.file_stem().unwrap().to_str().unwrap();
+        std::fs::write(package.join("meshes").join(format!("{name}.dae")), collada_mm_y_up(&vertices, &triangles)).unwrap();
+    }
+    let urdf = std::fs::read_to_string(assets.join("smallrobotarm.urdf")).unwrap().replace(".stl\"", ".dae\"");
+    let urdf_path = package.join("smallrobotarm.urdf");
+    std::fs::write(&urdf_path, urdf).unwrap();
+    std::fs::copy(assets.join("smallrobotarm.srdf"), package.join("smallrobotarm.srdf")).unwrap();
+    urdf_path
+}
+
+/// A run of the COLLADA model draws each link's mesh in the `.rrd` as a Rerun mesh (Rerun reads no
+/// COLLADA itself) with every triangle of the file, and the MCAP carries the file as a COLLADA model
+/// for Foxglove.
+#[test]
+fn collada_visuals_are_drawn_in_both_recordings() {
+    let dir = tempfile::tempdir().unwrap();
+    let urdf = collada_smallrobotarm(dir.path());
+    let (rrd, mcap) = (dir.path().join("dae.rrd"), dir.path().join("dae.mcap"));
+    assert_eq!(common::armscope(&["run", "--urdf", urdf.to_str().unwrap(), "--duration", "0.1", "--rrd", rrd.to_str().unwrap(), "--mcap", mcap.to_str().unwrap()]), 0);
+    let model = load_urdf(&urdf).unwrap();
+    let rrd = common::rrd::Rrd::open(&rrd);
+    let entities = rrd.entities();
+    for frame in model.frames.iter().filter(|f| !f.visuals.is_empty()) {
+        let armscope::model::Geometry::Mesh { path, .. } = &frame.visuals[0].geometry else { panic!("{}: a mesh", frame.name) };
+        let triangles = armscope::model::mesh_file::read_mesh(path).unwrap().triangle_count();
+        let entity = entities.keys().find(|e| e.ends_with(&format!("/{}/visual_0", frame.name))).unwrap_or_else(|| panic!("{}'s visual in {:?}", frame.name, entities.keys()));
+        assert_eq!(rrd.static_instances(entity, "Mesh3D:triangle_indices"), triangles, "{entity}");
+    }
+    let bytes = std::fs::read(&mcap).unwrap();
+    let geometry = mcap::MessageStream::new(&bytes).unwrap().map(|m| m.unwrap()).find(|m| m.channel.topic == "/robot/geometry").expect("the geometry");
+    let text = String::from_utf8_lossy(&geometry.data);
+    assert_eq!(text.matches("model/vnd.collada+xml").count(), model.frames.iter().filter(|f| !f.visuals.is_empty()).count());
+}
+
+/// A COLLADA file that is not one (here cut short) leaves the run whole: the link is left out of the
+/// collision checks and undrawn in the `.rrd`, each said in a notice naming the link and the file.
+#[test]
+fn an_unreadable_collada_mesh_is_a_notice_naming_the_link_and_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let urdf = collada_smallrobotarm(dir.path());
+    let broken = urdf.parent().unwrap().join("meshes/link2.dae");
+    let text = std::fs::read_to_string(&broken).unwrap();
+    std::fs::write(&broken, &text[..text.len() / 2]).unwrap();
+    let rrd = dir.path().join("broken.rrd");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_armscope"))
+        .args(["run", "--urdf", urdf.to_str().unwrap(), "--duration", "0.1", "--collisions", "--rrd", rrd.to_str().unwrap(), "--no-mcap"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    for what in ["left out of the collision checks", "not drawn"] {
+        let notice = stderr.lines().find(|l| l.contains(what)).unwrap_or_else(|| panic!("a notice '{what}' in {stderr}"));
+        assert!(notice.contains("link 'link2'") && notice.contains("link2.dae"), "{notice}");
+    }
+    assert!(rrd.exists());
+}
+
+/// A COLLADA document of `vertices` (m, Z up): written in millimetres with Y up, under a parent
+/// node turned a quarter about the file's y and a child node shifted 10 mm, the file's numbers
+/// undoing both.
+fn collada_mm_y_up(vertices: &[[f64; 3]], triangles: &[[u32; 3]]) -> String {
+    // a point p (Z up) is the file's (p.x, p.z, −p.y) under Y up; the parent's turn about the
+    // file's y, (x, y, z) ↦ (z, y, −x), is undone by (x, y, z) ↦ (−z, y, x); the child's shift by −10
+    let file: Vec<String> = vertices
+        .iter()
+        .map(|p| {
+            let (x, y, z) = (p[0] * 1000.0, p[2] * 1000.0, -p[1] * 1000.0);
+            let (x, y, z) = (-z, y, x);
+            format!("{} {} {}", x - 10.0, y, z)
+        })
+        .collect();
+    let indices: Vec<String> = triangles.iter().map(|t| format!("{} {} {}", t[0], t[1], t[2])).collect();
+    format!(
+        r##"<?xml version="1.0" encoding="utf-8"?>
+<COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">
+  <asset><unit name="millimeter" meter="0.001"/><up_axis>Y_UP</up_axis></asset>
+  <library_geometries><geometry id="part" name="part"><mesh>
+    <source id="part-positions"><float_array id="part-positions-array" count="{n3}">{positions}</float_array>
+      <technique_common><accessor source="#part-positions-array" count="{n}" stride="3"><param name="X" type="float"/><param name="Y" type="float"/><param name="Z" type="float"/></accessor></technique_common></source>
+    <vertices id="part-vertices"><input semantic="POSITION" source="#part-positions"/></vertices>
+    <triangles count="{t}"><input semantic="VERTEX" source="#part-vertices" offset="0"/><p>{indices}</p></triangles>
+  </mesh></geometry></library_geometries>
+  <library_visual_scenes><visual_scene id="scene">
+    <node id="turned"><rotate>0 1 0 90</rotate><node id="shifted"><translate>10 0 0</translate><instance_geometry url="#part"/></node></node>
+  </visual_scene></library_visual_scenes>
+  <scene><instance_visual_scene url="#scene"/></scene>
+</COLLADA>
+"##,
+        n3 = 3 * vertices.len(),
+        n = vertices.len(),
+        t = triangles.len(),
+        positions = file.join(" "),
+        indices = indices.join(" "),
+    )
+}
+
+fn collision_fixture(file: &str) -> Value {
+    serde_json::from_str(&std::fs::read_to_string(common::repo().join("tests/fixtures/collisions").join(file)).unwrap()).unwrap()
+}
+
+fn assert_matches_coal(model: &armscope::model::Model, fixture: &Value, file: &str, tolerance: f64, min_contacts: usize) {
+    let c = Collisions::new(model, None, &Default::default()).unwrap();
+    let pairs: Vec<(String, String)> = c.pairs.iter().map(|&(a, b)| (model.frames[a].name.clone(), model.frames[b].name.clone())).collect();
+    let expected: Vec<(String, String)> = fixture["pairs"].as_array().unwrap().iter().map(|p| (p[0].as_str().unwrap().to_string(), p[1].as_str().unwrap().to_string())).collect();
+    assert_eq!(pairs, expected, "{file}: the active pairs");
+    let (mut compared, mut contacts) = (0, 0);
+    for state in fixture["states"].as_array().unwrap() {
+        let q: Vec<f64> = model.joints.iter().map(|j| state["q"][&j.name].as_f64().unwrap()).collect();
+        let ours = c.at(model, &q, 0.05);
+        for ((a, b), coal) in expected.iter().zip(state["distances"].as_array().unwrap()) {
+            let coal = coal.as_f64().unwrap();
+            let mine = ours.iter().find(|(x, y, _)| x == a && y == b).map(|p| p.2);
+            if coal.abs() < 1e-3 || mine.is_some_and(|m| m.abs() < 1e-3) {
+                continue;
+            }
+            match mine {
+                None => assert!(coal > 0.05 - tolerance, "{file}: {a}–{b} at {q:?}: coal {coal}, armscope beyond 5 cm"),
+                Some(m) if coal <= 0.0 => {
+                    assert!(m <= 0.0, "{file}: {a}–{b}: coal in contact ({coal}), armscope {m}");
+                    contacts += 1;
                 }
-                match mine {
-                    None => assert!(coal > 0.05 - tolerance, "{file}: {a}–{b} at {q:?}: coal {coal}, armscope beyond 5 cm"),
-                    Some(m) if coal <= 0.0 => {
-                        assert!(m <= 0.0, "{file}: {a}–{b}: coal in contact ({coal}), armscope {m}");
-                        contacts += 1;
-                    }
-                    Some(m) => {
-                        assert!((m - coal).abs() <= tolerance, "{file}: {a}–{b}: coal {coal}, armscope {m}");
-                        compared += 1;
-                    }
+                Some(m) => {
+                    assert!((m - coal).abs() <= tolerance, "{file}: {a}–{b}: coal {coal}, armscope {m}");
+                    compared += 1;
                 }
             }
         }
-        assert!(compared >= 20 && contacts >= min_contacts, "{file}: {compared} distances and {contacts} contacts compared");
     }
+    assert!(compared >= 20 && contacts >= min_contacts, "{file}: {compared} distances and {contacts} contacts compared");
 }
 
 /// At the box model's zero pose (the arm level at 0.26 m, the carrier's box from 0.1 to 0.26 m), a

@@ -41,28 +41,10 @@ pub(crate) fn parry_shape(geometry: &Geometry) -> Result<SharedShape, String> {
     })
 }
 
-/// An exact triangle mesh from an STL or OBJ file, scaled.
+/// An exact triangle mesh from an STL, OBJ or COLLADA file, scaled, its coincident vertices merged.
 fn mesh(path: &Path, scale: [f64; 3]) -> Result<SharedShape, String> {
-    let extension = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
-    let (vertices, indices): (Vec<[f64; 3]>, Vec<[u32; 3]>) = match extension.as_str() {
-        "stl" => {
-            let mut file = std::fs::File::open(path).map_err(|e| format!("{}: {e}", path.display()))?;
-            let m = stl_io::read_stl(&mut file).map_err(|e| format!("{}: {e}", path.display()))?;
-            (m.vertices.iter().map(|v| [v[0] as f64, v[1] as f64, v[2] as f64]).collect(), m.faces.iter().map(|f| f.vertices.map(|i| i as u32)).collect())
-        }
-        "obj" => {
-            let (models, _) = tobj::load_obj(path, &tobj::GPU_LOAD_OPTIONS).map_err(|e| format!("{}: {e}", path.display()))?;
-            let (mut vertices, mut indices) = (Vec::new(), Vec::new());
-            for m in models {
-                let base = vertices.len() as u32;
-                vertices.extend(m.mesh.positions.chunks(3).map(|p| [p[0] as f64, p[1] as f64, p[2] as f64]));
-                indices.extend(m.mesh.indices.chunks(3).map(|t| [base + t[0], base + t[1], base + t[2]]));
-            }
-            (vertices, indices)
-        }
-        other => return Err(format!("{}: a .{other} mesh is not read for collisions (STL and OBJ are)", path.display())),
-    };
-    let vertices: Vec<Vector> = vertices.iter().map(|v| Vector::new(v[0] * scale[0], v[1] * scale[1], v[2] * scale[2])).collect();
+    let (vertices, indices) = crate::model::mesh_file::read_mesh(path)?.welded(scale);
+    let vertices: Vec<Vector> = vertices.iter().map(|v| Vector::new(v[0], v[1], v[2])).collect();
     SharedShape::trimesh(vertices, indices).map_err(|e| format!("{}: {e:?}", path.display()))
 }
 

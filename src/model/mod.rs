@@ -1,6 +1,7 @@
 //! The read-only robot model: built once from a URDF, shared by every simulation of it.
 
 mod error;
+pub mod mesh_file;
 mod joint_motion;
 mod urdf;
 

@@ -191,6 +191,7 @@ fn build(text: &str, source: &Path, options: LoadOptions) -> Result<Model, K> {
     if let Some(unreached) = frame_of_link.iter().position(|f| f.is_none()) {
         return Err(K::Cycle(robot.links[unreached].name.clone()));
     }
+    collada_up_axis_notices(&frames, &mut notices);
     if bodies.is_empty() {
         return Err(K::NoMovingJoints);
     }
@@ -515,6 +516,28 @@ fn link_collisions(link: &urdf_rs::Link, base_dir: &Path, notices: &mut Vec<Stri
             }
         })
         .collect()
+}
+
+/// One notice per COLLADA file that declares an up axis other than z: it is turned (the spec's
+/// reading, Foxglove's and Gazebo's), which RViz, MoveIt and Pinocchio do not do — the one place
+/// those tools draw the same file differently.
+fn collada_up_axis_notices(frames: &[Frame], notices: &mut Vec<String>) {
+    let mut seen = std::collections::HashSet::new();
+    for frame in frames {
+        for shape in frame.visuals.iter().chain(&frame.collisions) {
+            let Geometry::Mesh { path, .. } = &shape.geometry else { continue };
+            if !super::mesh_file::is_collada(path) || !seen.insert(path.clone()) {
+                continue;
+            }
+            if let Some(up) = super::mesh_file::declared_up_axis(path).filter(|up| up != "Z_UP") {
+                notices.push(format!(
+                    "link '{}': mesh {} is {up} (COLLADA's <up_axis>): turned so that its up axis is z, as Foxglove and Gazebo draw it (RViz, MoveIt and Pinocchio leave it unturned)",
+                    frame.name,
+                    path.display()
+                ));
+            }
+        }
+    }
 }
 
 fn geometry(g: &urdf_rs::Geometry, base_dir: &Path) -> Result<Geometry, String> {

@@ -131,7 +131,7 @@ impl Default for ToolPath {
 
 impl ToolPath {
     pub(super) fn push(&mut self, p: Point3) {
-        self.overview.push(p.clone());
+        self.overview.push(p);
         self.piece.push(p);
     }
 
@@ -146,8 +146,8 @@ impl ToolPath {
             return None;
         }
         let red = color([1.0, 0.25, 0.2, 1.0]);
-        let last = self.piece.last().cloned().expect("two points");
-        let piece = std::mem::replace(&mut self.piece, vec![last.clone()]);
+        let last = *self.piece.last().expect("two points");
+        let piece = std::mem::replace(&mut self.piece, vec![last]);
         let mut overview = self.overview.points().to_vec();
         if overview.last() != Some(&last) {
             overview.push(last);
@@ -505,7 +505,8 @@ impl Recorder for McapRecorder {
 
     fn record(&mut self, s: &Sample) -> Result<(), Error> {
         let stamp = self.stamp(s.t);
-        let ts = Some(self.timestamp(s.t));
+        let timestamp = self.timestamp(s.t);
+        let ts = Some(timestamp);
         let model = self.model.as_ref().expect("started");
         let pose_step = s.k.is_multiple_of(self.steps_per_tf) || s.is_final;
         if pose_step {
@@ -568,7 +569,7 @@ impl Recorder for McapRecorder {
         out.log_encoded(&mut ch.joint_states, |bytes| self.joint_states.encode(ts.as_ref(), &self.joint_values, bytes), stamp).map_err(fail)?;
         out.log_encoded(&mut ch.controller, |bytes| super::step_messages::controller_telemetry(&self.telemetry, bytes), stamp).map_err(fail)?;
         if let (Some(c), Some((state, contacts))) = (self.collisions.as_mut(), ch.collisions.as_mut()) {
-            if let Some(update) = c.record(s, ts.unwrap_or_default()) {
+            if let Some(update) = c.record(s, timestamp) {
                 out.log(contacts, &update, stamp).map_err(fail)?;
             }
             out.log(state, &c.state, stamp).map_err(fail)?;

@@ -87,8 +87,8 @@ fn rgba(c: &foxglove::messages::Color) -> ColorRgba {
 
 fn fox_pose(p: &Option<foxglove::messages::Pose>) -> Pose {
     let Some(p) = p else { return Pose::default() };
-    let t = p.position.clone().unwrap_or_default();
-    let q = p.orientation.clone().unwrap_or(foxglove::messages::Quaternion { x: 0.0, y: 0.0, z: 0.0, w: 1.0 });
+    let t = p.position.unwrap_or_default();
+    let q = p.orientation.unwrap_or(foxglove::messages::Quaternion { x: 0.0, y: 0.0, z: 0.0, w: 1.0 });
     Pose { position: Vector3 { x: t.x, y: t.y, z: t.z }, orientation: Quaternion { x: q.x, y: q.y, z: q.z, w: q.w } }
 }
 

@@ -305,10 +305,24 @@ impl RerunRecorder {
                 }
                 rec.log_static(path.as_str(), &t).map_err(|x| self.err(x))?;
                 let color = visual.rgba.map(|c| rerun::Color::from_unmultiplied_rgba((c[0] * 255.0) as u8, (c[1] * 255.0) as u8, (c[2] * 255.0) as u8, (c[3] * 255.0) as u8));
-                let color = color.unwrap_or(rerun::Color::from_rgb(170, 170, 180));
+                // a COLLADA mesh without a URDF colour keeps its materials' colours (untinted)
+                let collada = matches!(&visual.geometry, Geometry::Mesh { path, .. } if crate::model::mesh_file::is_collada(path));
+                let color = color.unwrap_or(if collada { rerun::Color::WHITE } else { rerun::Color::from_rgb(170, 170, 180) });
                 // a checked link turns red in contact: its colour is then temporal, not static
                 let highlighted = self.collisions.as_ref().is_some_and(|c| c.checked(f));
-                let kind = log_geometry(rec, &path, &visual.geometry, (!highlighted).then_some(color)).map_err(|m| self.err(m))?;
+                let kind = match log_geometry(rec, &path, &visual.geometry, (!highlighted).then_some(color)) {
+                    Ok(kind) => kind,
+                    // a mesh that cannot be read leaves its link undrawn, not the run unrecorded
+                    Err(why) if matches!(visual.geometry, Geometry::Mesh { .. }) => {
+                        let notice = format!("link '{}': {why}; its visual is not drawn in the .rrd", frame.name);
+                        if let Some(report) = &self.notice_sink {
+                            report(&notice);
+                        }
+                        self.notices.push(notice);
+                        continue;
+                    }
+                    Err(why) => return Err(self.err(why)),
+                };
                 if let (true, Some(c)) = (highlighted, self.collisions.as_mut()) {
                     c.register(f, Recolour { path, kind, colour: color });
                 }

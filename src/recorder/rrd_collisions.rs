@@ -22,6 +22,7 @@ pub enum Kind {
     Capsules,
     Ellipsoids,
     Asset,
+    Mesh,
 }
 
 /// An entity whose colour changes with contact, and its own colour.
@@ -70,6 +71,15 @@ pub fn log_geometry(rec: &RecordingStream, path: &str, geometry: &Geometry, colo
             }))?;
             Kind::Ellipsoids
         }
+        // Rerun reads STL and OBJ itself; COLLADA goes as the triangles read here
+        Geometry::Mesh { path: file, .. } if crate::model::mesh_file::is_collada(file) => {
+            let mesh = crate::model::mesh_file::read_mesh(file)?;
+            r(rec.log_static(path, &match colour {
+                Some(c) => mesh3d(&mesh).with_albedo_factor(c.0),
+                None => mesh3d(&mesh),
+            }))?;
+            Kind::Mesh
+        }
         Geometry::Mesh { path: file, .. } => {
             let asset = rerun::Asset3D::from_file_path(file).map_err(|e| format!("{}: {e}", file.display()))?;
             r(rec.log_static(path, &match colour {
@@ -81,6 +91,39 @@ pub fn log_geometry(rec: &RecordingStream, path: &str, geometry: &Geometry, colo
     })
 }
 
+/// The grey of a mesh part whose file gives it no colour.
+const MESH_GREY: [f32; 4] = [0.67, 0.67, 0.7, 1.0];
+
+/// A mesh file's parts as one Rerun mesh, each part in its material's colour; corners with the
+/// same position, normal and colour are one vertex (a file's per-corner vertices would make the
+/// recording larger than the file).
+fn mesh3d(mesh: &crate::model::mesh_file::MeshFile) -> rerun::Mesh3D {
+    let with_normals = mesh.parts.iter().all(|p| p.normals.len() == p.vertices.len());
+    let (mut positions, mut normals, mut colours, mut triangles) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let mut index_of: std::collections::HashMap<([u32; 3], [u32; 3], u32), u32> = std::collections::HashMap::new();
+    for part in &mesh.parts {
+        let [r, g, b, a] = part.colour.unwrap_or(MESH_GREY).map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8);
+        let colour = Color::from_unmultiplied_rgba(r, g, b, a);
+        let corner: Vec<u32> = (0..part.vertices.len())
+            .map(|k| {
+                let normal = if with_normals { part.normals[k] } else { [0.0; 3] };
+                let key = (part.vertices[k].map(f32::to_bits), normal.map(f32::to_bits), colour.0.0);
+                *index_of.entry(key).or_insert_with(|| {
+                    positions.push(part.vertices[k]);
+                    if with_normals {
+                        normals.push(normal);
+                    }
+                    colours.push(colour);
+                    positions.len() as u32 - 1
+                })
+            })
+            .collect();
+        triangles.extend(part.triangles.iter().map(|t| t.map(|v| corner[v as usize])));
+    }
+    let out = rerun::Mesh3D::new(positions).with_triangle_indices(triangles).with_vertex_colors(colours);
+    if with_normals { out.with_vertex_normals(normals) } else { out }
+}
+
 fn log_colour(rec: &RecordingStream, r: &Recolour, colour: Color) -> RecordingStreamResult<()> {
     let path = r.path.as_str();
     match r.kind {
@@ -89,6 +132,7 @@ fn log_colour(rec: &RecordingStream, r: &Recolour, colour: Color) -> RecordingSt
         Kind::Capsules => rec.log(path, &rerun::Capsules3D::update_fields().with_colors([colour])),
         Kind::Ellipsoids => rec.log(path, &rerun::Ellipsoids3D::update_fields().with_colors([colour])),
         Kind::Asset => rec.log(path, &rerun::Asset3D::update_fields().with_albedo_factor(colour.0)),
+        Kind::Mesh => rec.log(path, &rerun::Mesh3D::update_fields().with_albedo_factor(colour.0)),
     }
 }
 

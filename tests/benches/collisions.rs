@@ -23,7 +23,7 @@ fn checks(c: &mut Criterion) {
             seed ^= seed << 17;
             (seed >> 11) as f64 / (1u64 << 53) as f64
         };
-        let states: Vec<Vec<f64>> = (0..64).map(|_| model.joints.iter().map(|j| j.lower.max(-3.14) + (j.upper.min(3.14) - j.lower.max(-3.14)) * uniform()).collect()).collect();
+        let states: Vec<Vec<f64>> = (0..64).map(|_| model.joints.iter().map(|j| j.lower.max(-std::f64::consts::PI) + (j.upper.min(std::f64::consts::PI) - j.lower.max(-std::f64::consts::PI)) * uniform()).collect()).collect();
         let mut data = Data::new(&model);
         let mut cd = CollisionData::new(&collisions.shapes);
         let mut out = StateCollisions::default();

@@ -158,6 +158,18 @@ impl Rrd {
         rows
     }
 
+    /// How many instances an entity's static `component` holds (a mesh's triangles, a batch's
+    /// boxes), over its static rows.
+    pub fn static_instances(&self, entity: &str, component: &str) -> usize {
+        let mut count = 0;
+        for chunk in self.chunks.iter().filter(|c| c.is_static() && c.entity_path().to_string() == entity) {
+            if let Some(column) = chunk.components().0.values().find(|c| c.descriptor.component.as_str() == component) {
+                count += (0..column.list_array.len()).filter(|&k| !column.list_array.is_null(k)).map(|k| column.list_array.value(k).len()).sum::<usize>();
+            }
+        }
+        count
+    }
+
     /// The `Scalars:scalars` rows of an entity.
     pub fn series(&self, entity: &str) -> Vec<(f64, Vec<f64>)> {
         self.component(entity, "Scalars:scalars")
