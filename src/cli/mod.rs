@@ -7,6 +7,7 @@ mod compare;
 mod envelope;
 mod identify;
 mod model;
+mod replay;
 mod run;
 mod size;
 mod testbench;
@@ -19,6 +20,7 @@ pub use compare::{CompareArgs, compare};
 pub use envelope::{EnvelopeArgs, envelope};
 pub use identify::{IdentifyArgs, identify};
 pub use model::{ModelArgs, model};
+pub use replay::{ReplayArgs, replay, trace_path};
 pub use crate::flags::{GainArgs, MotorArgs, RunArgs, WaveArgs};
 pub use run::{default_run_name, run};
 pub use size::{SizeArgs, parse_ratios, size};
@@ -69,6 +71,9 @@ pub enum Command {
     Testbench(TestbenchArgs),
     /// Fit a servo's parameters (BAM's JSON) to bench logs, and check them on held-out logs.
     Identify(IdentifyArgs),
+    /// What a real arm's recorded motion took: a LeRobot dataset, ROS 2 bag or CSV into the torque
+    /// each joint needed, held against what its motor gives; the episodes that overloaded first.
+    Replay(ReplayArgs),
 }
 
 /// Parse `args` and run; returns the process exit code. Errors are printed as one line.
@@ -113,6 +118,7 @@ fn run_command(command: Command) -> Result<i32, Error> {
         Command::Catalogue(args) => catalogue(&args),
         Command::Testbench(args) => testbench(&args),
         Command::Identify(args) => identify(&args),
+        Command::Replay(args) => replay(&args),
     }
 }
 

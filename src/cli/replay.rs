@@ -1,0 +1,158 @@
+//! `armscope replay`: a recorded motion (LeRobot dataset, ROS 2 bag, armscope `.mcap`, CSV) into
+//! the torque each joint needed, held against what its motor gives.
+
+use super::*;
+use crate::motion::{JointMap, Source};
+use crate::replay::{ReplayOptions, Replayer, replay_episodes, report};
+
+#[derive(Args, Debug)]
+pub struct ReplayArgs {
+    /// The recording: a LeRobot dataset folder (v2.1 or v3.0), a ROS 2 bag or armscope recording
+    /// (.mcap with sensor_msgs/msg/JointState or foxglove.JointStates), or a CSV (`t` and a column
+    /// per joint, SI units).
+    #[arg(value_name = "SOURCE")]
+    pub source: PathBuf,
+    /// The arm's URDF.
+    #[arg(long, value_name = "PATH")]
+    pub urdf: PathBuf,
+    /// Episodes to replay (comma list; default: all).
+    #[arg(long, value_delimiter = ',', num_args = 1)]
+    pub episode: Option<Vec<i64>>,
+    /// The dataset's columns to replay: `observation.state` (the follower's positions) or `action`
+    /// (the commands).
+    #[arg(long, default_value = "observation.state")]
+    pub feature: String,
+    /// How the recording's columns become the URDF's joints (TOML: `[joints.NAME] column, unit,
+    /// sign, offset`; optionally a LeRobot `calibration` file). Built in: bags and tables named by
+    /// joint in SI units, the SO-101's LeRobot datasets.
+    #[arg(long, value_name = "FILE")]
+    pub joint_map: Option<PathBuf>,
+    /// A bag's joint-state topic (default: /joint_states, or the only one).
+    #[arg(long)]
+    pub topic: Option<String>,
+    /// A payload at the tool, kg.
+    #[arg(long, default_value_t = 0.0)]
+    pub payload: f64,
+    /// The link whose origin is the tool (where the payload sits; default: the deepest link).
+    #[arg(long, value_name = "LINK")]
+    pub tool: Option<String>,
+    /// A motor file: each joint's motor and gearbox (the torque it gives at speed, the rotor's
+    /// reflected inertia, the winding's heat); without it, the URDF's effort limits.
+    #[arg(long, value_name = "FILE")]
+    pub motors: Option<PathBuf>,
+    /// Write `t,q1..qN,qd1..qN,qdd1..qN,tau1..tauN` per sample (several episodes: one file each,
+    /// `STEM_episode_N.csv`).
+    #[arg(long, value_name = "FILE")]
+    pub trace: Option<PathBuf>,
+    /// Write every episode's findings as JSON.
+    #[arg(long, value_name = "FILE")]
+    pub summary_json: Option<PathBuf>,
+    /// Where to write the Rerun recording of the episode (several: of the most loaded one; default:
+    /// recordings/replay_SOURCE[_episode_N].rrd).
+    #[arg(long, value_name = "PATH")]
+    pub rrd: Option<PathBuf>,
+    /// Where to write its MCAP (default: recordings/replay_SOURCE[_episode_N].mcap).
+    #[arg(long, value_name = "PATH")]
+    pub mcap: Option<PathBuf>,
+    /// No Rerun recording file.
+    #[arg(long)]
+    pub no_rrd: bool,
+    /// No MCAP file.
+    #[arg(long)]
+    pub no_mcap: bool,
+    /// The MCAP's encoding, as `run --mcap-encoding`.
+    #[arg(long, value_enum, default_value_t = crate::recorder::McapEncoding::Foxglove)]
+    pub mcap_encoding: crate::recorder::McapEncoding,
+    /// Episodes at once (default: all cores).
+    #[arg(long)]
+    pub jobs: Option<usize>,
+}
+
+/// `armscope replay`.
+pub fn replay(args: &ReplayArgs) -> Result<i32, Error> {
+    let model = crate::model::load_urdf(&args.urdf)?;
+    let source = Source::open(&args.source, args.topic.as_deref())?;
+    let episodes = match &args.episode {
+        Some(list) => list.clone(),
+        None => source.episodes(),
+    };
+    if episodes.is_empty() {
+        return Err(Error::flag(args.source.display().to_string(), "no episodes"));
+    }
+    let first = source.read(episodes[0], &args.feature)?;
+    let map = match &args.joint_map {
+        Some(path) => JointMap::load(path, &model)?,
+        None => match JointMap::builtin(source.kind(), &model, &first) {
+            Some(map) => map,
+            None => {
+                println!("{}", JointMap::template(&model, &first.column_names()));
+                return Err(Error::flag("--joint-map", format!("needed: armscope knows no map from {}'s columns to {}'s joints; a template is printed above", args.source.display(), args.urdf.display())));
+            }
+        },
+    };
+    drop(first);
+    let options = ReplayOptions { payload: args.payload, tool: args.tool.clone(), motors: args.motors.clone() };
+    let replayer = Replayer::new(model, &options, map)?;
+    for notice in &replayer.model.notices {
+        eprintln!("armscope: notice: {notice}");
+    }
+    eprintln!("armscope: joint map: {}", replayer.map.source);
+    let jobs = args.jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
+    let several = episodes.len() > 1;
+    let trace = args.trace.clone();
+    let write_trace = move |index: i64, replay: &crate::replay::EpisodeReplay| -> Result<(), Error> {
+        let Some(path) = &trace else { return Ok(()) };
+        let path = if several { trace_path(path, index) } else { path.clone() };
+        crate::replay::trace::write(&path, &replay.motion)
+    };
+    let summaries = replay_episodes(&replayer, &source, &episodes, &args.feature, jobs, &write_trace)?;
+    for s in &summaries {
+        for notice in &s.notices {
+            eprintln!("armscope: notice: {notice}");
+        }
+    }
+    if several {
+        print!("{}", report::ranking_text(&summaries));
+        println!("\nthe most loaded:");
+    }
+    if let Some(worst) = summaries.first() {
+        print!("{}", report::episode_text(&replayer, worst));
+    }
+    if let Some(worst) = summaries.first()
+        && !(args.no_rrd && args.no_mcap)
+    {
+        // the most loaded episode again, whole, into the recordings
+        let index = worst.index.unwrap_or(0);
+        let episode = source.read(index, &args.feature)?;
+        let replay = replayer.replay(&episode)?;
+        let stem = args.source.file_stem().map_or("recording".into(), |s| s.to_string_lossy().into_owned());
+        let name = crate::runner::file_safe(&match worst.index {
+            Some(i) => format!("replay_{stem}_episode_{i}"),
+            None => format!("replay_{stem}"),
+        });
+        let recordings = PathBuf::from("recordings");
+        let outputs = crate::replay::recording::RecordingOutputs {
+            rrd: (!args.no_rrd).then(|| args.rrd.clone().unwrap_or_else(|| recordings.join(format!("{name}.rrd")))),
+            mcap: (!args.no_mcap).then(|| args.mcap.clone().unwrap_or_else(|| recordings.join(format!("{name}.mcap")))),
+            mcap_encoding: args.mcap_encoding,
+            name,
+        };
+        crate::replay::recording::record(&replayer, &replay, &outputs)?;
+        for path in outputs.rrd.iter().chain(&outputs.mcap) {
+            eprintln!("armscope: wrote {}", path.display());
+        }
+    }
+    if let Some(path) = &args.summary_json {
+        let doc = report::summary_json(&replayer, &args.source.display().to_string(), &summaries);
+        let text = serde_json::to_string_pretty(&doc).map_err(|e| Error::output(path, e))?;
+        std::fs::write(path, text + "\n").map_err(|e| Error::output(path, e))?;
+    }
+    Ok(0)
+}
+
+/// `trace.csv` → `trace_episode_7.csv`.
+pub fn trace_path(path: &std::path::Path, index: i64) -> PathBuf {
+    let stem = path.file_stem().map_or("trace".into(), |s| s.to_string_lossy().into_owned());
+    let ext = path.extension().map_or("csv".into(), |e| e.to_string_lossy().into_owned());
+    path.with_file_name(format!("{stem}_episode_{index}.{ext}"))
+}

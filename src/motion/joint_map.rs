@@ -1,0 +1,242 @@
+//! How a recording's columns become the URDF's joint coordinates (`--joint-map FILE.toml`):
+//!
+//! ```toml
+//! calibration = "so101_follower.json"   # optional: a LeRobot calibration file
+//! [joints.shoulder_pan]
+//! column = "shoulder_pan.pos"
+//! unit = "deg"          # deg | rad | m | range_0_100 | range_m100_100
+//! sign = 1              # q = sign·value_in_rad + offset
+//! offset = 0.0          # rad (m for a prismatic joint)
+//! ```
+//!
+//! A range maps linearly onto the joint's URDF limits (0…100 or −100…100 from lower to upper; sign
+//! −1 from upper to lower). With a LeRobot calibration file (`range_min`, `range_max`, `drive_mode`
+//! per motor) the value is turned back into the motor's tick t, as LeRobot's normalization made
+//! it, and the angle measured from the calibration pose, which reads tick 2047:
+//! q = sign·s·(t − 2047)·2π/4096 + offset, s = −1 where `drive_mode` is 1.
+
+use super::{Episode, SourceKind};
+use crate::error::Error;
+use crate::model::{JointKind, Model};
+use serde::Deserialize;
+use std::collections::BTreeMap;
+use std::f64::consts::TAU;
+use std::path::{Path, PathBuf};
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Unit {
+    Deg,
+    Rad,
+    /// Metres (a prismatic joint; the same as `rad`: SI).
+    M,
+    #[serde(rename = "range_0_100")]
+    Range0To100,
+    #[serde(rename = "range_m100_100")]
+    RangeM100To100,
+}
+
+impl Unit {
+    fn name(self) -> &'static str {
+        match self {
+            Unit::Deg => "deg",
+            Unit::Rad => "rad",
+            Unit::M => "m",
+            Unit::Range0To100 => "range_0_100",
+            Unit::RangeM100To100 => "range_m100_100",
+        }
+    }
+}
+
+/// LeRobot's per-motor calibration record.
+#[derive(Clone, Copy, Debug, Deserialize)]
+pub struct MotorCalibration {
+    #[serde(default)]
+    pub drive_mode: i64,
+    #[serde(default)]
+    pub homing_offset: i64,
+    pub range_min: f64,
+    pub range_max: f64,
+}
+
+/// The encoder's ticks per turn on LeRobot's Feetech and Dynamixel servos, and the tick the
+/// calibration pose reads.
+const TICKS_PER_TURN: f64 = 4096.0;
+const CALIBRATION_TICK: f64 = 2047.0;
+
+#[derive(Clone, Debug)]
+pub struct Entry {
+    pub joint: usize,
+    pub column: String,
+    pub unit: Unit,
+    pub sign: f64,
+    pub offset: f64,
+    pub calibration: Option<MotorCalibration>,
+}
+
+/// Every mapped coordinate of a model, and where its values come from.
+#[derive(Clone, Debug)]
+pub struct JointMap {
+    pub entries: Vec<Entry>,
+    /// The map file, or what the built-in map is.
+    pub source: String,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MapFile {
+    calibration: Option<PathBuf>,
+    joints: BTreeMap<String, JointEntry>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct JointEntry {
+    column: String,
+    unit: Unit,
+    #[serde(default = "one")]
+    sign: f64,
+    #[serde(default)]
+    offset: f64,
+    /// The motor's name in the calibration file (default: the column without `.pos`).
+    motor: Option<String>,
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+/// The built-in map of the SO-101 (example-robot-data's `so101.urdf`, the SO-ARM100 repository's
+/// `so101_new_calib.urdf`): LeRobot's own kinematics passes the five body joints' degrees to it as
+/// they are (sign +1, offset 0: `lerobot/model/kinematics.py`), the gripper's 0…100 spans its
+/// travel.
+const SO101_URDF: &str = "so101_new_calib";
+const SO101_JOINTS: [(&str, Unit); 6] = [("shoulder_pan", Unit::Deg), ("shoulder_lift", Unit::Deg), ("elbow_flex", Unit::Deg), ("wrist_flex", Unit::Deg), ("wrist_roll", Unit::Deg), ("gripper", Unit::Range0To100)];
+
+impl JointMap {
+    /// Read a map file and check its joints against the model.
+    pub fn load(path: &Path, model: &Model) -> Result<Self, Error> {
+        let fail = |m: String| Error::flag(path.display().to_string(), m);
+        let text = std::fs::read_to_string(path).map_err(|e| fail(e.to_string()))?;
+        let file: MapFile = toml::from_str(&text).map_err(|e| fail(e.message().to_string()))?;
+        let calibration: Option<BTreeMap<String, MotorCalibration>> = match &file.calibration {
+            Some(c) => {
+                let c = if c.is_relative() { path.parent().unwrap_or(Path::new(".")).join(c) } else { c.clone() };
+                let text = std::fs::read_to_string(&c).map_err(|e| Error::flag(c.display().to_string(), e.to_string()))?;
+                Some(serde_json::from_str(&text).map_err(|e| Error::flag(c.display().to_string(), format!("not a LeRobot calibration file: {e}")))?)
+            }
+            None => None,
+        };
+        let mut entries = Vec::new();
+        for (name, e) in file.joints {
+            let joint = model.joint_index(&name).ok_or_else(|| fail(format!("[joints.{name}]: no moving joint '{name}' in {} (joints: {})", model.source.display(), joint_names(model))))?;
+            if !(e.sign == 1.0 || e.sign == -1.0) {
+                return Err(fail(format!("[joints.{name}]: sign must be 1 or -1 (got {})", e.sign)));
+            }
+            if !e.offset.is_finite() {
+                return Err(fail(format!("[joints.{name}]: offset must be a number")));
+            }
+            let ranged = matches!(e.unit, Unit::Range0To100 | Unit::RangeM100To100);
+            let limits = model.joints[joint].lower.is_finite() && model.joints[joint].upper.is_finite();
+            let motor = e.motor.clone().unwrap_or_else(|| e.column.trim_end_matches(".pos").to_string());
+            let calibration = match &calibration {
+                Some(c) => Some(*c.get(&motor).ok_or_else(|| fail(format!("[joints.{name}]: no motor '{motor}' in the calibration file (motors: {})", c.keys().cloned().collect::<Vec<_>>().join(", "))))?),
+                None => None,
+            };
+            if ranged && calibration.is_none() && !limits {
+                return Err(fail(format!("[joints.{name}]: unit {} maps onto the joint's limits, and the URDF gives it none (give a calibration file, or unit deg/rad)", e.unit.name())));
+            }
+            entries.push(Entry { joint, column: e.column, unit: e.unit, sign: e.sign, offset: e.offset, calibration });
+        }
+        entries.sort_by_key(|e| e.joint);
+        Ok(Self { entries, source: path.display().to_string() })
+    }
+
+    /// The map armscope knows for this model and recording, if there is one: a bag's or a table's
+    /// columns named by joint (SI units), the SO-101's LeRobot datasets.
+    pub fn builtin(kind: SourceKind, model: &Model, episode: &Episode) -> Option<Self> {
+        match kind {
+            SourceKind::Bag | SourceKind::Csv => {
+                let entries: Vec<Entry> = model
+                    .joints
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, j)| episode.column(&j.name).is_some())
+                    .map(|(joint, j)| Entry { joint, column: j.name.clone(), unit: if j.kind == JointKind::Prismatic { Unit::M } else { Unit::Rad }, sign: 1.0, offset: 0.0, calibration: None })
+                    .collect();
+                (!entries.is_empty()).then(|| Self { entries, source: "columns named by joint, SI units".into() })
+            }
+            SourceKind::LeRobot => {
+                if model.name != SO101_URDF {
+                    return None;
+                }
+                let mut entries = Vec::new();
+                for (name, unit) in SO101_JOINTS {
+                    let joint = model.joint_index(name)?;
+                    let column = format!("{name}.pos");
+                    episode.column(&column)?;
+                    entries.push(Entry { joint, column, unit, sign: 1.0, offset: 0.0, calibration: None });
+                }
+                Some(Self { entries, source: "built-in SO-101 map (LeRobot's degrees, sign +1, offset 0; gripper 0…100 over its limits)".into() })
+            }
+        }
+    }
+
+    /// A map file to fill in for this model and recording: each joint with the column of the same
+    /// position in the recording, if there is one.
+    pub fn template(model: &Model, columns: &[&str]) -> String {
+        let mut out = String::from("# armscope joint map: q = sign·value_in_rad + offset (rad; m for a prismatic joint)\n");
+        out += &format!("# recording's columns: {}\n", columns.join(", "));
+        out += "# calibration = \"so101_follower.json\"   # a LeRobot calibration file, optional\n";
+        for (k, j) in model.joints.iter().enumerate() {
+            let column = columns.get(k).copied().unwrap_or("COLUMN");
+            out += &format!("\n[joints.{}]\ncolumn = \"{column}\"\nunit = \"deg\"   # deg | rad | m | range_0_100 | range_m100_100\nsign = 1\noffset = 0.0\n", j.name);
+        }
+        out
+    }
+
+    /// The recording's columns in the model's coordinates: per coordinate its series, `None` where
+    /// the map leaves the joint out.
+    pub fn apply(&self, model: &Model, episode: &Episode) -> Result<Vec<Option<Vec<f64>>>, Error> {
+        let mut out: Vec<Option<Vec<f64>>> = vec![None; model.dof()];
+        for e in &self.entries {
+            let column = episode.column(&e.column).ok_or_else(|| {
+                Error::flag(self.source.clone(), format!("joint '{}': no column '{}' in {} (columns: {})", model.joints[e.joint].name, e.column, episode.label, episode.column_names().join(", ")))
+            })?;
+            let joint = &model.joints[e.joint];
+            out[e.joint] = Some(column.values.iter().map(|&v| e.to_coordinate(v, joint.lower, joint.upper)).collect());
+        }
+        Ok(out)
+    }
+}
+
+impl Entry {
+    /// One recorded value in the joint's coordinate.
+    pub fn to_coordinate(&self, value: f64, lower: f64, upper: f64) -> f64 {
+        if let Some(c) = &self.calibration {
+            let (lo, hi) = (c.range_min, c.range_max);
+            // back to the motor's tick, as LeRobot normalized it (`_normalize`)
+            let tick = match self.unit {
+                Unit::Deg => value * (TICKS_PER_TURN - 1.0) / 360.0 + 0.5 * (lo + hi),
+                Unit::Rad | Unit::M => value * (TICKS_PER_TURN - 1.0) / TAU + 0.5 * (lo + hi),
+                Unit::RangeM100To100 => (value + 100.0) / 200.0 * (hi - lo) + lo,
+                Unit::Range0To100 => value / 100.0 * (hi - lo) + lo,
+            };
+            let drive = if c.drive_mode == 1 { -1.0 } else { 1.0 };
+            return self.sign * drive * (tick - CALIBRATION_TICK) * TAU / TICKS_PER_TURN + self.offset;
+        }
+        match self.unit {
+            Unit::Deg => self.sign * value.to_radians() + self.offset,
+            Unit::Rad | Unit::M => self.sign * value + self.offset,
+            Unit::Range0To100 | Unit::RangeM100To100 => {
+                let fraction = if self.unit == Unit::Range0To100 { value / 100.0 } else { (value + 100.0) / 200.0 };
+                let fraction = if self.sign < 0.0 { 1.0 - fraction } else { fraction };
+                lower + fraction * (upper - lower) + self.offset
+            }
+        }
+    }
+}
+
+fn joint_names(model: &Model) -> String {
+    model.joints.iter().map(|j| j.name.as_str()).collect::<Vec<_>>().join(", ")
+}

@@ -1,0 +1,136 @@
+//! Recorded motion of a real arm, read from where people keep it: LeRobot datasets (parquet), ROS 2
+//! bags and armscope recordings (`.mcap`), CSV tables. Each source gives episodes: sample times and
+//! named columns of values in the source's own units; [`joint_map`] turns them into the URDF's
+//! coordinates.
+
+pub mod bag;
+pub mod csv;
+pub mod joint_map;
+pub mod lerobot;
+
+pub use joint_map::JointMap;
+
+use crate::error::Error;
+use std::path::{Path, PathBuf};
+
+/// One recorded motion: samples at `time`, and per named column its values there.
+#[derive(Clone, Debug, Default)]
+pub struct Episode {
+    /// How reports name it ("episode 3", the file's name).
+    pub label: String,
+    /// The dataset's episode index, where it has one.
+    pub index: Option<i64>,
+    /// Seconds from the episode's first sample, strictly increasing.
+    pub time: Vec<f64>,
+    /// The positions (or commands), in the source's units.
+    pub columns: Vec<Column>,
+    /// Measured joint efforts, named by joint (a ROS 2 bag's `effort`), N·m or N.
+    pub effort: Vec<Column>,
+    /// What the reader assumed or left out, one line each.
+    pub notices: Vec<String>,
+}
+
+#[derive(Clone, Debug)]
+pub struct Column {
+    pub name: String,
+    pub values: Vec<f64>,
+}
+
+impl Episode {
+    pub fn column(&self, name: &str) -> Option<&Column> {
+        self.columns.iter().find(|c| c.name == name)
+    }
+
+    pub fn column_names(&self) -> Vec<&str> {
+        self.columns.iter().map(|c| c.name.as_str()).collect()
+    }
+}
+
+/// What kind of thing a recording is: its units and naming follow from it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SourceKind {
+    /// A LeRobot dataset: columns named by motor (`shoulder_pan.pos`), in the motors' own units.
+    LeRobot,
+    /// A ROS 2 bag or an armscope `.mcap`: JointState positions by joint name, SI units.
+    Bag,
+    /// A CSV table: `t` and one column per joint, SI units.
+    Csv,
+}
+
+/// A recording opened: which episodes it has, and each read on demand (a dataset of hundreds of
+/// episodes is never held whole).
+pub enum Source {
+    LeRobot(lerobot::Dataset),
+    Bag(bag::Bag),
+    Csv(PathBuf),
+}
+
+impl Source {
+    /// Open a LeRobot dataset folder, a `.mcap` file or a `.csv` file, told apart by what it is.
+    pub fn open(path: &Path, topic: Option<&str>) -> Result<Self, Error> {
+        let fail = |m: String| Error::flag(path.display().to_string(), m);
+        if path.is_dir() {
+            return Ok(Source::LeRobot(lerobot::Dataset::open(path)?));
+        }
+        if !path.exists() {
+            return Err(fail("no such file or folder".into()));
+        }
+        match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
+            Some("mcap") => Ok(Source::Bag(bag::Bag::open(path, topic)?)),
+            Some("csv") => Ok(Source::Csv(path.to_path_buf())),
+            _ => Err(fail("not a LeRobot dataset folder, a .mcap bag or a .csv table".into())),
+        }
+    }
+
+    pub fn kind(&self) -> SourceKind {
+        match self {
+            Source::LeRobot(_) => SourceKind::LeRobot,
+            Source::Bag(_) => SourceKind::Bag,
+            Source::Csv(_) => SourceKind::Csv,
+        }
+    }
+
+    /// The episodes it holds, by index (a bag or a table is one, index 0).
+    pub fn episodes(&self) -> Vec<i64> {
+        match self {
+            Source::LeRobot(d) => d.episode_indices(),
+            _ => vec![0],
+        }
+    }
+
+    /// Read one episode; `feature` picks a LeRobot dataset's column group (`observation.state`,
+    /// `action`).
+    pub fn read(&self, episode: i64, feature: &str) -> Result<Episode, Error> {
+        match self {
+            Source::LeRobot(d) => d.read_episode(episode, feature),
+            Source::Bag(b) => b.read(),
+            Source::Csv(path) => csv::read(path),
+        }
+    }
+
+    /// The rate the samples were taken at, Hz, where the source says it.
+    pub fn fps(&self) -> Option<f64> {
+        match self {
+            Source::LeRobot(d) => Some(d.fps),
+            _ => None,
+        }
+    }
+
+    /// The robot type the dataset says it was recorded with (`so101_follower`), if any.
+    pub fn robot_type(&self) -> Option<&str> {
+        match self {
+            Source::LeRobot(d) => d.robot_type.as_deref(),
+            _ => None,
+        }
+    }
+}
+
+/// Times must go forward: the first sample where they do not, in one line.
+pub fn check_increasing(time: &[f64], what: &str) -> Result<(), String> {
+    for (i, w) in time.windows(2).enumerate() {
+        if w[1].partial_cmp(&w[0]) != Some(std::cmp::Ordering::Greater) {
+            return Err(format!("{what}: timestamps do not increase at sample {} ({} s after {} s)", i + 1, w[1], w[0]));
+        }
+    }
+    Ok(())
+}

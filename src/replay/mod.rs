@@ -1,0 +1,112 @@
+//! Replay what a real arm did: a recorded episode (`crate::motion`) into the torque each joint
+//! needed, held against what its motor gives.
+//!
+//! config (URDF, payload, tool, motors) → [`Replayer`] (the model built once) → per episode:
+//! [`smoothing`] → [`inverse`] → [`verdict`] → [`report`] (text, JSON) and [`trace`] (CSV).
+
+pub mod inverse;
+pub mod recording;
+pub mod report;
+pub mod smoothing;
+pub mod trace;
+pub mod verdict;
+
+pub use inverse::{Motion, inverse_replay};
+pub use verdict::{Interval, JointVerdict, intervals_over};
+
+use crate::actuator::MotorSet;
+use crate::config::{DriveMode, RunConfig};
+use crate::error::Error;
+use crate::experiment::Experiment;
+use crate::model::Model;
+use crate::motion::{Episode, JointMap};
+use std::path::PathBuf;
+use std::sync::Arc;
+
+/// What the replay is asked to model beyond the URDF.
+#[derive(Clone, Debug, Default)]
+pub struct ReplayOptions {
+    /// A payload at the tool, kg.
+    pub payload: f64,
+    /// The link whose origin is the tool (where the payload sits).
+    pub tool: Option<String>,
+    /// A motor file: each joint's motor and gearbox (its torque at speed, its rotor's reflected
+    /// inertia, its thermal data).
+    pub motors: Option<PathBuf>,
+}
+
+/// The model (with payload and motors) and the joint map, built once for every episode.
+pub struct Replayer {
+    /// The model with the payload and the motors' parts and rotors.
+    pub model: Arc<Model>,
+    /// The URDF's model as loaded (recordings build their experiment from it).
+    pub base_model: Model,
+    pub motors: Option<Arc<MotorSet>>,
+    pub map: JointMap,
+    /// Where joints the map leaves out are held: 0 clamped into their range.
+    pub hold: Vec<f64>,
+    /// The experiment the model was built by (the recordings describe it).
+    pub experiment: Experiment,
+}
+
+/// One episode replayed.
+pub struct EpisodeReplay {
+    pub motion: Motion,
+    /// Per coordinate and sample, what the joint had in the direction it needed, N·m.
+    pub available: Vec<Vec<f64>>,
+    pub verdicts: Vec<JointVerdict>,
+}
+
+impl EpisodeReplay {
+    /// The largest |needed| / available of any joint (above 1: some joint gave up).
+    pub fn peak_load(&self) -> f64 {
+        self.verdicts.iter().enumerate().map(|(j, v)| v.peak_load(&self.motion.needed[j], &self.available[j])).fold(0.0, f64::max)
+    }
+}
+
+impl Replayer {
+    pub fn new(model: Model, options: &ReplayOptions, map: JointMap) -> Result<Self, Error> {
+        let config = RunConfig { urdf: model.source.clone(), payload: options.payload, tool: options.tool.clone(), motors: options.motors.clone(), drive: DriveMode::Pd, hold: true, ..RunConfig::default() };
+        let base_model = model.clone();
+        let experiment = Experiment::with_model(config, model)?;
+        let model = experiment.model.clone();
+        let hold = model.joints.iter().map(|j| 0.0_f64.clamp(j.lower.min(j.upper), j.upper.max(j.lower))).collect();
+        Ok(Self { model, base_model, motors: experiment.motors.clone(), map, hold, experiment })
+    }
+
+    pub fn replay(&self, episode: &Episode) -> Result<EpisodeReplay, Error> {
+        let motion = inverse_replay(&self.model, &self.map, episode, &self.hold)?;
+        let available = verdict::available_torques(&self.model, self.motors.as_deref(), &motion);
+        let verdicts = verdict::judge(&self.model, self.motors.as_deref(), &motion, &available);
+        Ok(EpisodeReplay { motion, available, verdicts })
+    }
+}
+
+/// Replay `episodes` of `source` on `jobs` threads, each read, replayed and reduced to its summary
+/// as it goes (memory stays that of one episode per thread); `each` sees every replay whole (to
+/// write its trace). The summaries come back the most loaded first.
+pub fn replay_episodes(
+    replayer: &Replayer,
+    source: &crate::motion::Source,
+    episodes: &[i64],
+    feature: &str,
+    jobs: usize,
+    each: &(dyn Fn(i64, &EpisodeReplay) -> Result<(), Error> + Sync),
+) -> Result<Vec<report::EpisodeSummary>, Error> {
+    use rayon::prelude::*;
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(jobs.max(1)).build().map_err(|e| Error::flag("--jobs", e.to_string()))?;
+    let results: Vec<Result<report::EpisodeSummary, Error>> = pool.install(|| {
+        episodes
+            .par_iter()
+            .map(|&index| {
+                let episode = source.read(index, feature)?;
+                let replay = replayer.replay(&episode)?;
+                each(index, &replay)?;
+                Ok(report::EpisodeSummary::of(&replay, episode.index))
+            })
+            .collect()
+    });
+    let mut summaries = results.into_iter().collect::<Result<Vec<_>, Error>>()?;
+    summaries.sort_by(|a, b| b.peak_load.total_cmp(&a.peak_load));
+    Ok(summaries)
+}
