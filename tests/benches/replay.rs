@@ -3,6 +3,7 @@
 //! The datasets are written here (tests/common/lerobot.rs): SO-101 motions in LeRobot's layout.
 
 #[path = "../common/lerobot.rs"]
+#[allow(dead_code)]
 mod lerobot;
 
 use armscope::model::load_urdf;
