@@ -191,3 +191,30 @@ pub(super) fn zstd_level(level: i32) -> u32 {
     level as u32
 }
 
+
+/// The run's configuration as both encodings write it (`armscope.config` metadata): model, URDF,
+/// settings, gains, notices, plant, command, and how the file's timestamps relate to the run's time.
+pub(super) fn config_metadata(run: &super::RunInfo, start_ns: u64, timestamps: &str) -> std::collections::BTreeMap<String, String> {
+    let (e, model) = (run.experiment, &*run.experiment.model);
+    let mut meta = std::collections::BTreeMap::new();
+    meta.insert("model".into(), model.name.clone());
+    meta.insert("urdf".into(), model.source.display().to_string());
+    meta.insert("config".into(), serde_json::to_string(&e.config).unwrap_or_default());
+    meta.insert("gains".into(), serde_json::to_string(&e.gains).unwrap_or_default());
+    meta.insert("notices".into(), serde_json::to_string(&model.notices).unwrap_or_default());
+    meta.insert("plant".into(), run.plant.clone());
+    meta.insert("command".into(), run.trajectory.clone());
+    meta.insert("start_time_unix_ns".into(), start_ns.to_string());
+    meta.insert("timestamps".into(), timestamps.into());
+    meta
+}
+
+/// The `/controller` channel's metadata in both encodings: the joint order and torque limits,
+/// constant over a run (not repeated in every message).
+pub(super) fn controller_metadata(run: &super::RunInfo) -> std::collections::BTreeMap<String, String> {
+    let e = run.experiment;
+    let mut meta = std::collections::BTreeMap::new();
+    meta.insert("joints".to_string(), serde_json::to_string(&e.model.joints.iter().map(|j| &j.name).collect::<Vec<_>>()).unwrap_or_default());
+    meta.insert("torque_limit".to_string(), serde_json::to_string(&e.controller().effort).unwrap_or_default());
+    meta
+}

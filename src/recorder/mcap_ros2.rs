@@ -285,20 +285,9 @@ impl Recorder for Ros2McapRecorder {
         let mut out = Out::new(sinks);
         let now = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).unwrap_or_default();
         self.start_ns = now.as_nanos() as u64;
-        let mut meta = BTreeMap::new();
-        meta.insert("model".into(), model.name.clone());
-        meta.insert("urdf".into(), model.source.display().to_string());
-        meta.insert("config".into(), serde_json::to_string(&e.config).unwrap_or_default());
-        meta.insert("gains".into(), serde_json::to_string(&e.gains).unwrap_or_default());
-        meta.insert("notices".into(), serde_json::to_string(&model.notices).unwrap_or_default());
-        meta.insert("plant".into(), run.plant.clone());
-        meta.insert("command".into(), run.trajectory.clone());
-        meta.insert("start_time_unix_ns".into(), self.start_ns.to_string());
-        meta.insert("timestamps".into(), "log time = header stamp = start_time_unix_ns + simulation time (s) × 1e9".into());
+        let meta = super::mcap_out::config_metadata(run, self.start_ns, "log time = header stamp = start_time_unix_ns + simulation time (s) × 1e9");
         out.write_metadata("armscope.config", meta).map_err(|err| self.err(err))?;
-        let mut controller_meta = BTreeMap::new();
-        controller_meta.insert("joints".to_string(), serde_json::to_string(&model.joints.iter().map(|j| &j.name).collect::<Vec<_>>()).unwrap_or_default());
-        controller_meta.insert("torque_limit".to_string(), serde_json::to_string(&e.controller().effort).unwrap_or_default());
+        let controller_meta = super::mcap_out::controller_metadata(run);
         let stream = Qos::Stream { depth: 10 };
         let channels = (|| -> Result<Channels, String> {
             Ok(Channels {
@@ -411,42 +400,7 @@ impl Recorder for Ros2McapRecorder {
         let js = std::mem::take(&mut self.joint_state);
         self.log(|c| &mut c.joint_states, &js, stamp)?;
         self.joint_state = js;
-        let tel = &mut self.telemetry;
-        tel.time = s.t;
-        tel.tool_error = s.tool_error();
-        tel.tool_position.clear();
-        tel.tool_position.extend_from_slice(s.tool_position.as_slice());
-        for j in 0..s.q.len() {
-            tel.target[j] = s.cmd[j];
-            tel.error[j] = s.tracking_error(j);
-            tel.torque[j] = s.u[j];
-            tel.tau_g[j] = s.tau_g[j];
-            tel.saturated[j] = s.saturated[j] as u32;
-            tel.chatter[j] = s.chatter[j] as u32;
-            tel.torque_limit[j] = s.torque_limit[j];
-        }
-        if !tel.load_angle.is_empty() {
-            tel.load_angle.copy_from_slice(s.load_angle);
-            tel.lost_steps.copy_from_slice(s.lost_steps);
-        }
-        if let Some(motors) = &self.motors {
-            for (j, speed) in tel.motor_speed.iter_mut().enumerate() {
-                *speed = motors.motor_speed(j, s.v[j]).unwrap_or(0.0);
-            }
-        }
-        tel.winding_temperature.clear();
-        tel.winding_temperature.extend_from_slice(s.winding_temperature);
-        if !s.duty.is_empty() {
-            tel.duty.copy_from_slice(s.duty);
-            tel.current.copy_from_slice(s.current);
-            tel.supply.copy_from_slice(s.supply);
-        }
-        if !s.friction.is_empty() {
-            tel.friction.copy_from_slice(s.friction);
-            for (flag, &stuck) in tel.stuck.iter_mut().zip(s.stuck) {
-                *flag = stuck as u32;
-            }
-        }
+        self.telemetry.fill(s, self.motors.as_deref());
         {
             let path = self.path.clone();
             let (out, ch) = (self.out.as_mut().expect("started"), self.channels.as_mut().expect("started"));

@@ -78,6 +78,49 @@ pub struct ControllerTelemetry {
     pub supply: Vec<f64>,
 }
 
+impl ControllerTelemetry {
+    /// This step's values from a sample, into the vectors sized for the run when it started (both
+    /// MCAP encodings send the same message).
+    pub fn fill(&mut self, s: &crate::sample::Sample, motors: Option<&crate::actuator::MotorSet>) {
+        let tel = self;
+        tel.time = s.t;
+        tel.tool_error = s.tool_error();
+        tel.tool_position.clear();
+        tel.tool_position.extend_from_slice(s.tool_position.as_slice());
+        for j in 0..s.q.len() {
+            tel.target[j] = s.cmd[j];
+            tel.error[j] = s.tracking_error(j);
+            tel.torque[j] = s.u[j];
+            tel.tau_g[j] = s.tau_g[j];
+            tel.saturated[j] = s.saturated[j] as u32;
+            tel.chatter[j] = s.chatter[j] as u32;
+            tel.torque_limit[j] = s.torque_limit[j];
+        }
+        if !tel.load_angle.is_empty() {
+            tel.load_angle.copy_from_slice(s.load_angle);
+            tel.lost_steps.copy_from_slice(s.lost_steps);
+        }
+        if let Some(motors) = motors {
+            for (j, speed) in tel.motor_speed.iter_mut().enumerate() {
+                *speed = motors.motor_speed(j, s.v[j]).unwrap_or(0.0);
+            }
+        }
+        tel.winding_temperature.clear();
+        tel.winding_temperature.extend_from_slice(s.winding_temperature);
+        if !s.duty.is_empty() {
+            tel.duty.copy_from_slice(s.duty);
+            tel.current.copy_from_slice(s.current);
+            tel.supply.copy_from_slice(s.supply);
+        }
+        if !s.friction.is_empty() {
+            tel.friction.copy_from_slice(s.friction);
+            for (flag, &stuck) in tel.stuck.iter_mut().zip(s.stuck) {
+                *flag = stuck as u32;
+            }
+        }
+    }
+}
+
 /// The schema as MCAP's protobuf profile wants it: a serialized FileDescriptorSet. Kept next to
 /// the struct above; tests/recordings.rs decodes recorded messages through it (prost-reflect).
 pub fn file_descriptor_set() -> Vec<u8> {

@@ -14,6 +14,7 @@
 
 use super::log::BenchLog;
 use super::pendulum::Pendulum;
+use crate::actuator::bus_servo::friction::sign;
 use crate::actuator::bus_servo::{BusServo, FirmwareState, ServoParams};
 
 /// How the bench is stepped.
@@ -133,7 +134,7 @@ fn replay(log: &BenchLog, params: &ServoParams, options: &ReplayOptions, mut rec
                 let budget = friction.budget(out.torque, external, v) + friction.viscous * v.abs();
                 let net = out.torque + external;
                 let stop = bench.inertia / dt * v + net;
-                let friction_torque = -signum(stop) * stop.abs().min(budget);
+                let friction_torque = -sign(stop) * stop.abs().min(budget);
                 let acceleration = (net + friction_torque) / bench.inertia;
                 v = (v + acceleration * dt).clamp(-100.0, 100.0);
                 q += v * dt + 0.5 * acceleration * dt * dt;
@@ -149,22 +150,11 @@ fn replay(log: &BenchLog, params: &ServoParams, options: &ReplayOptions, mut rec
                     let band = h * friction.budget(out.torque, external, v);
                     // (J + h·K_v)·v' = J·v + h·(τ_m + τ_e) + h·τ_f, |τ_f| ≤ B, τ_f against v'
                     let impulse = bench.inertia * v + h * (out.torque + external);
-                    v = if impulse.abs() <= band { 0.0 } else { (impulse - signum(impulse) * band) / (bench.inertia + h * friction.viscous) };
+                    v = if impulse.abs() <= band { 0.0 } else { (impulse - sign(impulse) * band) / (bench.inertia + h * friction.viscous) };
                     q += h * v;
                 }
             }
         }
-    }
-}
-
-/// NumPy's sign.
-fn signum(x: f64) -> f64 {
-    if x > 0.0 {
-        1.0
-    } else if x < 0.0 {
-        -1.0
-    } else {
-        0.0
     }
 }
 

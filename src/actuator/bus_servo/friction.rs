@@ -277,8 +277,8 @@ impl ServoFriction {
     }
 }
 
-/// NumPy's sign: −1, 0 or +1.
-fn sign(x: f64) -> f64 {
+/// NumPy's sign: −1, 0 or +1 (BAM's models and bench step use it; `f64::signum` gives ±1 at 0).
+pub(crate) fn sign(x: f64) -> f64 {
     if x > 0.0 {
         1.0
     } else if x < 0.0 {
