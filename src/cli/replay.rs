@@ -47,19 +47,10 @@ pub struct ReplayArgs {
     /// Write every episode's findings as JSON.
     #[arg(long, value_name = "FILE")]
     pub summary_json: Option<PathBuf>,
-    /// Where to write the Rerun recording of the episode (several: of the most loaded one; default:
-    /// recordings/replay_SOURCE[_episode_N].rrd).
-    #[arg(long, value_name = "PATH")]
-    pub rrd: Option<PathBuf>,
-    /// Where to write its MCAP (default: recordings/replay_SOURCE[_episode_N].mcap).
-    #[arg(long, value_name = "PATH")]
-    pub mcap: Option<PathBuf>,
-    /// No Rerun recording file.
-    #[arg(long)]
-    pub no_rrd: bool,
-    /// No MCAP file.
-    #[arg(long)]
-    pub no_mcap: bool,
+    /// The recordings of the episode (several: of the most loaded one; NAME:
+    /// replay_SOURCE[_episode_N]).
+    #[command(flatten)]
+    pub files: crate::flags::RecordingFiles,
     /// The MCAP's encoding, as `run --mcap-encoding`.
     #[arg(long, value_enum, default_value_t = crate::recorder::McapEncoding::Foxglove)]
     pub mcap_encoding: crate::recorder::McapEncoding,
@@ -79,18 +70,20 @@ pub fn replay(args: &ReplayArgs) -> Result<i32, Error> {
     if episodes.is_empty() {
         return Err(Error::flag(args.source.display().to_string(), "no episodes"));
     }
-    let first = source.read(episodes[0], &args.feature)?;
     let map = match &args.joint_map {
         Some(path) => JointMap::load(path, &model)?,
-        None => match JointMap::builtin(source.kind(), &model, &first) {
-            Some(map) => map,
-            None => {
-                println!("{}", JointMap::template(&model, &first.column_names()));
-                return Err(Error::flag("--joint-map", format!("needed: armscope knows no map from {}'s columns to {}'s joints; a template is printed above", args.source.display(), args.urdf.display())));
+        // a built-in map is chosen by the recording's columns: those of its first episode
+        None => {
+            let first = source.read(episodes[0], &args.feature)?;
+            match JointMap::builtin(source.kind(), &model, &first) {
+                Some(map) => map,
+                None => {
+                    println!("{}", JointMap::template(&model, &first.column_names()));
+                    return Err(Error::flag("--joint-map", format!("needed: armscope knows no map from {}'s columns to {}'s joints; a template is printed above", args.source.display(), args.urdf.display())));
+                }
             }
-        },
+        }
     };
-    drop(first);
     let options = ReplayOptions { payload: args.payload, tool: args.tool.clone(), motors: args.motors.clone() };
     let replayer = Replayer::new(model, &options, map)?;
     for notice in &replayer.model.notices {
@@ -99,13 +92,32 @@ pub fn replay(args: &ReplayArgs) -> Result<i32, Error> {
     eprintln!("armscope: joint map: {}", replayer.map.source);
     let jobs = args.jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
     let several = episodes.len() > 1;
-    let trace = args.trace.clone();
-    let write_trace = move |index: i64, replay: &crate::replay::EpisodeReplay| -> Result<(), Error> {
-        let Some(path) = &trace else { return Ok(()) };
-        let path = if several { trace_path(path, index) } else { path.clone() };
-        crate::replay::trace::write(&path, &replay.motion)
+    let wants_recordings = !(args.files.no_rrd && args.files.no_mcap);
+    let dataset = source.kind() == crate::motion::SourceKind::LeRobot;
+    let stem = args.source.file_stem().map_or("recording".into(), |s| s.to_string_lossy().into_owned());
+    // the recordings of one episode: recordings/replay_SOURCE[_episode_N].rrd/.mcap unless told
+    let record = |index: i64, replay: &crate::replay::EpisodeReplay| -> Result<(), Error> {
+        let name = crate::runner::file_safe(&if dataset { format!("replay_{stem}_episode_{index}") } else { format!("replay_{stem}") });
+        let (rrd, mcap) = args.files.paths(&name);
+        let outputs = crate::replay::recording::RecordingOutputs { rrd, mcap, mcap_encoding: args.mcap_encoding, name };
+        crate::replay::recording::record(&replayer, replay, &outputs)?;
+        for path in outputs.rrd.iter().chain(&outputs.mcap) {
+            eprintln!("armscope: wrote {}", path.display());
+        }
+        Ok(())
     };
-    let summaries = replay_episodes(&replayer, &source, &episodes, &args.feature, jobs, &write_trace)?;
+    let each = |index: i64, replay: &crate::replay::EpisodeReplay| -> Result<(), Error> {
+        if let Some(path) = &args.trace {
+            let path = if several { trace_path(path, index) } else { path.clone() };
+            crate::replay::trace::write(&path, &replay.motion)?;
+        }
+        // a lone episode is recorded as it is replayed; of several, the most loaded once known
+        if !several && wants_recordings {
+            record(index, replay)?;
+        }
+        Ok(())
+    };
+    let summaries = replay_episodes(&replayer, &source, &episodes, &args.feature, jobs, &each)?;
     for s in &summaries {
         for notice in &s.notices {
             eprintln!("armscope: notice: {notice}");
@@ -117,29 +129,10 @@ pub fn replay(args: &ReplayArgs) -> Result<i32, Error> {
     }
     if let Some(worst) = summaries.first() {
         print!("{}", report::episode_text(&replayer, worst));
-    }
-    if let Some(worst) = summaries.first()
-        && !(args.no_rrd && args.no_mcap)
-    {
-        // the most loaded episode again, whole, into the recordings
-        let index = worst.index.unwrap_or(0);
-        let episode = source.read(index, &args.feature)?;
-        let replay = replayer.replay(&episode)?;
-        let stem = args.source.file_stem().map_or("recording".into(), |s| s.to_string_lossy().into_owned());
-        let name = crate::runner::file_safe(&match worst.index {
-            Some(i) => format!("replay_{stem}_episode_{i}"),
-            None => format!("replay_{stem}"),
-        });
-        let recordings = PathBuf::from("recordings");
-        let outputs = crate::replay::recording::RecordingOutputs {
-            rrd: (!args.no_rrd).then(|| args.rrd.clone().unwrap_or_else(|| recordings.join(format!("{name}.rrd")))),
-            mcap: (!args.no_mcap).then(|| args.mcap.clone().unwrap_or_else(|| recordings.join(format!("{name}.mcap")))),
-            mcap_encoding: args.mcap_encoding,
-            name,
-        };
-        crate::replay::recording::record(&replayer, &replay, &outputs)?;
-        for path in outputs.rrd.iter().chain(&outputs.mcap) {
-            eprintln!("armscope: wrote {}", path.display());
+        if several && wants_recordings {
+            // the most loaded episode again, whole (the batch kept only its findings)
+            let index = worst.index.unwrap_or(0);
+            record(index, &replayer.replay(&source.read(index, &args.feature)?)?)?;
         }
     }
     if let Some(path) = &args.summary_json {

@@ -66,9 +66,7 @@ pub fn run(args: &RunArgs) -> Result<i32, Error> {
             return Err(Error::flag("--realtime", format!("must be a positive factor (got {f})")));
         }
     }
-    let recordings = PathBuf::from("recordings");
-    let rrd_path = (!args.no_rrd).then(|| args.rrd.clone().unwrap_or_else(|| recordings.join(format!("{name}.rrd"))));
-    let mcap_path = (!args.no_mcap).then(|| args.mcap.clone().unwrap_or_else(|| recordings.join(format!("{name}.mcap"))));
+    let (rrd_path, mcap_path) = args.files.paths(&name);
     let live = if args.spawn {
         Some(LiveViewer::Spawn)
     } else {

@@ -34,18 +34,9 @@ pub struct TestbenchArgs {
     /// Write one CSV per log here, named after the log (t,goal_position,position_measured,position_sim).
     #[arg(long, value_name = "DIR")]
     pub trace_dir: Option<PathBuf>,
-    /// Where to write the Rerun recording (default: recordings/testbench.rrd).
-    #[arg(long, value_name = "PATH")]
-    pub rrd: Option<PathBuf>,
-    /// Where to write the MCAP (default: recordings/testbench.mcap).
-    #[arg(long, value_name = "PATH")]
-    pub mcap: Option<PathBuf>,
-    /// No Rerun recording.
-    #[arg(long)]
-    pub no_rrd: bool,
-    /// No MCAP.
-    #[arg(long)]
-    pub no_mcap: bool,
+    /// The recordings (NAME: testbench).
+    #[command(flatten)]
+    pub files: crate::flags::RecordingFiles,
     /// No table on the console.
     #[arg(long, short)]
     pub quiet: bool,
@@ -115,17 +106,15 @@ pub fn testbench(args: &TestbenchArgs) -> Result<i32, Error> {
     if let Some(dir) = &args.trace_dir {
         recording::write_traces(dir, &runs)?;
     }
-    let recordings = PathBuf::from("recordings");
-    if !args.no_rrd {
-        let path = args.rrd.clone().unwrap_or_else(|| recordings.join("testbench.rrd"));
+    let (rrd, mcap) = args.files.paths("testbench");
+    if let Some(path) = rrd {
         crate::runner::create_parent(&path)?;
         recording::write_rrd(&path, &runs)?;
         if !args.quiet {
             println!("wrote {}", path.display());
         }
     }
-    if !args.no_mcap {
-        let path = args.mcap.clone().unwrap_or_else(|| recordings.join("testbench.mcap"));
+    if let Some(path) = mcap {
         crate::runner::create_parent(&path)?;
         recording::write_mcap(&path, &runs)?;
         if !args.quiet {

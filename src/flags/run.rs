@@ -122,18 +122,8 @@ pub struct RunArgs {
     /// Name of the recordings (default: from the flags, e.g. "default", "no-ff").
     #[arg(long)]
     pub name: Option<String>,
-    /// Where to write the Rerun recording (default: recordings/NAME.rrd).
-    #[arg(long, value_name = "PATH")]
-    pub rrd: Option<PathBuf>,
-    /// Where to write the MCAP for Foxglove (default: recordings/NAME.mcap).
-    #[arg(long, value_name = "PATH")]
-    pub mcap: Option<PathBuf>,
-    /// No Rerun recording file.
-    #[arg(long)]
-    pub no_rrd: bool,
-    /// No MCAP file.
-    #[arg(long)]
-    pub no_mcap: bool,
+    #[command(flatten)]
+    pub files: super::shared::RecordingFiles,
     /// foxglove: Foxglove's protobuf schemas; ros2: ROS 2's CDR with ros2msg schemas, as rosbag2
     /// writes a bag (`ros2 bag play`, RViz, PlotJuggler, rosbags, Rerun's MCAP importer).
     #[arg(long, value_enum, default_value_t = crate::recorder::McapEncoding::Foxglove)]

@@ -69,3 +69,31 @@ pub struct MotorArgs {
     #[arg(long, value_enum, default_value = "native")]
     pub drive: crate::config::DriveMode,
 }
+
+/// Where a command writes its recordings: `recordings/NAME.rrd` and `recordings/NAME.mcap` unless
+/// told otherwise.
+#[derive(Args, Debug, Clone, Default)]
+pub struct RecordingFiles {
+    /// Where to write the Rerun recording (default: recordings/NAME.rrd).
+    #[arg(long, value_name = "PATH")]
+    pub rrd: Option<PathBuf>,
+    /// Where to write the MCAP for Foxglove (default: recordings/NAME.mcap).
+    #[arg(long, value_name = "PATH")]
+    pub mcap: Option<PathBuf>,
+    /// No Rerun recording file.
+    #[arg(long)]
+    pub no_rrd: bool,
+    /// No MCAP file.
+    #[arg(long)]
+    pub no_mcap: bool,
+}
+
+impl RecordingFiles {
+    /// The `.rrd` and `.mcap` to write for a recording named `name` (None: not wanted).
+    pub fn paths(&self, name: &str) -> (Option<PathBuf>, Option<PathBuf>) {
+        let recordings = PathBuf::from("recordings");
+        let rrd = (!self.no_rrd).then(|| self.rrd.clone().unwrap_or_else(|| recordings.join(format!("{name}.rrd"))));
+        let mcap = (!self.no_mcap).then(|| self.mcap.clone().unwrap_or_else(|| recordings.join(format!("{name}.mcap"))));
+        (rrd, mcap)
+    }
+}

@@ -268,22 +268,10 @@ impl<'a> VectorColumn<'a> {
             return Ok(Self { starts, floats: floats(list.values().as_ref())? });
         }
         if let Some(list) = array.as_list_opt::<i32>() {
-            let offsets = list.value_offsets();
-            for r in 0..rows {
-                if (offsets[r + 1] - offsets[r]) as usize != width {
-                    return Err(wrong_width(r, (offsets[r + 1] - offsets[r]) as usize));
-                }
-            }
-            return Ok(Self { starts: offsets[..rows].iter().map(|&o| o as usize).collect(), floats: floats(list.values().as_ref())? });
+            return Ok(Self { starts: list_starts(list.value_offsets(), width).map_err(|(r, got)| wrong_width(r, got))?, floats: floats(list.values().as_ref())? });
         }
         if let Some(list) = array.as_list_opt::<i64>() {
-            let offsets = list.value_offsets();
-            for r in 0..rows {
-                if (offsets[r + 1] - offsets[r]) as usize != width {
-                    return Err(wrong_width(r, (offsets[r + 1] - offsets[r]) as usize));
-                }
-            }
-            return Ok(Self { starts: offsets[..rows].iter().map(|&o| o as usize).collect(), floats: floats(list.values().as_ref())? });
+            return Ok(Self { starts: list_starts(list.value_offsets(), width).map_err(|(r, got)| wrong_width(r, got))?, floats: floats(list.values().as_ref())? });
         }
         if width == 1 {
             return Ok(Self { starts: (0..rows).collect(), floats: floats(array)? });
@@ -298,6 +286,19 @@ impl<'a> VectorColumn<'a> {
             Floats::F64(v) => v[i],
         }
     }
+}
+
+/// Each row's first value in a List or LargeList column, if every row holds `width` values (else
+/// the first row that does not, and how many it holds).
+fn list_starts<O: arrow::array::OffsetSizeTrait>(offsets: &[O], width: usize) -> Result<Vec<usize>, (usize, usize)> {
+    offsets
+        .windows(2)
+        .enumerate()
+        .map(|(row, w)| {
+            let (start, end) = (w[0].as_usize(), w[1].as_usize());
+            if end - start == width { Ok(start) } else { Err((row, end - start)) }
+        })
+        .collect()
 }
 
 fn read_episodes_jsonl(root: &Path, chunks_size: i64) -> Result<Vec<EpisodeEntry>, Error> {

@@ -57,13 +57,6 @@ pub struct EpisodeReplay {
     pub verdicts: Vec<JointVerdict>,
 }
 
-impl EpisodeReplay {
-    /// The largest |needed| / available of any joint (above 1: some joint gave up).
-    pub fn peak_load(&self) -> f64 {
-        self.verdicts.iter().enumerate().map(|(j, v)| v.peak_load(&self.motion.needed[j], &self.available[j])).fold(0.0, f64::max)
-    }
-}
-
 impl Replayer {
     pub fn new(model: Model, options: &ReplayOptions, map: JointMap) -> Result<Self, Error> {
         let config = RunConfig { urdf: model.source.clone(), payload: options.payload, tool: options.tool.clone(), motors: options.motors.clone(), drive: DriveMode::Pd, hold: true, ..RunConfig::default() };

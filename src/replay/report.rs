@@ -31,7 +31,7 @@ pub struct EffortGap {
 impl EpisodeSummary {
     pub fn of(replay: &EpisodeReplay, index: Option<i64>) -> Self {
         let m = &replay.motion;
-        let loads: Vec<f64> = replay.verdicts.iter().enumerate().map(|(j, v)| v.peak_load(&m.needed[j], &replay.available[j])).collect();
+        let loads: Vec<f64> = m.needed.iter().zip(&replay.available).map(|(needed, available)| super::verdict::peak_load(needed, available)).collect();
         let worst = loads.iter().enumerate().fold((0, 0.0_f64), |(bi, b), (i, &l)| if l > b { (i, l) } else { (bi, b) });
         let measured_vs_model = m
             .measured

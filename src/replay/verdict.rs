@@ -75,11 +75,9 @@ pub struct JointVerdict {
     pub winding: Option<WindingSummary>,
 }
 
-impl JointVerdict {
-    /// The largest |needed| / available over the episode (1 = exactly at its limit).
-    pub fn peak_load(&self, needed: &[f64], limit: &[f64]) -> f64 {
-        needed.iter().zip(limit).map(|(n, l)| if *l > 0.0 { n.abs() / l } else if n.abs() > 0.0 { f64::INFINITY } else { 0.0 }).fold(0.0, f64::max)
-    }
+/// The largest |needed| / available over a series (1 = exactly at its limit).
+pub fn peak_load(needed: &[f64], limit: &[f64]) -> f64 {
+    needed.iter().zip(limit).map(|(n, l)| if *l > 0.0 { n.abs() / l } else if n.abs() > 0.0 { f64::INFINITY } else { 0.0 }).fold(0.0, f64::max)
 }
 
 /// Per coordinate and sample, the torque the joint could have had in the direction it needed:
