@@ -71,6 +71,7 @@ fn build(text: &str, source: &Path, options: LoadOptions) -> Result<Model, K> {
         return Err(K::Urdf(format!("root element is <{}>, expected <robot>", doc.root_element().tag_name().name())));
     }
     let mut notices = Vec::new();
+    let mut missing_meshes = Vec::new();
     let repaired = without_empty_textures(&doc, text, &mut notices);
     let robot = urdf_rs::read_from_string(repaired.as_deref().unwrap_or(text)).map_err(|e| K::Urdf(one_line(e)))?;
 
@@ -171,8 +172,8 @@ fn build(text: &str, source: &Path, options: LoadOptions) -> Result<Model, K> {
         if let Some(b) = body {
             body_inertia[b] = body_inertia[b].combined(&link_inertia(ul).transformed(&placement));
         }
-        let visuals = link_visuals(ul, &robot.materials, base_dir, &mut notices);
-        let collisions = link_collisions(ul, base_dir, &mut notices);
+        let visuals = link_visuals(ul, &robot.materials, base_dir, &mut missing_meshes);
+        let collisions = link_collisions(ul, base_dir, &mut missing_meshes);
         frame_of_link[link] = Some(frames.len());
         frames.push(Frame {
             name: ul.name.clone(),
@@ -191,6 +192,7 @@ fn build(text: &str, source: &Path, options: LoadOptions) -> Result<Model, K> {
     if let Some(unreached) = frame_of_link.iter().position(|f| f.is_none()) {
         return Err(K::Cycle(robot.links[unreached].name.clone()));
     }
+    missing_mesh_notices(&missing_meshes, &mut notices);
     collada_up_axis_notices(&frames, &mut notices);
     if bodies.is_empty() {
         return Err(K::NoMovingJoints);
@@ -472,7 +474,7 @@ fn check_joint(joint: &urdf_rs::Joint) -> Result<(), K> {
 /// A link's visuals. A mesh that cannot be found (a URDF shared without its mesh folder is common)
 /// is a notice, and the link is drawn without it: with its collision shapes if they can be drawn,
 /// else as a box with the link's inertia. The simulation does not need the geometry.
-fn link_visuals(link: &urdf_rs::Link, materials: &[urdf_rs::Material], base_dir: &Path, notices: &mut Vec<String>) -> Vec<Visual> {
+fn link_visuals(link: &urdf_rs::Link, materials: &[urdf_rs::Material], base_dir: &Path, missing_meshes: &mut Vec<MissingMesh>) -> Vec<Visual> {
     let mut missing = false;
     let mut visuals: Vec<Visual> = link
         .visual
@@ -484,7 +486,7 @@ fn link_visuals(link: &urdf_rs::Link, materials: &[urdf_rs::Material], base_dir:
                     urdf_rs::Geometry::Mesh { filename, .. } => filename.as_str(),
                     _ => "",
                 };
-                notices.push(format!("link '{}': mesh '{filename}' not found (looked for {looked}); drawing the link without it", link.name));
+                missing_meshes.push(MissingMesh { link: link.name.clone(), filename: filename.to_string(), looked, collision: false });
                 missing = true;
                 None
             }
@@ -501,7 +503,7 @@ fn link_visuals(link: &urdf_rs::Link, materials: &[urdf_rs::Material], base_dir:
 
 /// A link's collision geometry (`<collision>`); a mesh that cannot be found is a notice, and the
 /// shape is left out of the collision checks.
-fn link_collisions(link: &urdf_rs::Link, base_dir: &Path, notices: &mut Vec<String>) -> Vec<Visual> {
+fn link_collisions(link: &urdf_rs::Link, base_dir: &Path, missing_meshes: &mut Vec<MissingMesh>) -> Vec<Visual> {
     link.collision
         .iter()
         .filter_map(|c| match geometry(&c.geometry, base_dir) {
@@ -511,11 +513,49 @@ fn link_collisions(link: &urdf_rs::Link, base_dir: &Path, notices: &mut Vec<Stri
                     urdf_rs::Geometry::Mesh { filename, .. } => filename.as_str(),
                     _ => "",
                 };
-                notices.push(format!("link '{}': collision mesh '{filename}' not found (looked for {looked}); left out of the collision checks", link.name));
+                missing_meshes.push(MissingMesh { link: link.name.clone(), filename: filename.to_string(), looked, collision: true });
                 None
             }
         })
         .collect()
+}
+
+/// A mesh file a link names that is not on disk.
+struct MissingMesh {
+    link: String,
+    filename: String,
+    looked: String,
+    collision: bool,
+}
+
+/// What was done without the meshes that are not on disk, in one notice: a URDF shared without its mesh
+/// folder misses every mesh, and one line per mesh (forty on an SO-101) would bury every other notice.
+fn missing_mesh_notices(missing: &[MissingMesh], notices: &mut Vec<String>) {
+    match missing {
+        [] => {}
+        [one] if one.collision => notices.push(format!("link '{}': collision mesh '{}' not found (looked for {}); left out of the collision checks", one.link, one.filename, one.looked)),
+        [one] => notices.push(format!("link '{}': mesh '{}' not found (looked for {}); drawing the link without it", one.link, one.filename, one.looked)),
+        [first, ..] => {
+            let mut files: Vec<&str> = missing.iter().map(|m| m.filename.as_str()).collect();
+            files.sort_unstable();
+            files.dedup();
+            let mut links: Vec<&str> = Vec::new();
+            for m in missing {
+                if !links.contains(&m.link.as_str()) {
+                    links.push(&m.link);
+                }
+            }
+            notices.push(format!(
+                "{} mesh files not found ('{}'), named by links '{}' (the first, '{}' of link '{}', looked for {}): those links are drawn without them and the shapes left out of the collision checks",
+                files.len(),
+                files.join("', '"),
+                links.join("', '"),
+                first.filename,
+                first.link,
+                first.looked
+            ));
+        }
+    }
 }
 
 /// One notice per COLLADA file that declares an up axis other than z: it is turned (the spec's
