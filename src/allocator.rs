@@ -6,7 +6,7 @@
 /// stays within 1.32× of the 30 s run's (`cargo bench --bench scaling`: 31 MB at 30 s, 41 MB at 10
 /// min, 36 MB at 1 h). Purging at once (0 ms) kept it flatter (29 / 37 / 35 MB) but madvise'd and
 /// faulted pages back in all the time: the tutorial batch (13 runs, two at once, with the comparison)
-/// spent 1.29 s in the kernel and took 1.85 s; with 1 ms, 0.92 s and 1.51 s (medians of 7, same session).
+/// spent 1.29 s in the kernel and took 1.85 s; with 1 ms, 0.92 s and 1.51 s (medians of 7 runs, interleaved).
 pub fn return_freed_memory_soon() {
     // `mi_option_purge_delay` in mimalloc.h's `mi_option_e` (v2 and v3); libmimalloc-sys 0.1.49
     // names no constant for it

@@ -7,6 +7,7 @@ mod compare;
 mod envelope;
 mod identify;
 mod model;
+mod reference;
 mod replay;
 mod run;
 mod size;
@@ -20,6 +21,7 @@ pub use compare::{CompareArgs, compare};
 pub use envelope::{EnvelopeArgs, envelope};
 pub use identify::{IdentifyArgs, identify};
 pub use model::{ModelArgs, model};
+pub use reference::{CompletionsArgs, ReferenceArgs, commands, completions, long_help, markdown as reference_markdown, reference};
 pub use replay::{ReplayArgs, replay, trace_path};
 pub use crate::flags::{GainArgs, MotorArgs, RunArgs, WaveArgs};
 pub use run::{default_run_name, run};
@@ -74,6 +76,10 @@ pub enum Command {
     /// What a real arm's recorded motion took: a LeRobot dataset, ROS 2 bag or CSV into the torque
     /// each joint needed, held against what its motor gives; the episodes that overloaded first.
     Replay(ReplayArgs),
+    /// The command reference generated from this command line: one Markdown page, or man pages.
+    Reference(ReferenceArgs),
+    /// A shell completion script on stdout, e.g. `armscope completions bash > ~/.local/share/bash-completion/completions/armscope`.
+    Completions(CompletionsArgs),
 }
 
 /// Parse `args` and run; returns the process exit code. Errors are printed as one line.
@@ -119,6 +125,8 @@ fn run_command(command: Command) -> Result<i32, Error> {
         Command::Testbench(args) => testbench(&args),
         Command::Identify(args) => identify(&args),
         Command::Replay(args) => replay(&args),
+        Command::Reference(args) => reference(&args),
+        Command::Completions(args) => completions(&args),
     }
 }
 
