@@ -2,7 +2,7 @@
 //! the torque each joint needed, held against what its motor gives.
 
 use super::*;
-use crate::motion::{JointMap, Source};
+use crate::motion::{Mapped, open_mapped};
 use crate::replay::{ReplayOptions, Replayer, replay_episodes, report};
 
 #[derive(Args, Debug)]
@@ -15,21 +15,8 @@ pub struct ReplayArgs {
     /// The arm's URDF.
     #[arg(long, value_name = "PATH")]
     pub urdf: PathBuf,
-    /// Episodes to replay (comma list; default: all).
-    #[arg(long, value_delimiter = ',', num_args = 1)]
-    pub episode: Option<Vec<i64>>,
-    /// The dataset's columns to replay: `observation.state` (the follower's positions) or `action`
-    /// (the commands).
-    #[arg(long, default_value = "observation.state")]
-    pub feature: String,
-    /// How the recording's columns become the URDF's joints (TOML: `[joints.NAME] column, unit,
-    /// sign, offset`; optionally a LeRobot `calibration` file). Built in: bags and tables named by
-    /// joint in SI units, the SO-101's LeRobot datasets.
-    #[arg(long, value_name = "FILE")]
-    pub joint_map: Option<PathBuf>,
-    /// A bag's joint-state topic (default: /joint_states, or the only one).
-    #[arg(long)]
-    pub topic: Option<String>,
+    #[command(flatten)]
+    pub recorded: crate::flags::RecordedMotionArgs,
     /// A payload at the tool, kg.
     #[arg(long, default_value_t = 0.0)]
     pub payload: f64,
@@ -62,26 +49,12 @@ pub struct ReplayArgs {
 /// `armscope replay`.
 pub fn replay(args: &ReplayArgs) -> Result<i32, Error> {
     let model = crate::model::load_urdf(&args.urdf)?;
-    let source = Source::open(&args.source, args.topic.as_deref())?;
-    let episodes = match &args.episode {
-        Some(list) => list.clone(),
-        None => source.episodes(),
-    };
-    if episodes.is_empty() {
-        return Err(Error::flag(args.source.display().to_string(), "no episodes"));
-    }
-    let map = match &args.joint_map {
-        Some(path) => JointMap::load(path, &model)?,
-        // a built-in map is chosen by the recording's columns: those of its first episode
-        None => {
-            let first = source.read(episodes[0], &args.feature)?;
-            match JointMap::builtin(source.kind(), &model, &first) {
-                Some(map) => map,
-                None => {
-                    println!("{}", JointMap::template(&model, &first.column_names()));
-                    return Err(Error::flag("--joint-map", format!("needed: armscope knows no map from {}'s columns to {}'s joints; a template is printed above", args.source.display(), args.urdf.display())));
-                }
-            }
+    let recorded = &args.recorded;
+    let (source, episodes, map) = match open_mapped(&args.source, recorded.topic.as_deref(), recorded.episode.as_deref(), &recorded.feature, recorded.joint_map.as_deref(), &model)? {
+        Mapped::Ready(r) => (r.source, r.episodes, r.map),
+        Mapped::NeedsMap { template } => {
+            println!("{template}");
+            return Err(needs_map(&args.source, &args.urdf));
         }
     };
     let options = ReplayOptions { payload: args.payload, tool: args.tool.clone(), motors: args.motors.clone() };
@@ -117,7 +90,7 @@ pub fn replay(args: &ReplayArgs) -> Result<i32, Error> {
         }
         Ok(())
     };
-    let summaries = replay_episodes(&replayer, &source, &episodes, &args.feature, jobs, &each)?;
+    let summaries = replay_episodes(&replayer, &source, &episodes, &recorded.feature, jobs, &each)?;
     for s in &summaries {
         for notice in &s.notices {
             eprintln!("armscope: notice: {notice}");
@@ -132,7 +105,7 @@ pub fn replay(args: &ReplayArgs) -> Result<i32, Error> {
         if several && wants_recordings {
             // the most loaded episode again, whole (the batch kept only its findings)
             let index = worst.index.unwrap_or(0);
-            record(index, &replayer.replay(&source.read(index, &args.feature)?)?)?;
+            record(index, &replayer.replay(&source.read(index, &recorded.feature)?)?)?;
         }
     }
     if let Some(path) = &args.summary_json {
@@ -141,6 +114,11 @@ pub fn replay(args: &ReplayArgs) -> Result<i32, Error> {
         std::fs::write(path, text + "\n").map_err(|e| Error::output(path, e))?;
     }
     Ok(0)
+}
+
+/// The one-line error when no joint map is known for a recording (its template printed above it).
+pub fn needs_map(source: &std::path::Path, urdf: &std::path::Path) -> Error {
+    Error::flag("--joint-map", format!("needed: armscope knows no map from {}'s columns to {}'s joints; a template is printed above", source.display(), urdf.display()))
 }
 
 /// `trace.csv` → `trace_episode_7.csv`.

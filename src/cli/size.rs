@@ -17,6 +17,13 @@ pub struct SizeArgs {
     /// The motion: every experiment of a batch manifest (each must pass; their `motors` are replaced).
     #[arg(long, value_name = "FILE", conflicts_with_all = ["trajectory"])]
     pub manifest: Option<PathBuf>,
+    /// The motion: every recorded episode of a LeRobot dataset, ROS 2 bag or CSV (as `replay`),
+    /// smoothed and followed as a joint schedule; the drives must carry them all (their envelope).
+    #[arg(long, value_name = "SOURCE", conflicts_with_all = ["trajectory", "manifest"])]
+    pub from: Option<PathBuf>,
+    /// With --from: which episodes, and how the recording's columns map to the joints.
+    #[command(flatten)]
+    pub recorded: crate::flags::RecordedMotionArgs,
     /// Simulated time of the wave or schedule, s (default: the schedule's length, or as `run`).
     #[arg(long, value_name = "SECONDS")]
     pub duration: Option<f64>,
@@ -183,6 +190,9 @@ fn motions(args: &SizeArgs) -> Result<Vec<(String, RunConfig)>, Error> {
         srdf: args.srdf.clone(),
         ..RunConfig::default()
     };
+    if let Some(source) = &args.from {
+        return recorded_motions(args, source, base);
+    }
     let Some(path) = &args.manifest else {
         let name = if args.trajectory.is_some() { "trajectory".to_string() } else { format!("wave ω = {} rad/s, {}°, {duration} s", args.wave.freq(), args.wave.amp_deg()) };
         return Ok(vec![(name, base)]);
@@ -214,6 +224,41 @@ fn motions(args: &SizeArgs) -> Result<Vec<(String, RunConfig)>, Error> {
     Ok(out)
 }
 
+/// `--from SOURCE`: each episode replayed (smoothed as `replay` smooths it) and written as a joint
+/// schedule into OUT/episodes/, then followed from its first pose for its own length.
+fn recorded_motions(args: &SizeArgs, source: &std::path::Path, base: RunConfig) -> Result<Vec<(String, RunConfig)>, Error> {
+    use crate::motion::{Mapped, open_mapped};
+    use crate::replay::{ReplayOptions, Replayer, schedule};
+    let model = crate::model::load_urdf(&args.urdf)?;
+    let recorded = &args.recorded;
+    let mapped = match open_mapped(source, recorded.topic.as_deref(), recorded.episode.as_deref(), &recorded.feature, recorded.joint_map.as_deref(), &model)? {
+        Mapped::Ready(r) => r,
+        Mapped::NeedsMap { template } => {
+            println!("{template}");
+            return Err(super::replay::needs_map(source, &args.urdf));
+        }
+    };
+    let replayer = Replayer::new(model, &ReplayOptions { payload: 0.0, tool: args.tool.clone(), motors: None }, mapped.map)?;
+    eprintln!("armscope: joint map: {}", replayer.map.source);
+    let dir = args.out.join("episodes");
+    std::fs::create_dir_all(&dir).map_err(|e| Error::output(&dir, e))?;
+    let several = mapped.episodes.len() > 1 || mapped.source.kind() == crate::motion::SourceKind::LeRobot;
+    let mut out = Vec::new();
+    for index in mapped.episodes {
+        let motion = replayer.replay(&mapped.source.read(index, &recorded.feature)?)?.motion;
+        for notice in &motion.notices {
+            eprintln!("armscope: notice: {notice}");
+        }
+        let path = dir.join(if several { format!("episode_{index}.csv") } else { "recording.csv".to_string() });
+        schedule::write(&path, &motion)?;
+        let (length, first_pose) = schedule::span(&motion);
+        let q0 = first_pose.iter().map(|q| format!("{q:?}")).collect::<Vec<_>>().join(",");
+        let name = if several { format!("episode {index}") } else { "recording".to_string() };
+        out.push((name, RunConfig { trajectory: Some(path), duration: args.duration.unwrap_or(length), q0: Some(q0), ..base.clone() }));
+    }
+    Ok(out)
+}
+
 /// `armscope size`.
 pub fn size(args: &SizeArgs) -> Result<i32, Error> {
     if !(args.payload >= 0.0 && args.payload.is_finite()) {
@@ -232,6 +277,13 @@ pub fn size(args: &SizeArgs) -> Result<i32, Error> {
     }
     if !(1..=1024).contains(&args.microsteps) {
         return Err(Error::flag("--microsteps", "must be 1 to 1024"));
+    }
+    if args.from.is_none() {
+        let r = &args.recorded;
+        let stray = [(r.episode.is_some(), "--episode"), (r.joint_map.is_some(), "--joint-map"), (r.topic.is_some(), "--topic"), (r.feature != "observation.state", "--feature")];
+        if let Some((_, flag)) = stray.iter().find(|(set, _)| *set) {
+            return Err(Error::flag(*flag, "only with --from SOURCE (a recorded motion to size for)"));
+        }
     }
     let motions = motions(args)?;
     let first = &motions[0].1;
@@ -332,7 +384,7 @@ pub fn size(args: &SizeArgs) -> Result<i32, Error> {
         files.push(path);
     }
     print!("{md}");
-    if args.manifest.is_none() && report.joints.iter().any(|j| j.chosen.is_some()) {
+    if args.manifest.is_none() && args.from.is_none() && report.joints.iter().any(|j| j.chosen.is_some()) {
         // the verifying simulation as a command (servo joints ran with gains tuned to their rotors)
         let servos = report.joints.iter().filter_map(|j| j.chosen.map(|c| &j.candidates[c])).any(|c| request.catalogue.drive_train(&c.motor).is_some_and(|d| d.is_ok_and(|d| d.motor.as_stepper().is_none())));
         let path = args.motors_out.clone().unwrap_or_else(|| args.out.join("motors.toml"));

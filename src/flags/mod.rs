@@ -5,4 +5,4 @@ mod run;
 mod shared;
 
 pub use run::RunArgs;
-pub use shared::{GainArgs, MotorArgs, RecordingFiles, WaveArgs};
+pub use shared::{GainArgs, MotorArgs, RecordedMotionArgs, RecordingFiles, WaveArgs};

@@ -97,3 +97,24 @@ impl RecordingFiles {
         (rrd, mcap)
     }
 }
+
+/// Which episodes of a recorded motion, and how its columns become the URDF's joints: shared by
+/// `replay` and `size --from`.
+#[derive(Args, Debug, Clone, Default)]
+pub struct RecordedMotionArgs {
+    /// Episodes to use (comma list; default: all).
+    #[arg(long, value_delimiter = ',', num_args = 1)]
+    pub episode: Option<Vec<i64>>,
+    /// The dataset's columns to use: `observation.state` (the follower's positions) or `action`
+    /// (the commands).
+    #[arg(long, default_value = "observation.state")]
+    pub feature: String,
+    /// How the recording's columns become the URDF's joints (TOML: `[joints.NAME] column, unit,
+    /// sign, offset`; optionally a LeRobot `calibration` file). Built in: bags and tables named by
+    /// joint in SI units, the SO-101's LeRobot datasets.
+    #[arg(long, value_name = "FILE")]
+    pub joint_map: Option<PathBuf>,
+    /// A bag's joint-state topic (default: /joint_states, or the only one).
+    #[arg(long)]
+    pub topic: Option<String>,
+}

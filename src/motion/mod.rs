@@ -134,3 +134,41 @@ pub fn check_increasing(time: &[f64], what: &str) -> Result<(), String> {
     }
     Ok(())
 }
+
+/// A recording ready to use on an arm: its source, the episodes asked for, and the joint map.
+pub struct MappedRecording {
+    pub source: Source,
+    pub episodes: Vec<i64>,
+    pub map: JointMap,
+}
+
+/// What opening a recording for an arm gave: ready, or no map known from its columns to the arm's
+/// joints (then a template of one to fill in).
+pub enum Mapped {
+    Ready(MappedRecording),
+    NeedsMap { template: String },
+}
+
+/// Open a recording for `model`: the episodes asked for (default: all), and the joint map — the
+/// user's file, else a built-in map chosen by the recording's columns (those of its first episode).
+pub fn open_mapped(path: &Path, topic: Option<&str>, episodes: Option<&[i64]>, feature: &str, joint_map: Option<&Path>, model: &crate::model::Model) -> Result<Mapped, Error> {
+    let source = Source::open(path, topic)?;
+    let episodes = match episodes {
+        Some(list) => list.to_vec(),
+        None => source.episodes(),
+    };
+    if episodes.is_empty() {
+        return Err(Error::flag(path.display().to_string(), "no episodes"));
+    }
+    let map = match joint_map {
+        Some(file) => JointMap::load(file, model)?,
+        None => {
+            let first = source.read(episodes[0], feature)?;
+            match JointMap::builtin(source.kind(), model, &first) {
+                Some(map) => map,
+                None => return Ok(Mapped::NeedsMap { template: JointMap::template(model, &first.column_names()) }),
+            }
+        }
+    };
+    Ok(Mapped::Ready(MappedRecording { source, episodes, map }))
+}

@@ -7,6 +7,7 @@
 pub mod inverse;
 pub mod recording;
 pub mod report;
+pub mod schedule;
 pub mod smoothing;
 pub mod trace;
 pub mod verdict;
