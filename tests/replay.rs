@@ -24,7 +24,7 @@ fn spec(episodes: usize, seconds: f64, model: &Model) -> Spec {
     let gripper = &model.joints[model.joint_index("gripper").unwrap()];
     let mut storage: Vec<Storage> = (0..5).map(|j| Storage::Degrees { sign: SIGNS[j], offset: OFFSETS[j] }).collect();
     storage.push(Storage::Range0To100 { lower: gripper.lower, upper: gripper.upper });
-    Spec { fps: 30.0, frames: (seconds * 30.0) as usize + 1, episodes: (0..episodes).map(motions).collect(), storage }
+    Spec { fps: 30.0, frames: (seconds * 30.0) as usize + 1, episodes: (0..episodes).map(motions).collect(), storage, observed: None }
 }
 
 fn joint_map(dir: &Path) -> PathBuf {

@@ -27,7 +27,7 @@ fn dataset(root: &Path) -> Spec {
     };
     let mut storage: Vec<Storage> = (0..5).map(|_| Storage::Degrees { sign: 1.0, offset: 0.0 }).collect();
     storage.push(Storage::Range0To100 { lower: gripper.lower, upper: gripper.upper });
-    let spec = Spec { fps: 30.0, frames: 6 * 30 + 1, episodes: vec![motion(1.0, 1.0), motion(1.5, 1.9)], storage };
+    let spec = Spec { fps: 30.0, frames: 6 * 30 + 1, episodes: vec![motion(1.0, 1.0), motion(1.5, 1.9)], storage, observed: None };
     spec.write_v3(root);
     spec
 }

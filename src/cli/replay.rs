@@ -44,6 +44,12 @@ pub struct ReplayArgs {
     /// Episodes at once (default: all cores).
     #[arg(long)]
     pub jobs: Option<usize>,
+    /// Forward replay instead: drive the simulated arm with each episode's commands (`action`)
+    /// through each joint's motor (a bus servo through its firmware loop; needs --motors), starting
+    /// where the commands start, and compare it with what the follower did (--feature, by default
+    /// `observation.state`): the tracking of reality and of the model, and the gap between them.
+    #[arg(long, requires = "motors")]
+    pub forward: bool,
 }
 
 /// `armscope replay`.
@@ -59,6 +65,9 @@ pub fn replay(args: &ReplayArgs) -> Result<i32, Error> {
     };
     let options = ReplayOptions { payload: args.payload, tool: args.tool.clone(), motors: args.motors.clone() };
     let replayer = Replayer::new(model, &options, map)?;
+    if args.forward {
+        return forward(args, &replayer, &source, &episodes);
+    }
     for notice in &replayer.model.notices {
         eprintln!("armscope: notice: {notice}");
     }
@@ -110,6 +119,33 @@ pub fn replay(args: &ReplayArgs) -> Result<i32, Error> {
     }
     if let Some(path) = &args.summary_json {
         let doc = report::summary_json(&replayer, &args.source.display().to_string(), &summaries);
+        let text = serde_json::to_string_pretty(&doc).map_err(|e| Error::output(path, e))?;
+        std::fs::write(path, text + "\n").map_err(|e| Error::output(path, e))?;
+    }
+    Ok(0)
+}
+
+/// `replay --forward`: each episode's commands through the simulated arm's motors, against the follower.
+fn forward(args: &ReplayArgs, replayer: &Replayer, source: &crate::motion::Source, episodes: &[i64]) -> Result<i32, Error> {
+    use crate::replay::forward::{ForwardOptions, forward, schedule_path, text};
+    if source.kind() != crate::motion::SourceKind::LeRobot {
+        return Err(Error::flag("--forward", format!("{}: needs a LeRobot dataset, whose episodes hold the commands (action) beside what the follower did", args.source.display())));
+    }
+    let motors = args.motors.clone().ok_or_else(|| Error::flag("--forward", "needs --motors: the servos that follow the commands"))?;
+    // the command schedules go where the recordings go
+    let dir = args.files.rrd.as_ref().and_then(|p| p.parent().map(|d| d.to_path_buf())).filter(|d| !d.as_os_str().is_empty()).unwrap_or_else(|| PathBuf::from("recordings"));
+    std::fs::create_dir_all(&dir).map_err(|e| Error::output(&dir, e))?;
+    let mut documents = Vec::new();
+    for &index in episodes {
+        let commands = source.read(index, "action")?;
+        let observed = source.read(index, &args.recorded.feature)?;
+        let options = ForwardOptions { motors: motors.clone(), payload: args.payload, tool: args.tool.clone(), schedule: schedule_path(&dir, index) };
+        let replay = forward(replayer, &options, &commands, &observed)?;
+        print!("{}", text(&replay));
+        documents.push(serde_json::json!({ "episode": index, "joints": replay.joints }));
+    }
+    if let Some(path) = &args.summary_json {
+        let doc = serde_json::json!({ "source": args.source.display().to_string(), "forward": true, "parts_above_rad": crate::replay::forward::PARTS_ABOVE, "episodes": documents });
         let text = serde_json::to_string_pretty(&doc).map_err(|e| Error::output(path, e))?;
         std::fs::write(path, text + "\n").map_err(|e| Error::output(path, e))?;
     }

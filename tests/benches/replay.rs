@@ -19,7 +19,7 @@ fn dataset(root: &std::path::Path, episodes: usize) -> Replayer {
     let gripper = &model.joints[5];
     let mut storage = vec![Storage::Degrees { sign: 1.0, offset: 0.0 }; 5];
     storage.push(Storage::Range0To100 { lower: gripper.lower, upper: gripper.upper });
-    Spec { fps: 30.0, frames: 601, episodes: (0..episodes).map(motions).collect(), storage }.write_v3(root);
+    Spec { fps: 30.0, frames: 601, episodes: (0..episodes).map(motions).collect(), storage, observed: None }.write_v3(root);
     let source = Source::open(root, None).unwrap();
     let map = JointMap::builtin(source.kind(), &model, &source.read(0, "observation.state").unwrap()).unwrap();
     Replayer::new(model, &ReplayOptions { payload: 0.2, ..Default::default() }, map).unwrap()

@@ -78,6 +78,9 @@ pub struct Spec {
     /// Per episode, per joint (the six columns), its true motion.
     pub episodes: Vec<Vec<Sines>>,
     pub storage: Vec<Storage>,
+    /// Per episode, frame and joint, what the follower did (rad), where it differs from the command
+    /// (`observation.state`; the command, `action`, is `episodes`); None: the follower is the command.
+    pub observed: Option<Vec<Vec<Vec<f64>>>>,
 }
 
 impl Spec {
@@ -92,11 +95,19 @@ impl Spec {
         out
     }
 
+    fn observed_values(&self, episode: usize) -> Option<Vec<f32>> {
+        let observed = &self.observed.as_ref()?[episode];
+        Some((0..self.frames).flat_map(|f| (0..6).map(move |j| self.storage[j].value(observed[f][j]))).collect())
+    }
+
     fn batch(&self, episode: usize, first_index: i64) -> RecordBatch {
         let n = self.frames;
         let item = Arc::new(Field::new("item", DataType::Float32, true));
-        let state = FixedSizeListArray::try_new(item.clone(), 6, Arc::new(Float32Array::from(self.values(episode))), None).unwrap();
-        let action = state.clone();
+        let action = FixedSizeListArray::try_new(item.clone(), 6, Arc::new(Float32Array::from(self.values(episode))), None).unwrap();
+        let state = match self.observed_values(episode) {
+            Some(values) => FixedSizeListArray::try_new(item.clone(), 6, Arc::new(Float32Array::from(values)), None).unwrap(),
+            None => action.clone(),
+        };
         let columns: Vec<ArrayRef> = vec![
             Arc::new(action),
             Arc::new(state),

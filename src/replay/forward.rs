@@ -1,0 +1,176 @@
+//! Forward replay: an episode's commands (LeRobot's `action`, the leader's positions) followed by the
+//! simulated arm through each joint's motor — a bus servo through its firmware loop — and held against
+//! what the real follower did (`observation.state`): the sim-to-real gap of the whole arm, per joint.
+
+use super::{Replayer, inverse_replay, schedule};
+use crate::config::RunConfig;
+use crate::error::Error;
+use crate::experiment::Experiment;
+use crate::motion::Episode;
+use crate::recorder::{Recorder, RunInfo};
+use crate::sample::Sample;
+use crate::summary::Summary;
+use std::path::{Path, PathBuf};
+
+/// The gap at which the simulated and the real follower are said to part, rad (3°: well above an
+/// encoder's quantum and a servo's deadband, well below a missed motion).
+pub const PARTS_ABOVE: f64 = 0.05;
+
+/// One joint's tracking, real and simulated, and the gap between them, rad (m).
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct JointGap {
+    pub joint: String,
+    /// Mean and largest |observed − commanded|: how the real follower tracked.
+    pub real_tracking_mae: f64,
+    pub real_tracking_max: f64,
+    /// Mean and largest |simulated − commanded|: how the model tracked.
+    pub sim_tracking_mae: f64,
+    pub sim_tracking_max: f64,
+    /// Mean and largest |simulated − observed|, and when the largest was, s.
+    pub gap_mae: f64,
+    pub gap_max: f64,
+    pub gap_max_at: f64,
+    /// The first time the gap exceeds [`PARTS_ABOVE`], s.
+    pub parts_at: Option<f64>,
+}
+
+/// One episode replayed forward.
+#[derive(Clone, Debug)]
+pub struct ForwardReplay {
+    pub label: String,
+    /// The episode's frame times from its first frame, s.
+    pub time: Vec<f64>,
+    /// Per joint of the map, at every frame: commanded, observed and simulated positions.
+    pub commanded: Vec<Vec<f64>>,
+    pub observed: Vec<Vec<f64>>,
+    pub simulated: Vec<Vec<f64>>,
+    pub joints: Vec<JointGap>,
+}
+
+/// What the run needs beyond the replayer: the motor file (required: the joints' servos), payload and
+/// tool, and where to write the command schedule the run follows.
+pub struct ForwardOptions {
+    pub motors: PathBuf,
+    pub payload: f64,
+    pub tool: Option<String>,
+    pub schedule: PathBuf,
+}
+
+/// Follow `commands` on the simulated arm from where they start, and compare with `observed`.
+pub fn forward(replayer: &Replayer, options: &ForwardOptions, commands: &Episode, observed: &Episode) -> Result<ForwardReplay, Error> {
+    let model = &replayer.base_model;
+    let command = inverse_replay(&replayer.model, &replayer.map, commands, &replayer.hold)?;
+    let reality = inverse_replay(&replayer.model, &replayer.map, observed, &replayer.hold)?;
+    if command.len() != reality.len() || command.time.iter().zip(&reality.time).any(|(a, b)| (a - b).abs() > 1e-9) {
+        return Err(Error::flag(commands.label.clone(), format!("its commands ({} frames) and observations ({} frames) are not sampled at the same times", command.len(), reality.len())));
+    }
+    schedule::write(&options.schedule, &command)?;
+    // the run starts where the commands start: a servo's firmware holds its goal there, sagged under
+    // the weight as the real follower's did (a motor with no firmware model starts on the pose)
+    let (length, first_command) = schedule::span(&command);
+    let n = model.dof();
+    let start: Vec<String> = first_command.iter().map(|q| format!("{q:?}")).collect();
+    let config = RunConfig {
+        urdf: model.source.clone(),
+        motors: Some(options.motors.clone()),
+        payload: options.payload,
+        tool: options.tool.clone(),
+        trajectory: Some(options.schedule.clone()),
+        duration: length,
+        q0: Some(start.join(",")),
+        ..RunConfig::default()
+    };
+    let experiment = Experiment::with_model(config, model.clone())?;
+    let mut capture = Capture { q: Vec::new() };
+    let summary = crate::sim::simulate(&experiment, &mut [&mut capture], None)?;
+    if !matches!(summary.status, crate::summary::RunStatus::Completed) {
+        return Err(Error::Diverged(format!("{}: the forward replay did not complete: {:?}", commands.label, summary.status)));
+    }
+    let dt = experiment.dt();
+    let t0 = command.time[0];
+    let time: Vec<f64> = command.time.iter().map(|t| t - t0).collect();
+    let mapped: Vec<usize> = (0..n).filter(|&j| command.recorded[j].is_some() && reality.recorded[j].is_some()).collect();
+    let step_at = |t: f64| ((t / dt).round() as usize).min(capture.q.len() - 1);
+    let (mut commanded, mut observed, mut simulated, mut joints) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    for &j in &mapped {
+        let c: Vec<f64> = command.recorded[j].clone().unwrap_or_default();
+        let o: Vec<f64> = reality.recorded[j].clone().unwrap_or_default();
+        let s: Vec<f64> = time.iter().map(|&t| capture.q[step_at(t)][j]).collect();
+        let stats = |a: &[f64], b: &[f64]| -> (f64, f64, usize) {
+            let mut worst = (0.0f64, 0usize);
+            let mut sum = 0.0;
+            for k in 0..a.len() {
+                let e = (a[k] - b[k]).abs();
+                sum += e;
+                if e > worst.0 {
+                    worst = (e, k);
+                }
+            }
+            (sum / a.len() as f64, worst.0, worst.1)
+        };
+        let (real_mae, real_max, _) = stats(&o, &c);
+        let (sim_mae, sim_max, _) = stats(&s, &c);
+        let (gap_mae, gap_max, at) = stats(&s, &o);
+        let parts_at = (0..time.len()).find(|&k| (s[k] - o[k]).abs() > PARTS_ABOVE).map(|k| time[k]);
+        joints.push(JointGap {
+            joint: model.joints[j].name.clone(),
+            real_tracking_mae: real_mae,
+            real_tracking_max: real_max,
+            sim_tracking_mae: sim_mae,
+            sim_tracking_max: sim_max,
+            gap_mae,
+            gap_max,
+            gap_max_at: time[at],
+            parts_at,
+        });
+        commanded.push(c);
+        observed.push(o);
+        simulated.push(s);
+    }
+    Ok(ForwardReplay { label: commands.label.clone(), time, commanded, observed, simulated, joints })
+}
+
+/// The run's joint positions at every control step.
+struct Capture {
+    q: Vec<Vec<f64>>,
+}
+
+impl Recorder for Capture {
+    fn start(&mut self, _run: &RunInfo) -> Result<(), Error> {
+        Ok(())
+    }
+    fn record(&mut self, sample: &Sample) -> Result<(), Error> {
+        self.q.push(sample.q.to_vec());
+        Ok(())
+    }
+    fn finish(&mut self, _run: &RunInfo, _summary: &Summary) -> Result<(), Error> {
+        Ok(())
+    }
+}
+
+/// The forward replay as a person reads it: a row per joint, mrad (mm on a prismatic joint).
+pub fn text(replay: &ForwardReplay) -> String {
+    let mut out = format!("{}: the simulated arm following its commands, against the real follower (mrad)\n", replay.label);
+    out += &format!("  {:<16} {:>18} {:>18} {:>22}  {}\n", "joint", "real tracking", "model tracking", "gap model − real", "parts (gap > 50 mrad)");
+    out += &format!("  {:<16} {:>18} {:>18} {:>22}\n", "", "mean / max", "mean / max", "mean / max (at)");
+    for g in &replay.joints {
+        let parts = g.parts_at.map_or("never".to_string(), |t| format!("at {t:.2} s"));
+        out += &format!(
+            "  {:<16} {:>8.1} / {:>7.1} {:>8.1} / {:>7.1} {:>8.1} / {:>6.1} ({:>5.2} s)  {parts}\n",
+            g.joint,
+            g.real_tracking_mae * 1e3,
+            g.real_tracking_max * 1e3,
+            g.sim_tracking_mae * 1e3,
+            g.sim_tracking_max * 1e3,
+            g.gap_mae * 1e3,
+            g.gap_max * 1e3,
+            g.gap_max_at
+        );
+    }
+    out
+}
+
+/// Where the command schedule of episode `index` is written beside the run's other outputs.
+pub fn schedule_path(dir: &Path, index: i64) -> PathBuf {
+    dir.join(format!("forward_commands_episode_{index}.csv"))
+}
