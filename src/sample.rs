@@ -46,6 +46,9 @@ pub struct Sample<'a> {
     pub duty: &'a [f64],
     pub current: &'a [f64],
     pub supply: &'a [f64],
+    /// A recording's measured effort per joint beside the model's torque `u` (a replayed bag's
+    /// `effort`; NaN where a joint has none); empty for a simulation.
+    pub measured_effort: &'a [f64],
     /// With collision checks: the pairs closer than 5 cm at this state, nearest first (distance ≤ 0:
     /// in contact); empty without checks.
     pub collisions: &'a [crate::collision::PairDistance],

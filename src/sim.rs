@@ -24,6 +24,7 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
     let mut plant = experiment.make_plant();
     let controller = experiment.controller();
     let info = RunInfo {
+        measured_effort: Vec::new(),
         experiment,
         plant: plant.describe(),
         trajectory: experiment.trajectory.describe(),
@@ -132,6 +133,7 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
             winding_temperature: if heat.any() { &heat.winding_temperature } else { &no_temperatures },
             duty: &duty,
             current: &current,
+            measured_effort: &[],
             supply: &supply,
             collisions: collision_check.as_ref().map_or(&[], |(_, state, _)| state.close.as_slice()),
             tool_position: frame_pose(model, &data, model.tool_frame).translation,

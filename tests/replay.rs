@@ -316,8 +316,31 @@ fn the_replay_records_the_arm_needed_and_available_torques_like_a_run() {
         assert!((time - t[k]).abs() < 1e-9 && (values[0] - tau[k]).abs() < 1e-5 * tau[k].abs().max(1.0), "sample {k}");
     }
     assert_eq!(file.series("/joints/shoulder_lift/torque_limit").len(), rows);
-    // the MCAP holds a joint state per sample
+    // the bag's measured effort beside the model's torque, and their difference (the friction and
+    // model error the arm really has), at every sample
+    let episode = Source::open(&bag, None).unwrap().read(0, "observation.state").unwrap();
+    let effort = &episode.effort.iter().find(|c| c.name == "shoulder_lift").expect("the bag has effort").values;
+    let measured = file.series("/joints/shoulder_lift/measured_effort");
+    assert_eq!(measured.len(), rows);
+    for (k, (_, values)) in measured.iter().enumerate() {
+        assert!((values[0] - effort[k]).abs() < 1e-9, "sample {k}: measured {} against the bag's {}", values[0], effort[k]);
+        assert!((values[1] - (effort[k] - tau[k])).abs() < 1e-5 * tau[k].abs().max(1.0), "sample {k}: measured − model");
+    }
+    // the MCAP holds a joint state per sample, and the measured effort in /controller
     let bytes = std::fs::read(&mcap).unwrap();
     let count = mcap::MessageStream::new(&bytes).unwrap().filter(|m| m.as_ref().unwrap().channel.topic == "/joint_states").count();
     assert_eq!(count, rows);
+    let lift = so101_joint_index("shoulder_lift");
+    let controller: Vec<f64> = mcap::MessageStream::new(&bytes)
+        .unwrap()
+        .map(|m| m.unwrap())
+        .filter(|m| m.channel.topic == "/controller")
+        .map(|m| <armscope::recorder::ControllerTelemetry as prost::Message>::decode(&m.data[..]).unwrap().measured_effort[lift])
+        .collect();
+    assert_eq!(controller.len(), rows);
+    assert!(controller.iter().zip(effort).all(|(a, b)| (a - b).abs() < 1e-9), "/controller.measured_effort is the bag's effort");
+}
+
+fn so101_joint_index(name: &str) -> usize {
+    load_urdf(&so101()).unwrap().joint_index(name).unwrap()
 }

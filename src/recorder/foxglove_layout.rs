@@ -6,7 +6,7 @@
 use crate::dynamics::{body_poses, frame_pose_in};
 use crate::model::Model;
 use crate::spatial::Pose;
-use super::plot_colours::{FRICTION_RGB, LIMIT_RGB, TARGET_RGB, hex, joint_rgb};
+use super::plot_colours::{FRICTION_RGB, LIMIT_RGB, MEASURED_RGB, TARGET_RGB, hex, joint_rgb};
 use super::torque_axis::TorqueAxis;
 use serde_json::{Value, json};
 
@@ -67,6 +67,8 @@ pub struct RunPlots<'a> {
     pub friction: bool,
     /// Per joint, driven open loop (stepper mode): a plot of load angles and lost steps.
     pub stepped: &'a [bool],
+    /// Per joint, a replayed recording's measured effort beside the model's torque (empty: none).
+    pub measured: &'a [bool],
     /// Per joint, its torque plot's range.
     pub torque_axes: &'a [TorqueAxis],
     /// Per joint, its motor has thermal data: a plot of the winding temperatures.
@@ -89,7 +91,7 @@ fn split_evenly(mut panels: Vec<Value>, direction: &str) -> Value {
 /// The layout of a run of `model` from `q0` showing `plots`. Each joint's torque plot spans
 /// ±`plots.torque_axes[i].half_range` when given.
 pub fn layout_for_run(model: &Model, q0: &[f64], plots: &RunPlots) -> Value {
-    let RunPlots { motors, friction, stepped, torque_axes, heated, collisions } = *plots;
+    let RunPlots { motors, friction, stepped, measured, torque_axes, heated, collisions } = *plots;
     let (target, distance) = camera(model, q0);
     let names: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();
     let angles = names
@@ -105,7 +107,8 @@ pub fn layout_for_run(model: &Model, q0: &[f64], plots: &RunPlots) -> Value {
         .map(|(i, n)| {
             let limit = motors.then(|| coloured(format!("/controller.torque_limit[{i}]"), format!("{n} limit"), LIMIT_RGB));
             let friction = friction.then(|| coloured(format!("/controller.friction[{i}]"), format!("{n} friction"), FRICTION_RGB));
-            let paths = std::iter::once(coloured(format!("/controller.torque[{i}]"), format!("{n} torque"), joint_rgb(i))).chain(limit).chain(friction).collect();
+            let measured = measured.get(i).copied().unwrap_or(false).then(|| coloured(format!("/controller.measured_effort[{i}]"), format!("{n} measured effort"), MEASURED_RGB));
+            let paths = std::iter::once(coloured(format!("/controller.torque[{i}]"), format!("{n} torque"), joint_rgb(i))).chain(limit).chain(friction).chain(measured).collect();
             let mut panel = plot(paths);
             if let Some(axis) = torque_axes.get(i) {
                 panel["minYValue"] = json!(-axis.half_range);
@@ -231,7 +234,7 @@ mod tests {
         let axes: Vec<TorqueAxis> = (0..n).map(|i| TorqueAxis::new(0.1 * (i + 1) as f64, 35.0)).collect();
         let stepped = [false, true, false, false, false, false];
         let heated = [false, true, false, false, false, false];
-        let l = layout_for_run(&model, &vec![0.0; n], &RunPlots { motors: true, friction: true, stepped: &stepped, torque_axes: &axes, heated: &heated, collisions: false });
+        let l = layout_for_run(&model, &vec![0.0; n], &RunPlots { motors: true, friction: true, stepped: &stepped, measured: &[], torque_axes: &axes, heated: &heated, collisions: false });
         // the tree places every configured panel exactly once, and only those
         let mut ids = Vec::new();
         placed(&l["layout"], &mut ids);

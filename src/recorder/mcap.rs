@@ -459,6 +459,7 @@ impl Recorder for McapRecorder {
             duty: per_joint(e.servos.is_some()),
             current: per_joint(e.servos.is_some()),
             supply: per_joint(e.servos.is_some()),
+            measured_effort: Vec::new(),
         };
         self.motors = e.motors.clone();
         self.scene = scene_from_model(model).map_err(|(path, err)| Error::output(&path, err))?;
@@ -636,7 +637,15 @@ fn write_layout(run: &RunInfo, mcap: &std::path::Path, torque_axes: &[super::tor
     let e = run.experiment;
     let stepped = e.stepped_joints();
     let heated: Vec<bool> = e.motor_heat().iter().map(Option::is_some).collect();
-    let plots = super::foxglove_layout::RunPlots { motors: e.motors.is_some(), friction: e.joint_has_friction().contains(&true), stepped: &stepped, torque_axes, heated: &heated, collisions: e.collisions.is_some() };
+    let plots = super::foxglove_layout::RunPlots {
+        motors: e.motors.is_some(),
+        friction: e.joint_has_friction().contains(&true),
+        stepped: &stepped,
+        measured: &run.measured_effort,
+        torque_axes,
+        heated: &heated,
+        collisions: e.collisions.is_some(),
+    };
     let layout = super::foxglove_layout::layout_for_run(&e.model, &e.initial_state().0, &plots);
     let layout_path = super::foxglove_layout::layout_path(mcap);
     std::fs::write(&layout_path, serde_json::to_string_pretty(&layout).unwrap_or_default()).map_err(|err| Error::output(&layout_path, err))

@@ -199,6 +199,7 @@ pub fn controller_telemetry(t: &ControllerTelemetry, out: &mut Vec<u8>) {
     w.f64_sequence(&t.duty);
     w.f64_sequence(&t.current);
     w.f64_sequence(&t.supply);
+    w.f64_sequence(&t.measured_effort);
 }
 
 /// A `/controller` message of the ROS 2 encoding back (the comparison of finished runs reads it).
@@ -218,7 +219,8 @@ pub fn decode_controller_telemetry(bytes: &[u8]) -> Result<ControllerTelemetry, 
     let (motor_speed, friction) = (r.f64_sequence()?, r.f64_sequence()?);
     let stuck = flags(&mut r)?;
     let (winding_temperature, duty, current, supply) = (r.f64_sequence()?, r.f64_sequence()?, r.f64_sequence()?, r.f64_sequence()?);
-    Ok(ControllerTelemetry { time, target, error, torque, tau_g, saturated, chatter, tool_error, tool_position, torque_limit, load_angle, lost_steps, motor_speed, friction, stuck, winding_temperature, duty, current, supply })
+    let measured_effort = r.f64_sequence()?;
+    Ok(ControllerTelemetry { time, target, error, torque, tau_g, saturated, chatter, tool_error, tool_position, torque_limit, load_angle, lost_steps, motor_speed, friction, stuck, winding_temperature, duty, current, supply, measured_effort })
 }
 
 impl Ros2McapRecorder {
@@ -354,6 +356,7 @@ impl Recorder for Ros2McapRecorder {
             duty: per_joint(e.servos.is_some()),
             current: per_joint(e.servos.is_some()),
             supply: per_joint(e.servos.is_some()),
+            measured_effort: Vec::new(),
             ..Default::default()
         };
         self.motors = e.motors.clone();

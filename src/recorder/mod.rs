@@ -55,6 +55,9 @@ pub struct RunInfo<'a> {
     /// Each joint's torque plot scale, worked out on first use: recorders read it through
     /// [`RunInfo::torque_axes`]; only the loop that makes a `RunInfo` sets it.
     pub(crate) torque_axes: torque_axis::LazyAxes<'a>,
+    /// Per joint, whether the samples carry a measured effort beside the model's torque (a replayed
+    /// bag's `effort`); empty for a simulation.
+    pub measured_effort: Vec<bool>,
 }
 
 impl RunInfo<'_> {

@@ -40,6 +40,11 @@ pub const STUCK_RGB: (u8, u8, u8) = (120, 120, 120);
 /// A motor's shaft speed in its joint's stepper plot, beside the load angle in the joint's colour.
 pub const MOTOR_SPEED_RGB: (u8, u8, u8) = (235, 235, 235);
 
+/// A recording's measured effort in each torque plot (a replayed bag's), and its difference from
+/// the model's torque (the friction and model error the arm really has).
+pub const MEASURED_RGB: (u8, u8, u8) = (255, 160, 40);
+pub const MEASURED_GAP_RGB: (u8, u8, u8) = (90, 200, 250);
+
 /// A servo motor's current in its joint's servo plot, beside the duty in the joint's colour.
 pub const CURRENT_RGB: (u8, u8, u8) = (235, 235, 235);
 

@@ -18,7 +18,7 @@ use rerun::{RecordingStream, TimeColumn};
 use super::torque_axis::TorqueAxis;
 use super::rrd_collisions::{Recolour, RrdCollisions, log_geometry};
 use super::column_pool::ColumnPool;
-use super::plot_colours::{CHATTER_RGB, CURRENT_RGB, FRICTION_RGB, GRAVITY_TORQUE_RGB, LIMIT_RGB, MOTOR_SPEED_RGB, SATURATED_RGB, STUCK_RGB, TARGET_RGB, joint_rgb};
+use super::plot_colours::{CHATTER_RGB, CURRENT_RGB, FRICTION_RGB, GRAVITY_TORQUE_RGB, LIMIT_RGB, MEASURED_GAP_RGB, MEASURED_RGB, MOTOR_SPEED_RGB, SATURATED_RGB, STUCK_RGB, TARGET_RGB, joint_rgb};
 use rerun::external::arrow::buffer::{Buffer, OffsetBuffer};
 use std::collections::VecDeque;
 use std::path::PathBuf;
@@ -75,6 +75,9 @@ struct JointColumns {
     winding: Vec<f64>,
     /// Firmware mode: `joints/<joint>/servo`, [PWM duty, motor current (A)] per step.
     servo: Vec<f64>,
+    /// A replayed recording with measured effort: `joints/<joint>/measured_effort`, [measured effort,
+    /// measured − model torque] per step.
+    measured: Vec<f64>,
 }
 
 impl JointColumns {
@@ -93,11 +96,12 @@ impl JointColumns {
             friction: Vec::new(),
             winding: Vec::new(),
             servo: Vec::new(),
+            measured: Vec::new(),
         }
     }
 
     fn clear(&mut self) {
-        for c in [&mut self.position, &mut self.torque, &mut self.status, &mut self.saturated_times, &mut self.saturated_torque, &mut self.limit, &mut self.load_angle, &mut self.lost_steps, &mut self.motor_speed, &mut self.friction, &mut self.winding, &mut self.servo] {
+        for c in [&mut self.position, &mut self.torque, &mut self.status, &mut self.saturated_times, &mut self.saturated_torque, &mut self.limit, &mut self.load_angle, &mut self.lost_steps, &mut self.motor_speed, &mut self.friction, &mut self.winding, &mut self.servo, &mut self.measured] {
             c.clear();
         }
     }
@@ -153,6 +157,8 @@ pub struct RerunRecorder {
     notice_sink: Option<Box<dyn Fn(&str) + Send>>,
     /// Per joint: its motor has thermal data (its winding temperature is recorded).
     heated: Vec<bool>,
+    /// Per joint: the samples carry a measured effort (a replayed bag's).
+    measured: Vec<bool>,
     /// With collision checks: what is in contact, drawn and plotted.
     collisions: Option<RrdCollisions>,
     /// Memory for the columns sent at every block, for their row ids and the trail's points.
@@ -205,6 +211,7 @@ impl RerunRecorder {
             notices: Vec::new(),
             notice_sink: None,
             heated: Vec::new(),
+            measured: Vec::new(),
             collisions: None,
             values_pool: ColumnPool::default(),
             ids_pool: ColumnPool::default(),
@@ -367,6 +374,7 @@ impl RerunRecorder {
                 ("friction", lines(&[format!("{name} friction (N·m)"), format!("{name} stuck (0/1)")], &[rgb(FRICTION_RGB), rgb(STUCK_RGB)], &[1.0, 1.0])),
                 ("winding_temperature", lines(&[format!("{name} winding (°C)")], &[c], &[1.5])),
                 ("servo", lines(&[format!("{name} PWM duty (−1 … 1)"), format!("{name} current (A)")], &[c, rgb(CURRENT_RGB)], &[1.5, 1.0])),
+                ("measured_effort", lines(&[format!("{name} measured effort (N·m)"), format!("{name} measured − model (N·m)")], &[rgb(MEASURED_RGB), rgb(MEASURED_GAP_RGB)], &[1.5, 1.0])),
             ];
             let has_motor = self.motors.as_ref().is_some_and(|m| m.joints.get(j).is_some_and(Option::is_some));
             let recorded = |leaf: &str| match leaf {
@@ -375,6 +383,7 @@ impl RerunRecorder {
                 "friction" => friction,
                 "winding_temperature" => self.heated[j],
                 "servo" => self.servo_driven[j],
+                "measured_effort" => self.measured[j],
                 _ => true,
             };
             for (leaf, style) in styles.into_iter().filter(|(leaf, _)| recorded(leaf)) {
@@ -446,6 +455,9 @@ impl RerunRecorder {
             }
             if self.servo_driven[j] {
                 send(&format!("{base}/servo"), time.clone(), scalars(&c.servo, 2))?;
+            }
+            if self.measured[j] {
+                send(&format!("{base}/measured_effort"), time.clone(), scalars(&c.measured, 2))?;
             }
             if self.stepped[j] {
                 send(&format!("{base}/load_angle"), time.clone(), scalars(&c.load_angle, 1))?;
@@ -718,7 +730,7 @@ pub fn blueprint(joint_names: &[String], stepped: &[bool], servo_driven: &[bool]
             let axis = torque_axes.get(i);
             let view: ContainerLike = TimeSeriesView::new(axis.map_or_else(|| format!("{j} torque vs ±limit"), |a| a.title(j)))
                 .with_origin(format!("{prefix}joints/{j}"))
-                .with_contents(["$origin/torque", "$origin/torque_limit", "$origin/saturated_torque", "$origin/friction"])
+                .with_contents(["$origin/torque", "$origin/torque_limit", "$origin/saturated_torque", "$origin/friction", "$origin/measured_effort"])
                 .into();
             if let (Some(axis), ContainerLike::View(v)) = (axis, &view) {
                 torque_ranges.push((v.blueprint_path(), axis.half_range));
@@ -864,6 +876,7 @@ impl Recorder for RerunRecorder {
         self.stepped = e.stepped_joints();
         self.servo_driven = e.firmware_joints();
         self.heated = e.motor_heat().iter().map(Option::is_some).collect();
+        self.measured = (0..model.dof()).map(|j| run.measured_effort.get(j).copied().unwrap_or(false)).collect();
         self.motors = e.motors.clone();
         let cap = FILE_BLOCK_STEPS + 1;
         self.times = Vec::with_capacity(cap);
@@ -940,6 +953,10 @@ impl Recorder for RerunRecorder {
             }
             if self.heated[j] {
                 c.winding.push(s.winding_temperature[j]);
+            }
+            if self.measured[j] {
+                let measured = s.measured_effort[j];
+                c.measured.extend_from_slice(&[measured, measured - s.u[j]]);
             }
             if self.servo_driven[j] {
                 c.servo.extend_from_slice(&[s.duty[j], s.current[j]]);

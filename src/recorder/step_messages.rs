@@ -192,6 +192,7 @@ pub fn controller_telemetry(message: &ControllerTelemetry, out: &mut Vec<u8>) {
     packed_doubles(17, &m.duty, out);
     packed_doubles(18, &m.current, out);
     packed_doubles(19, &m.supply, out);
+    packed_doubles(20, &m.measured_effort, out);
 }
 
 #[cfg(test)]
@@ -295,6 +296,7 @@ mod tests {
                     duty: if shift % 4 == 1 { d(4) } else { vec![] },
                     current: if shift % 4 == 1 { d(5) } else { vec![] },
                     supply: if shift % 4 == 1 { d(6) } else { vec![] },
+                    measured_effort: if shift % 3 == 2 { d(7) } else { vec![] },
                 };
                 let mut ours = vec![0xCD];
                 controller_telemetry(&message, &mut ours);

@@ -76,6 +76,10 @@ pub struct ControllerTelemetry {
     /// Firmware mode: the supply at each servo, V.
     #[prost(double, repeated, tag = "19")]
     pub supply: Vec<f64>,
+    /// A replayed recording's measured effort per joint beside the model's torque, N·m (NaN where a
+    /// joint has none; empty for a simulation).
+    #[prost(double, repeated, tag = "20")]
+    pub measured_effort: Vec<f64>,
 }
 
 impl ControllerTelemetry {
@@ -107,6 +111,8 @@ impl ControllerTelemetry {
         }
         tel.winding_temperature.clear();
         tel.winding_temperature.extend_from_slice(s.winding_temperature);
+        tel.measured_effort.clear();
+        tel.measured_effort.extend_from_slice(s.measured_effort);
         if !s.duty.is_empty() {
             tel.duty.copy_from_slice(s.duty);
             tel.current.copy_from_slice(s.current);
@@ -154,6 +160,7 @@ pub fn file_descriptor_set() -> Vec<u8> {
             field("duty", 17, true, Type::Double),
             field("current", 18, true, Type::Double),
             field("supply", 19, true, Type::Double),
+            field("measured_effort", 20, true, Type::Double),
         ],
         ..Default::default()
     };

@@ -50,6 +50,7 @@ pub fn record(replayer: &Replayer, replay: &EpisodeReplay, outputs: &RecordingOu
             .collect()
     };
     let info = RunInfo {
+        measured_effort: motion.measured.iter().map(Option::is_some).collect(),
         experiment: &experiment,
         plant: "a recorded motion, replayed by inverse dynamics (no simulation)".into(),
         trajectory: format!("{} as recorded", motion.label),
@@ -80,6 +81,9 @@ pub fn record(replayer: &Replayer, replay: &EpisodeReplay, outputs: &RecordingOu
     let (mut q, mut v, mut cmd, mut cmd_dot, mut u, mut tau_g) = (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
     let (mut saturated, mut limit) = (vec![false; n], vec![0.0; n]);
     let (zeros, no_steps, flags) = (vec![0.0; n], vec![0i64; n], vec![false; n]);
+    // a bag's measured effort beside the model's torque (NaN on a joint it has none for)
+    let has_measured = motion.measured.iter().any(Option::is_some);
+    let mut measured = if has_measured { vec![f64::NAN; n] } else { Vec::new() };
     let started = std::time::Instant::now();
     for k in 0..samples {
         for j in 0..n {
@@ -90,6 +94,9 @@ pub fn record(replayer: &Replayer, replay: &EpisodeReplay, outputs: &RecordingOu
             u[j] = motion.needed[j][k];
             limit[j] = replay.available[j][k];
             saturated[j] = u[j].abs() > limit[j];
+            if let (Some(slot), Some(series)) = (measured.get_mut(j), &motion.measured[j]) {
+                *slot = series[k];
+            }
         }
         forward_kinematics(model, &mut data, &q);
         gravity_from_kinematics(model, &mut data);
@@ -119,6 +126,7 @@ pub fn record(replayer: &Replayer, replay: &EpisodeReplay, outputs: &RecordingOu
             duty: &[],
             current: &[],
             supply: &[],
+            measured_effort: &measured,
             collisions: &[],
             tool_position,
             tool_target,
