@@ -9,7 +9,8 @@ use armscope::actuator::bus_servo::{FrictionModel, ServoFriction, ServoParams};
 use armscope::identify::{FitOptions, Space, fit};
 use armscope::testbench::synthetic::{Bench, Trajectory, record};
 use armscope::testbench::{ReplayOptions, Step, mae};
-use criterion::{Criterion, black_box, criterion_group, criterion_main};
+use criterion::{Criterion, criterion_group, criterion_main};
+use std::hint::black_box;
 
 fn servo() -> ServoParams {
     let friction = ServoFriction {
