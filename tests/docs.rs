@@ -34,19 +34,23 @@ fn read_expanded(path: &Path) -> String {
         .collect()
 }
 
+/// The lines of a Markdown text outside its fenced code blocks.
+fn prose_lines(markdown: &str) -> impl Iterator<Item = &str> {
+    let mut in_code = false;
+    markdown.lines().filter(move |line| {
+        let fence = line.trim_start().starts_with("```");
+        if fence {
+            in_code = !in_code;
+        }
+        !fence && !in_code
+    })
+}
+
 /// The id mdBook gives a heading: its text (code spans and link texts as text), lower case, spaces as
 /// dashes, alphanumerics, `-` and `_` kept, everything else dropped; a repeated id gets `-1`, `-2`, ….
 fn heading_ids(markdown: &str) -> BTreeSet<String> {
     let mut ids = BTreeSet::new();
-    let mut in_code = false;
-    for line in markdown.lines() {
-        if line.trim_start().starts_with("```") {
-            in_code = !in_code;
-            continue;
-        }
-        if in_code {
-            continue;
-        }
+    for line in prose_lines(markdown) {
         if let Some(text) = line.strip_prefix('#').map(|t| t.trim_start_matches('#').trim()) {
             let text = strip_links(text);
             let id: String = text
@@ -102,15 +106,7 @@ fn strip_links(text: &str) -> String {
 /// Every `](target)` of a Markdown text outside code blocks.
 fn links(markdown: &str) -> Vec<String> {
     let mut found = Vec::new();
-    let mut in_code = false;
-    for line in markdown.lines() {
-        if line.trim_start().starts_with("```") {
-            in_code = !in_code;
-            continue;
-        }
-        if in_code {
-            continue;
-        }
+    for line in prose_lines(markdown) {
         let mut rest = line;
         while let Some(at) = rest.find("](") {
             let after = &rest[at + 2..];
