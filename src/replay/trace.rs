@@ -1,6 +1,6 @@
 //! `replay --trace FILE.csv`: one row per sample, `t,q1..qN,qd1..qN,qdd1..qN,tau1..tauN` in the
 //! joint order of `armscope model`, t in seconds from the episode's first sample, every number
-//! round-trip exact.
+//! round-trip exact. The CSV writer here also writes the joint schedules of [`super::schedule`].
 
 use super::inverse::Motion;
 use crate::error::Error;
@@ -16,16 +16,21 @@ pub fn header(n: usize) -> Vec<String> {
 }
 
 pub fn write(path: &Path, motion: &Motion) -> Result<(), Error> {
+    write_columns(path, &header(motion.q.len()), &motion.time, 0.0, &[&motion.q, &motion.qd, &motion.qdd, &motion.needed])
+}
+
+/// A CSV under `header`: per sample k, `time[k] − t0`, then every joint of each of `series` in turn,
+/// every number round-trip exact.
+pub(super) fn write_columns(path: &Path, header: &[String], time: &[f64], t0: f64, series: &[&Vec<Vec<f64>>]) -> Result<(), Error> {
     use std::fmt::Write as _;
     let file = std::fs::File::create(path).map_err(|e| Error::output(path, e))?;
     let mut out = BufWriter::new(file);
-    let n = motion.q.len();
-    let mut line = header(n).join(",");
+    let mut line = header.join(",");
     line.push('\n');
-    for k in 0..motion.len() {
-        let _ = write!(line, "{:?}", motion.time[k]);
-        for series in [&motion.q, &motion.qd, &motion.qdd, &motion.needed] {
-            for joint in series {
+    for (k, t) in time.iter().enumerate() {
+        let _ = write!(line, "{:?}", t - t0);
+        for joints in series {
+            for joint in joints.iter() {
                 let _ = write!(line, ",{:?}", joint[k]);
             }
         }
