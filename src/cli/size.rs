@@ -228,7 +228,7 @@ fn motions(args: &SizeArgs) -> Result<Vec<(String, RunConfig)>, Error> {
 /// schedule into OUT/episodes/, then followed from its first pose for its own length.
 fn recorded_motions(args: &SizeArgs, source: &std::path::Path, base: RunConfig) -> Result<Vec<(String, RunConfig)>, Error> {
     use crate::motion::{Mapped, open_mapped};
-    use crate::replay::{ReplayOptions, Replayer, schedule};
+    use crate::replay::{ReplayOptions, Replayer, inverse_replay, schedule};
     let model = crate::model::load_urdf(&args.urdf)?;
     let recorded = &args.recorded;
     let mapped = match open_mapped(source, recorded.topic.as_deref(), recorded.episode.as_deref(), &recorded.feature, recorded.joint_map.as_deref(), &model)? {
@@ -245,7 +245,8 @@ fn recorded_motions(args: &SizeArgs, source: &std::path::Path, base: RunConfig) 
     let several = mapped.episodes.len() > 1 || mapped.source.kind() == crate::motion::SourceKind::LeRobot;
     let mut out = Vec::new();
     for index in mapped.episodes {
-        let motion = replayer.replay(&mapped.source.read(index, &recorded.feature)?)?.motion;
+        // the smoothed motion alone: no motor is held against it here
+        let motion = inverse_replay(&replayer.model, &replayer.map, &mapped.source.read(index, &recorded.feature)?, &replayer.hold)?;
         for notice in &motion.notices {
             eprintln!("armscope: notice: {notice}");
         }
