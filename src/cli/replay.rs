@@ -133,7 +133,7 @@ fn forward(args: &ReplayArgs, replayer: &Replayer, source: &crate::motion::Sourc
     }
     let motors = args.motors.clone().ok_or_else(|| Error::flag("--forward", "needs --motors: the servos that follow the commands"))?;
     // the command schedules go where the recordings go
-    let dir = args.files.rrd.as_ref().and_then(|p| p.parent().map(|d| d.to_path_buf())).filter(|d| !d.as_os_str().is_empty()).unwrap_or_else(|| PathBuf::from("recordings"));
+    let dir = args.files.folder();
     std::fs::create_dir_all(&dir).map_err(|e| Error::output(&dir, e))?;
     let mut documents = Vec::new();
     for &index in episodes {

@@ -89,12 +89,21 @@ pub struct RecordingFiles {
 }
 
 impl RecordingFiles {
+    /// The folder the recordings go to by default.
+    pub const FOLDER: &'static str = "recordings";
+
     /// The `.rrd` and `.mcap` to write for a recording named `name` (None: not wanted).
     pub fn paths(&self, name: &str) -> (Option<PathBuf>, Option<PathBuf>) {
-        let recordings = PathBuf::from("recordings");
+        let recordings = PathBuf::from(Self::FOLDER);
         let rrd = (!self.no_rrd).then(|| self.rrd.clone().unwrap_or_else(|| recordings.join(format!("{name}.rrd"))));
         let mcap = (!self.no_mcap).then(|| self.mcap.clone().unwrap_or_else(|| recordings.join(format!("{name}.mcap"))));
         (rrd, mcap)
+    }
+
+    /// Where files that go with the recordings belong: beside `--rrd`, else the default folder.
+    pub fn folder(&self) -> PathBuf {
+        let beside = self.rrd.as_ref().and_then(|p| p.parent()).filter(|d| !d.as_os_str().is_empty());
+        beside.map_or_else(|| PathBuf::from(Self::FOLDER), PathBuf::from)
     }
 }
 
