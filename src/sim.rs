@@ -207,6 +207,13 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
         summary.winding = heat.summary();
     }
     summary.collisions = collision_check.map(|(_, _, log)| log.finish());
+    if let Some(s) = servos.as_ref() {
+        for (servo, trip) in summary.servos.iter_mut().zip(s.trips(n)) {
+            if let Some(servo) = servo {
+                servo.protection_trip = trip;
+            }
+        }
+    }
     if let Some(motors) = &experiment.motors {
         summary.drive_duty = motors
             .joints

@@ -1,5 +1,6 @@
 //! The numbers a run ends with: tracking error, saturation, limit hits, tool range.
 
+use crate::actuator::bus_servo::Trip;
 use crate::sample::Sample;
 use serde::{Deserialize, Serialize};
 
@@ -64,6 +65,9 @@ pub struct ServoDuty {
     /// The motor's current, A: its largest and its RMS over the control steps.
     pub peak_current: f64,
     pub rms_current: f64,
+    /// The firmware protection that tripped, if one did (a Feetech's overload or overcurrent).
+    #[serde(default)]
+    pub protection_trip: Option<Trip>,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -368,6 +372,7 @@ impl SummaryBuilder {
                         peak_abs_duty: self.peak_duty[i],
                         peak_current: self.peak_current[i],
                         rms_current: if self.control_steps == 0 { 0.0 } else { (self.sum_squared_current[i] / self.control_steps as f64).sqrt() },
+                        protection_trip: None,
                     })
                 })
                 .collect(),
@@ -405,6 +410,9 @@ impl Summary {
             if let Some(Some(servo)) = self.servos.get(j) {
                 // a servo's position loop: at full duty it gives what the supply allows, and its
                 // current is what heats it and trips the supply
+                if let Some(trip) = &servo.protection_trip {
+                    out.push(format!("{name}: {} — a real one reports an {} error", trip.describe(), trip.kind.name()));
+                }
                 if servo.full_duty_percent > 0.0 {
                     out.push(format!(
                         "{name}: its servo at full duty {:.1}% of the run (first at t = {:.3} s), drawing up to {:.2} A (RMS {:.2} A) — the position loop asks for more than the PWM gives there",

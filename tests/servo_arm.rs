@@ -165,3 +165,84 @@ fn a_firmware_current_limit_holds_the_current_and_says_so() {
     assert!(summary["summary"]["saturation_percent"][1].as_f64().unwrap() > 50.0);
     assert!(stdout.contains("shoulder_lift: its servo at its current limit"), "{stdout}");
 }
+
+/// Shoulder_lift's duty and position at every control step.
+#[derive(Default)]
+struct ShoulderLog {
+    rows: Vec<(f64, f64, f64)>,
+}
+
+impl armscope::recorder::Recorder for ShoulderLog {
+    fn start(&mut self, _: &armscope::recorder::RunInfo) -> Result<(), armscope::error::Error> {
+        Ok(())
+    }
+    fn record(&mut self, s: &armscope::sample::Sample) -> Result<(), armscope::error::Error> {
+        self.rows.push((s.t, s.duty[1], s.q[1]));
+        Ok(())
+    }
+    fn finish(&mut self, _: &armscope::recorder::RunInfo, _: &armscope::summary::Summary) -> Result<(), armscope::error::Error> {
+        Ok(())
+    }
+}
+
+fn held_with_a_kilogram(motors: &std::path::Path) -> (armscope::summary::Summary, ShoulderLog) {
+    let config = RunConfig { urdf: so101(), motors: Some(motors.to_path_buf()), payload: 1.0, hold: true, duration: 5.0, ..RunConfig::default() };
+    let experiment = Experiment::prepare(config).unwrap();
+    let mut log = ShoulderLog::default();
+    let summary = armscope::sim::simulate(&experiment, &mut [&mut log], None).unwrap();
+    (summary, log)
+}
+
+#[test]
+fn a_feetech_overload_protection_trips_after_its_time_and_leaves_its_protective_duty() {
+    // Feetech's factory settings: a duty of 80 % or more for 2 s limits the servo to 20 %. The
+    // SO-101 holding 1 kg at reach: shoulder_lift's loop asks for full duty and cannot hold; 2 s
+    // after its duty first reached 80 % the protection trips, and the shoulder, at 20 %, falls on.
+    let (summary, log) = held_with_a_kilogram(&so101_motors());
+    let trip = summary.servos[1].as_ref().unwrap().protection_trip.expect("shoulder_lift trips");
+    assert_eq!(trip.kind, armscope::actuator::bus_servo::TripKind::Overload);
+    assert!((trip.time - trip.since - 2.0).abs() < 1e-9, "{trip:?}");
+    // the duty first reached 80 % at the control step the timer started from (plant steps within it)
+    let first_over = log.rows.iter().find(|r| r.1.abs() >= 0.8).unwrap().0;
+    assert!((first_over - trip.since).abs() <= 1e-3 + 1e-9, "first at {first_over}, timer from {}", trip.since);
+    assert!(log.rows.iter().filter(|r| r.0 < trip.time).all(|r| r.1.abs() <= 0.97 + 1e-12));
+    assert!(log.rows.iter().filter(|r| r.0 > trip.time + 1e-3).all(|r| r.1.abs() <= 0.2 + 1e-12), "20 % once tripped");
+    assert!(summary.servos.iter().enumerate().all(|(j, s)| j == 1 || s.as_ref().is_none_or(|s| s.protection_trip.is_none())));
+    assert!(summary.saturation_verdicts().iter().any(|v| v.starts_with("shoulder_lift: its overload protection trips at t =") && v.contains("at most 20 % duty")));
+
+    // with Overload_Torque at 100 % (above the 97 % its PWM reaches) it never trips, and the
+    // shoulder, still at full duty, ends higher than the tripped one
+    let dir = tempfile::tempdir().unwrap();
+    let motors = dir.path().join("m.toml");
+    let text = std::fs::read_to_string(so101_motors()).unwrap().replace("[joints.shoulder_lift]\nmotor = \"STS3215-C018\"\nkp = 16", "[joints.shoulder_lift]\nmotor = \"STS3215-C018\"\nkp = 16\noverload_torque = 100");
+    std::fs::write(&motors, text).unwrap();
+    let (untripped, log_untripped) = held_with_a_kilogram(&motors);
+    assert!(untripped.servos[1].as_ref().unwrap().protection_trip.is_none());
+    let (fell, held) = (log.rows.last().unwrap().2, log_untripped.rows.last().unwrap().2);
+    assert!(fell > held + 0.05, "tripped {fell} rad vs untripped {held} rad");
+}
+
+#[test]
+fn protection_registers_are_checked_and_set_in_their_units() {
+    let dir = tempfile::tempdir().unwrap();
+    let urdf = so101();
+    let attempt = |body: &str| {
+        let motors = dir.path().join("p.toml");
+        std::fs::write(&motors, format!("in_urdf = true\n[joints.shoulder_lift]\n{body}\n")).unwrap();
+        run(&["run", "--urdf", urdf.to_str().unwrap(), "--motors", motors.to_str().unwrap(), "--duration", "0.01", "--no-rrd", "--no-mcap"])
+    };
+    let (code, _, stderr) = attempt("motor = \"STS3215-C018\"\noverload_torque = 101");
+    assert_ne!(code, 0);
+    assert!(stderr.contains("field 'overload_torque' must be a whole register value from 0 to 100 (got 101)"), "{stderr}");
+    let (code, _, stderr) = attempt("motor = \"XL330-M288\"\nprotection_current = 250");
+    assert_ne!(code, 0);
+    assert!(stderr.contains("field 'protection_current' sets a Feetech protection register, but motor 'XL330-M288' has no firmware model with protections"), "{stderr}");
+    // LeRobot's gripper settings: Protection_Current 250 (1.625 A), Overload_Torque 25
+    let motors = dir.path().join("ok.toml");
+    std::fs::write(&motors, "in_urdf = true\n[joints.shoulder_lift]\nmotor = \"STS3215-C018\"\nprotection_current = 250\noverload_torque = 25\nprotection_time = 50\n").unwrap();
+    let set = armscope::actuator::load_motor_file(&motors, &armscope::model::load_urdf(&urdf).unwrap()).unwrap();
+    let p = set.joints[1].as_ref().unwrap().servo.as_ref().unwrap().firmware.protection;
+    let (overload, overcurrent) = (p.overload.unwrap(), p.overcurrent.unwrap());
+    assert!((overcurrent.current - 1.625).abs() < 1e-12 && (overload.threshold - 0.25).abs() < 1e-12 && (overload.time - 0.5).abs() < 1e-12);
+    assert!((overload.protective - 0.2).abs() < 1e-12 && (overcurrent.time - 2.0).abs() < 1e-12, "the others keep the factory's");
+}

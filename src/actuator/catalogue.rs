@@ -58,6 +58,16 @@
 //! BAM parameter file such as `armscope identify` writes, beside this file) may set its P gain
 //! register `kp`, the `supply_voltage`, and a firmware `current_limit` (A: the duty narrowed to
 //! keep the current within it, as an XL330's Current Limit(38) in its current-based position mode).
+//! A Feetech STS servo's protections are its factory settings unless the joint sets their registers
+//! as LeRobot writes them, in the registers' units ([`super::bus_servo::protection`]):
+//!
+//! ```toml
+//! overload_torque = 25              # Overload_Torque, % of full duty: the overload timer starts above it
+//! protective_torque = 20            # Protective_Torque, %: the duty left once it trips
+//! protection_time = 200             # Protection_Time, 10 ms
+//! protection_current = 250          # Protection_Current, 6.5 mA: above it the overcurrent timer runs
+//! overcurrent_protection_time = 200 # 10 ms; once it trips the torque is off
+//! ```
 //!
 //! The reduction's losses act as friction at the joint by the direction power flows
 //! ([`super::LossyGear`]).
@@ -291,6 +301,36 @@ fn servo_settings(fields: &Fields, path: &Path, motor: &str, drive: &mut DriveTr
             "kp" => servo.firmware.kp = x,
             "supply_voltage" => servo.supply = x,
             _ => servo.firmware.current_limit = Some(x),
+        }
+    }
+    protection_registers(fields, motor, drive)
+}
+
+/// A Feetech's protection registers, by their names and in their units
+/// ([`super::bus_servo::protection`]): the largest value each register takes.
+const PROTECTION_REGISTERS: [(&str, f64); 5] = [("overload_torque", 100.0), ("protective_torque", 100.0), ("protection_time", 254.0), ("protection_current", 511.0), ("overcurrent_protection_time", 254.0)];
+
+/// A motor file joint's Feetech protection registers, set as LeRobot writes them (`Overload_Torque`,
+/// `Protection_Current`, …): overload and protective torque in %, times in 10 ms, the current in
+/// 6.5 mA.
+fn protection_registers(fields: &Fields, motor: &str, drive: &mut DriveTrain) -> Result<(), Error> {
+    use super::bus_servo::protection::{CURRENT_UNIT, PERCENT, TIME_UNIT};
+    for (key, largest) in PROTECTION_REGISTERS {
+        let Some(x) = fields.number(key)? else { continue };
+        if !(0.0..=largest).contains(&x) || x.fract() != 0.0 {
+            return Err(fields.err(key, &format!("must be a whole register value from 0 to {largest} (got {x})")));
+        }
+        let protection = drive.servo.as_mut().map(|s| &mut s.firmware.protection);
+        let Some(p) = protection.filter(|p| !p.is_none()) else {
+            return Err(fields.err(key, &format!("sets a Feetech protection register, but motor '{motor}' has no firmware model with protections (a Feetech STS servo's)")));
+        };
+        match (key, p.overload.as_mut(), p.overcurrent.as_mut()) {
+            ("overload_torque", Some(o), _) => o.threshold = x * PERCENT,
+            ("protective_torque", Some(o), _) => o.protective = x * PERCENT,
+            ("protection_time", Some(o), _) => o.time = x * TIME_UNIT,
+            ("protection_current", _, Some(o)) => o.current = x * CURRENT_UNIT,
+            ("overcurrent_protection_time", _, Some(o)) => o.time = x * TIME_UNIT,
+            _ => return Err(fields.err(key, &format!("sets a protection motor '{motor}' does not have"))),
         }
     }
     Ok(())
@@ -636,7 +676,7 @@ pub fn load_motor_file(path: &Path, model: &Model) -> Result<MotorSet, Error> {
         };
         let Value::Table(t) = value else { return Err(fail(path, format!("{what}: expected a table"))) };
         let fields = Fields { file: path, what: &what, table: t };
-        fields.known(&["motor", "reduction", "gear_ratio", "efficiency", "backdrive_efficiency", "breakaway_torque", "viscous", "rated_torque", "microsteps", "acceleration", "in_urdf", "mount_link", "mount_xyz", "servo_params", "kp", "supply_voltage", "current_limit"])?;
+        fields.known(&["motor", "reduction", "gear_ratio", "efficiency", "backdrive_efficiency", "breakaway_torque", "viscous", "rated_torque", "microsteps", "acceleration", "in_urdf", "mount_link", "mount_xyz", "servo_params", "kp", "supply_voltage", "current_limit", "overload_torque", "protective_torque", "protection_time", "protection_current", "overcurrent_protection_time"])?;
         set.acceleration[index] = fields.optional_positive("acceleration")?;
         set.mounts[index] = fields.mount(all_in_urdf)?;
         if let Some(m) = fields.optional_positive("microsteps")? {

@@ -10,7 +10,7 @@
 //! friction, as for every drive train). The servo's own friction (its model M1–M6) is the plant's
 //! too ([`crate::plant::JointFriction`]).
 
-use super::bus_servo::{BusServo, FirmwareState, ServoFriction, ServoOutput};
+use super::bus_servo::{BusServo, FirmwareState, ServoFriction, ServoOutput, Trip};
 use super::MotorSet;
 
 /// One joint's servo.
@@ -24,6 +24,18 @@ struct ServoJoint {
     goal: f64,
     /// The motor at the last plant step's start.
     out: ServoOutput,
+}
+
+impl ServoJoint {
+    /// The largest duty its firmware gives now (less once its overload protection has tripped).
+    fn duty_limit(&self) -> f64 {
+        self.servo.firmware.protection.duty_limit(&self.state.protection, self.servo.firmware.family.max_duty)
+    }
+
+    /// Whether its overcurrent protection has switched its torque off.
+    fn torque_off(&self) -> bool {
+        self.servo.firmware.protection.torque_off(&self.state.protection)
+    }
 }
 
 /// The joints a motor file drives through their servos' firmware.
@@ -47,7 +59,7 @@ impl FirmwareDrives {
             .filter_map(|(j, d)| {
                 let d = d.as_ref()?;
                 let servo = d.servo.clone()?;
-                Some(ServoJoint { joint: j, servo, gear_ratio: d.gear_ratio, state: FirmwareState { target: d.gear_ratio * start[j] }, goal: d.gear_ratio * start[j], out: ServoOutput::default() })
+                Some(ServoJoint { joint: j, servo, gear_ratio: d.gear_ratio, state: FirmwareState::at(d.gear_ratio * start[j]), goal: d.gear_ratio * start[j], out: ServoOutput::default() })
             })
             .collect();
         if joints.is_empty() {
@@ -103,16 +115,25 @@ impl FirmwareDrives {
     pub fn saturated(&self, j: usize) -> bool {
         self.joints.iter().find(|s| s.joint == j).is_some_and(|s| {
             let at_current_limit = s.servo.firmware.current_limit.is_some_and(|limit| s.out.current.abs() >= limit * (1.0 - 1e-9));
-            s.out.duty.abs() >= s.servo.firmware.family.max_duty || s.out.limited || at_current_limit
+            s.out.duty.abs() >= s.duty_limit() || s.out.limited || at_current_limit || s.torque_off()
         })
+    }
+
+    /// Per coordinate, the protection that tripped on its servo, if one did.
+    pub fn trips(&self, dof: usize) -> Vec<Option<Trip>> {
+        let mut out = vec![None; dof];
+        for s in &self.joints {
+            out[s.joint] = s.state.protection.trip;
+        }
+        out
     }
 
     /// The torque joint `j`'s servo gives at full duty at joint speed `speed` in the direction of
     /// `torque` (its limit at this step, at the joint).
     pub fn limit(&self, j: usize, torque: f64, speed: f64) -> f64 {
         self.joints.iter().find(|s| s.joint == j).map_or(0.0, |s| {
-            let d = s.servo.firmware.family.max_duty * if torque >= 0.0 { 1.0 } else { -1.0 };
-            s.gear_ratio * s.servo.drive(d, s.gear_ratio * speed, s.servo.supply, true).torque.abs()
+            let d = s.duty_limit() * if torque >= 0.0 { 1.0 } else { -1.0 };
+            s.gear_ratio * s.servo.drive(d, s.gear_ratio * speed, s.servo.supply, !s.torque_off()).torque.abs()
         })
     }
 

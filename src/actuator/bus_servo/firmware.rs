@@ -7,6 +7,8 @@
 //! / 2π per rad) times the P gain register over its divisor gives PWM counts, and the PWM counts of
 //! 100 % make it a fraction. e_g folds those together, per unit of the P gain register and rad.
 
+use super::protection::{self, Protection, ProtectionState};
+
 /// The firmware of one servo line.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Family {
@@ -24,6 +26,8 @@ pub struct Family {
     pub goal_speed_limiter: bool,
     /// That speed out of the box, rad/s.
     pub default_max_velocity: f64,
+    /// The firmware's protections out of the box ([`super::protection`]).
+    pub protection: Protection,
     /// Where the numbers were read.
     pub source: &'static str,
 }
@@ -41,6 +45,7 @@ pub const XL330: Family = Family {
     nominal_supply: 5.0,
     goal_speed_limiter: false,
     default_max_velocity: f64::INFINITY,
+    protection: Protection::NONE,
     source: "e_g = (4096/2π)/(256·885): Rhoban/bam bam/dynamixel/actuator.py at 1b5a1ce (the 256 divisor measured by BAM; \
              the Dynamixel manual says 128); 885 = 100 % is the PWM Limit(36) default and Position P Gain(84) defaults to 400 \
              (ROBOTIS e-manual docs/en/dxl/x/xl330-m288.md); 5.0 V: the e-manual's rated voltage (catalogue-sources.md §2)",
@@ -54,6 +59,7 @@ pub const XL320: Family = Family {
     nominal_supply: 7.5,
     goal_speed_limiter: false,
     default_max_velocity: f64::INFINITY,
+    protection: Protection::NONE,
     source: "Rhoban/bam bam/dynamixel/actuator.py at 1b5a1ce (e_g and d_max measured by BAM with an oscilloscope; its defaults V_in 7.5, k_p 32)",
 };
 
@@ -65,6 +71,7 @@ pub const MX64: Family = Family {
     nominal_supply: 15.0,
     goal_speed_limiter: false,
     default_max_velocity: f64::INFINITY,
+    protection: Protection::NONE,
     source: "Rhoban/bam bam/dynamixel/actuator.py at 1b5a1ce (e_g and d_max measured by BAM with an oscilloscope; its defaults V_in 15, k_p 32)",
 };
 
@@ -78,6 +85,7 @@ pub const STS3215: Family = Family {
     nominal_supply: 7.4,
     goal_speed_limiter: true,
     default_max_velocity: 3400.0 * std::f64::consts::TAU / 4096.0,
+    protection: protection::FEETECH_FACTORY,
     source: "Rhoban/bam bam/feetech/actuator.py at 1b5a1ce (e_g measured by BAM with an oscilloscope, times the identified \
              error_gain_ratio; d_max 0.97; k_p is the P_Coefficient register, default 32; the internal target moves at most \
              max_velocity, default 3400 counts/s of 4096 a turn)",
@@ -99,10 +107,18 @@ pub fn family_names() -> String {
 }
 
 /// The firmware's state between control ticks: where its internal target is (a Feetech's walks
-/// towards the goal; others take the goal as it comes).
+/// towards the goal; others take the goal as it comes), and its protections' timers.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct FirmwareState {
     pub target: f64,
+    pub protection: ProtectionState,
+}
+
+impl FirmwareState {
+    /// At rest with the internal target at `target`, no protection timing.
+    pub fn at(target: f64) -> Self {
+        Self { target, ..Self::default() }
+    }
 }
 
 /// The firmware's settings on one servo: its family, P gain register, the error gain's identified
@@ -116,12 +132,14 @@ pub struct Firmware {
     /// A current limit the firmware enforces by narrowing the duty (A; none in the XL330's and the
     /// STS3215's position mode: the XL330 applies Current Limit(38) only in its current-based modes).
     pub current_limit: Option<f64>,
+    /// Its protections (the family's out of the box; a motor file can set them).
+    pub protection: Protection,
 }
 
 impl Firmware {
     /// The family's firmware with P gain `kp` and the family's defaults elsewhere.
     pub fn new(family: Family, kp: f64) -> Self {
-        Self { family, kp, error_gain_ratio: 1.0, max_velocity: family.default_max_velocity, current_limit: None }
+        Self { family, kp, error_gain_ratio: 1.0, max_velocity: family.default_max_velocity, current_limit: None, protection: family.protection }
     }
 
     /// Duty per rad of error: e_g·r·k_p.

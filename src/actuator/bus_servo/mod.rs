@@ -25,10 +25,12 @@
 pub mod firmware;
 pub mod friction;
 pub mod params;
+pub mod protection;
 
 pub use firmware::{Family, Firmware, FirmwareState};
 pub use friction::{FrictionModel, ServoFriction};
 pub use params::ServoParams;
+pub use protection::{Protection, Trip, TripKind};
 
 use super::Motor;
 
@@ -127,10 +129,29 @@ impl BusServo {
         ServoOutput { duty, supply, current: torque / self.kt, torque, limited }
     }
 
-    /// One firmware tick and the motor's answer: `goal` at position `q`, speed `speed`.
+    /// One firmware tick of `dt` s and the motor's answer over it: `goal` at position `q`, speed
+    /// `speed`; a tripped protection limits the duty or switches the torque off, and the tick's
+    /// duty and current run its timers.
     pub fn tick(&self, state: &mut FirmwareState, goal: f64, q: f64, speed: f64, dt: f64, supply: f64, enabled: bool) -> ServoOutput {
-        let duty = self.firmware.tick(state, goal, q, speed, dt, supply, self.kt, self.resistance);
-        self.drive(duty, speed, supply, enabled)
+        let protection = &self.firmware.protection;
+        let limit = protection.duty_limit(&state.protection, self.firmware.family.max_duty);
+        let duty = self.firmware.tick(state, goal, q, speed, dt, supply, self.kt, self.resistance).clamp(-limit, limit);
+        let out = self.drive(duty, speed, supply, enabled && !protection.torque_off(&state.protection));
+        protection.update(&mut state.protection, out.duty, out.current, dt);
+        out
+    }
+
+    /// The duty that gives torque `torque` at the output at speed `speed` on the nominal supply
+    /// (the inverse of [`Self::drive`] within its envelope, unclipped): the load a Feetech's
+    /// protections see.
+    pub fn duty_for(&self, torque: f64, speed: f64) -> f64 {
+        let volts = torque * self.resistance / self.kt + self.kt * speed;
+        // the supply sags with the duty (its own resistance): a few fixed-point passes settle it
+        let mut duty = volts / self.supply;
+        for _ in 0..4 {
+            duty = volts / self.supply_at(self.supply, duty, speed);
+        }
+        duty
     }
 
     /// The torque at rest at full duty on the nominal supply, N·m.
