@@ -344,3 +344,60 @@ fn the_replay_records_the_arm_needed_and_available_torques_like_a_run() {
 fn so101_joint_index(name: &str) -> usize {
     load_urdf(&so101()).unwrap().joint_index(name).unwrap()
 }
+
+/// The SO-101 holding its arm out, swaying slowly: shoulder_lift's load rises and falls with its
+/// angle.
+fn a_long_hold_at_reach() -> Vec<Sines> {
+    let s = |center: f64, terms: &[(f64, f64, f64)]| Sines { center, terms: terms.to_vec() };
+    vec![s(0.0, &[(0.1, 0.7, 0.0)]), s(0.6, &[(0.6, 0.5, std::f64::consts::FRAC_PI_2)]), s(0.0, &[(0.1, 0.9, 1.0)]), s(0.0, &[(0.1, 1.1, 0.0)]), s(0.0, &[]), s(0.8, &[(0.2, 0.6, 0.0)])]
+}
+
+#[test]
+fn a_feetech_protection_trips_where_the_exact_motion_trips_it() {
+    // With the SO-101's STS3215s and 1 kg at the tool, shoulder_lift needs more than its servo's
+    // datasheet line for stretches of seconds: its firmware's duty is full there, and Feetech's
+    // overload protection (80 % for 2 s, factory settings) trips. The replay finds the trip where
+    // the exact motion's torques put it, to a frame, and from then on holds the joint to the 20 %
+    // duty the protection leaves.
+    let dir = tempfile::tempdir().unwrap();
+    let model = load_urdf(&so101()).unwrap();
+    let root = dir.path().join("hold");
+    let mut spec = spec(1, 12.0, &model);
+    spec.episodes = vec![a_long_hold_at_reach()];
+    spec.write_v3(&root);
+    let map = JointMap::load(&joint_map(dir.path()), &model).unwrap();
+    let options = ReplayOptions { payload: 1.0, motors: Some(common::repo().join("assets/motors/so101.toml")), ..Default::default() };
+    let replayer = Replayer::new(model, &options, map).unwrap();
+    let episode = Source::open(&root, None).unwrap().read(0, "observation.state").unwrap();
+    let replay = replayer.replay(&episode).unwrap();
+    let lift = replayer.model.joint_index("shoulder_lift").unwrap();
+    let load = replay.verdicts[lift].servo.expect("a servo model");
+    let trip = load.protection_trip.expect("shoulder_lift trips its overload protection");
+    assert_eq!(trip.kind, armscope::actuator::bus_servo::TripKind::Overload);
+
+    // the exact motion's duty: the same servo model on the true torques and speeds
+    let time = &episode.time;
+    let truth = true_torques(&replayer.model, &a_long_hold_at_reach(), time);
+    let drive = replayer.motors.as_ref().unwrap().joints[lift].as_ref().unwrap();
+    let servo = drive.servo.as_ref().unwrap();
+    let (mut duty, mut current) = (Vec::new(), Vec::new());
+    for (k, &t) in time.iter().enumerate() {
+        let speed = a_long_hold_at_reach()[lift].qd(t);
+        let (torque, shaft) = drive.servo_torque_for(truth[lift][k], speed, speed.abs() > armscope::replay::inverse::SLIDING_SPEED).unwrap();
+        let full = servo.drive(servo.firmware.family.max_duty * torque.signum(), shaft, servo.supply, true).torque.abs();
+        duty.push(if torque.abs() > full { 1.0 } else { servo.duty_for(torque, shaft) });
+        current.push(torque / servo.kt);
+    }
+    let exact = servo.firmware.protection.first_trip(time, &duty, &current).expect("the exact motion trips it");
+    let frame = 1.0 / 30.0;
+    assert!((trip.since - exact.since).abs() <= frame + 1e-9 && (trip.time - exact.time).abs() <= frame + 1e-9, "replayed {trip:?} vs exact {exact:?}");
+    assert!(exact.since > 0.5, "the load must build up inside the episode to test this ({exact:?})");
+    // from the trip on the joint has what 20 % duty gives: it is over its limit from there
+    let verdict = &replay.verdicts[lift];
+    let k_trip = time.iter().position(|&t| t >= trip.time).unwrap();
+    let limited = drive.available_at_duty(replay.motion.needed[lift][k_trip], replay.motion.qd[lift][k_trip], 0.2);
+    assert!((replay.available[lift][k_trip] - limited).abs() < 1e-12);
+    assert!(verdict.over.iter().any(|i| i.first <= k_trip && i.last > k_trip), "over from the trip on: {:?}", verdict.over);
+    let text = armscope::replay::report::episode_text(&replayer, &armscope::replay::report::EpisodeSummary::of(&replay, Some(0)));
+    assert!(text.contains(&format!("shoulder_lift: its overload protection trips at t = {:.2} s", trip.time)), "{text}");
+}

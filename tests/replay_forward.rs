@@ -47,23 +47,22 @@ impl Recorder for Capture {
     }
 }
 
-/// The "real" follower: the arm simulated along the exact commands (sampled every millisecond), at the
-/// frames.
-fn follower(dir: &Path) -> Vec<Vec<f64>> {
-    let motion = commands();
+/// The "real" follower: the arm simulated along the exact commands (sampled every millisecond) with
+/// `payload` at the tool, at the frames.
+fn follower(dir: &Path, motion: &[Sines], payload: f64) -> Vec<Vec<f64>> {
     let schedule = dir.join("exact_commands.csv");
     let mut text = String::from("t,q1,q2,q3,q4,q5,q6\n");
     for k in 0..=6000 {
         let t = k as f64 * 1e-3;
         text += &format!("{t:?}");
-        for m in &motion {
+        for m in motion {
             text += &format!(",{:?}", m.q(t));
         }
         text.push('\n');
     }
     std::fs::write(&schedule, text).unwrap();
     let start: Vec<String> = motion.iter().map(|m| format!("{:?}", m.q(0.0))).collect();
-    let config = RunConfig { urdf: so101(), motors: Some(motors()), payload: PAYLOAD, trajectory: Some(schedule), duration: 6.0, q0: Some(start.join(",")), ..RunConfig::default() };
+    let config = RunConfig { urdf: so101(), motors: Some(motors()), payload, trajectory: Some(schedule), duration: 6.0, q0: Some(start.join(",")), ..RunConfig::default() };
     let experiment = Experiment::prepare(config).unwrap();
     let mut capture = Capture(Vec::new());
     armscope::sim::simulate(&experiment, &mut [&mut capture], None).unwrap();
@@ -71,12 +70,16 @@ fn follower(dir: &Path) -> Vec<Vec<f64>> {
 }
 
 fn dataset(dir: &Path) -> PathBuf {
+    dataset_of(dir, "so101_follow", &commands(), PAYLOAD)
+}
+
+fn dataset_of(dir: &Path, name: &str, motion: &[Sines], payload: f64) -> PathBuf {
     let model = load_urdf(&so101()).unwrap();
     let gripper = &model.joints[model.joint_index("gripper").unwrap()];
     let mut storage: Vec<Storage> = (0..5).map(|_| Storage::Degrees { sign: 1.0, offset: 0.0 }).collect();
     storage.push(Storage::Range0To100 { lower: gripper.lower, upper: gripper.upper });
-    let root = dir.join("so101_follow");
-    Spec { fps: 30.0, frames: FRAMES, episodes: vec![commands()], storage, observed: Some(vec![follower(dir)]) }.write_v3(&root);
+    let root = dir.join(name);
+    Spec { fps: 30.0, frames: FRAMES, episodes: vec![motion.to_vec()], storage, observed: Some(vec![follower(dir, motion, payload)]) }.write_v3(&root);
     root
 }
 
@@ -98,6 +101,7 @@ fn the_same_arm_replayed_forward_meets_its_follower_and_a_missing_payload_opens_
     let same = replay_forward(&root, dir.path(), PAYLOAD);
     let without = replay_forward(&root, dir.path(), 0.0);
     assert_eq!(same.joints.len(), 6);
+    assert!(same.protection_trips.is_empty(), "{:?}", same.protection_trips);
     // the encoder's quantum (2π/4096 = 1.5 mrad) on the recorded follower, and the 30 fps commands'
     // smoothing: the same arm meets its follower within 2 mrad on average, where the follower itself
     // lags its commands by far more
@@ -110,6 +114,29 @@ fn the_same_arm_replayed_forward_meets_its_follower_and_a_missing_payload_opens_
     // 0.2 kg left out: the servos that hold it sag less in the model than in reality
     assert!(lift(&without).gap_mae > 3.0 * lift(&same).gap_mae + 1e-3, "shoulder_lift: gap {:.2} mrad without the payload, {:.2} with it", lift(&without).gap_mae * 1e3, lift(&same).gap_mae * 1e3);
 }
+
+#[test]
+fn a_follower_whose_shoulder_gives_up_is_met_by_a_model_that_gives_up_with_it() {
+    // The follower holds 1 kg at reach: its shoulder cannot, its duty is full, and Feetech's overload
+    // protection trips 2 s on (80 % held 2 s, then 20 %). Replayed forward with the same arm the
+    // model's shoulder trips too, and follows the real one down.
+    let dir = tempfile::tempdir().unwrap();
+    let still = |center: f64| Sines { center, terms: vec![(0.02, 0.5, 0.0)] };
+    let hold = vec![still(0.0), still(0.0), still(0.0), still(0.0), still(0.0), still(0.8)];
+    let root = dataset_of(dir.path(), "so101_overloaded", &hold, 1.0);
+    let replay = replay_forward(&root, dir.path(), 1.0);
+    let trips: Vec<&str> = replay.protection_trips.iter().map(|(joint, _)| joint.as_str()).collect();
+    assert_eq!(trips, ["shoulder_lift"]);
+    let trip = replay.protection_trips[0].1;
+    assert_eq!(trip.kind, armscope::actuator::bus_servo::TripKind::Overload);
+    assert!((trip.time - trip.since - 2.0).abs() < 1e-9);
+    let lift = replay.joints.iter().find(|g| g.joint == "shoulder_lift").unwrap();
+    // the real follower fell far from its command, and the model with it
+    assert!(lift.real_tracking_max > 0.3, "the follower fell {:.0} mrad", lift.real_tracking_max * 1e3);
+    assert!(lift.gap_mae < 0.1 * lift.real_tracking_mae, "gap {:.1} mrad vs the fall {:.1} mrad", lift.gap_mae * 1e3, lift.real_tracking_mae * 1e3);
+    assert!(armscope::replay::forward::text(&replay).contains("shoulder_lift: in the model its overload protection trips at t ="));
+}
+
 
 #[test]
 fn forward_replay_from_the_command_line_writes_its_findings_and_needs_a_dataset() {

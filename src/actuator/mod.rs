@@ -155,11 +155,44 @@ impl DriveTrain {
     /// the gearbox's rating; braking (back-driven), N·T_b/η_b plus the friction, which helps (a
     /// self-locking gear holds whatever the rating allows).
     pub fn available(&self, torque: f64, speed: f64) -> f64 {
+        self.available_from(torque, speed, self.motor_torque(torque, speed))
+    }
+
+    /// [`Self::available`] with the servo's duty held to `duty` (a tripped protection; 0: its
+    /// torque off): the motor's torque at that duty, with the motion or braking.
+    pub fn available_at_duty(&self, torque: f64, speed: f64, duty: f64) -> f64 {
+        let Some(servo) = &self.servo else { return self.available(torque, speed) };
+        let shaft = (self.gear_ratio * speed).abs();
+        let motor = if duty <= 0.0 {
+            0.0
+        } else if Self::braking(torque, speed) {
+            servo.drive(duty, -shaft, servo.supply, true).torque
+        } else {
+            servo.drive(duty, shaft, servo.supply, true).torque.max(0.0)
+        };
+        self.available_from(torque, speed, self.gear_ratio * motor)
+    }
+
+    /// What reaches the joint in the direction of `torque` with the motor giving `motor_torque`
+    /// (≥ 0, at the joint before the losses).
+    fn available_from(&self, torque: f64, speed: f64, motor_torque: f64) -> f64 {
         let sign = if torque >= 0.0 { 1.0 } else { -1.0 };
         // the direction of motion: the torque's when it drives (at rest too), the other braking
         let direction = if Self::braking(torque, speed) { -sign } else { sign };
-        let at_joint = sign * self.gear.output_torque(sign * self.motor_torque(torque, speed), direction, speed);
+        let at_joint = sign * self.gear.output_torque(sign * motor_torque, direction, speed);
         at_joint.max(0.0).min(self.rated_torque)
+    }
+
+    /// The torque at the servo's output (N·m, signed) and its speed (rad/s) for a joint torque
+    /// `torque` at joint speed `speed`: back through the reductions' losses, plus the servo's own
+    /// friction while it slides ([`bus_servo::ServoFriction`]); None without a servo model.
+    pub fn servo_torque_for(&self, torque: f64, speed: f64, sliding: bool) -> Option<(f64, f64)> {
+        let servo = self.servo.as_ref()?;
+        let along = torque + self.gear.viscous * speed;
+        let at_output = along.signum() * self.gear.motor_torque_for(torque, speed) / self.gear_ratio;
+        let shaft = self.gear_ratio * speed;
+        let friction = if sliding { shaft.signum() * servo.friction.budget(at_output, -at_output, shaft) + servo.friction.viscous * shaft } else { 0.0 };
+        Some((at_output + friction, shaft))
     }
 
     /// The range of the motor's torque at the joint before the gearbox's losses, N·T, at joint

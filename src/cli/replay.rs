@@ -142,7 +142,8 @@ fn forward(args: &ReplayArgs, replayer: &Replayer, source: &crate::motion::Sourc
         let options = ForwardOptions { motors: motors.clone(), payload: args.payload, tool: args.tool.clone(), schedule: schedule_path(&dir, index) };
         let replay = forward(replayer, &options, &commands, &observed)?;
         print!("{}", text(&replay));
-        documents.push(serde_json::json!({ "episode": index, "joints": replay.joints }));
+        let trips: Vec<serde_json::Value> = replay.protection_trips.iter().map(|(joint, trip)| serde_json::json!({ "joint": joint, "trip": trip })).collect();
+        documents.push(serde_json::json!({ "episode": index, "joints": replay.joints, "protection_trips": trips }));
     }
     if let Some(path) = &args.summary_json {
         let doc = serde_json::json!({ "source": args.source.display().to_string(), "forward": true, "parts_above_rad": crate::replay::forward::PARTS_ABOVE, "episodes": documents });

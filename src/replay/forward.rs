@@ -45,6 +45,9 @@ pub struct ForwardReplay {
     pub observed: Vec<Vec<f64>>,
     pub simulated: Vec<Vec<f64>>,
     pub joints: Vec<JointGap>,
+    /// The firmware protections the simulated servos tripped, by joint (a Feetech's overload or
+    /// overcurrent): where the model's follower gave up.
+    pub protection_trips: Vec<(String, crate::actuator::bus_servo::Trip)>,
 }
 
 /// What the run needs beyond the replayer: the motor file (required: the joints' servos), payload and
@@ -127,7 +130,8 @@ pub fn forward(replayer: &Replayer, options: &ForwardOptions, commands: &Episode
         observed.push(o);
         simulated.push(s);
     }
-    Ok(ForwardReplay { label: commands.label.clone(), time, commanded, observed, simulated, joints })
+    let protection_trips = summary.servos.iter().enumerate().filter_map(|(j, s)| Some((model.joints[j].name.clone(), s.as_ref()?.protection_trip?))).collect();
+    Ok(ForwardReplay { label: commands.label.clone(), time, commanded, observed, simulated, joints, protection_trips })
 }
 
 /// The run's joint positions at every control step.
@@ -166,6 +170,9 @@ pub fn text(replay: &ForwardReplay) -> String {
             g.gap_max * 1e3,
             g.gap_max_at
         );
+    }
+    for (joint, trip) in &replay.protection_trips {
+        out += &format!("  {joint}: in the model {}\n", trip.describe());
     }
     out
 }

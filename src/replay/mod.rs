@@ -71,8 +71,11 @@ impl Replayer {
 
     pub fn replay(&self, episode: &Episode) -> Result<EpisodeReplay, Error> {
         let motion = inverse_replay(&self.model, &self.map, episode, &self.hold)?;
-        let available = verdict::available_torques(&self.model, self.motors.as_deref(), &motion);
-        let verdicts = verdict::judge(&self.model, self.motors.as_deref(), &motion, &available);
+        let motors = self.motors.as_deref();
+        let mut available = verdict::available_torques(&self.model, motors, &motion);
+        let servos = verdict::servo_loads(&self.model, motors, &motion);
+        verdict::limit_after_trips(motors, &motion, &servos, &mut available);
+        let verdicts = verdict::judge(&self.model, motors, &motion, &available, &servos);
         Ok(EpisodeReplay { motion, available, verdicts })
     }
 }

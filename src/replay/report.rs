@@ -78,10 +78,18 @@ pub fn episode_text(replayer: &Replayer, s: &EpisodeSummary) -> String {
     }
     out += "\n";
     let w = s.joints.iter().map(|j| j.joint.chars().count()).max().unwrap_or(5).max(5) + 2;
-    out += &format!("  {:<w$}{:>10}{:>8}{:>10}{:>9}{:>11}{:>9}  {}\n", "joint", "peak N·m", "at s", "had N·m", "RMS N·m", "cont. N·m", "°C peak", "limit");
+    // a servo's duty (of its PWM) and current, where a joint has a servo model
+    let servos = s.joints.iter().any(|j| j.servo.is_some());
+    let servo_header = if servos { format!("{:>8}{:>8}", "duty %", "peak A") } else { String::new() };
+    out += &format!("  {:<w$}{:>10}{:>8}{:>10}{:>9}{:>11}{:>9}{servo_header}  {}\n", "joint", "peak N·m", "at s", "had N·m", "RMS N·m", "cont. N·m", "°C peak", "limit");
     for j in &s.joints {
         let winding = j.winding.map_or("–".to_string(), |w| format!("{:.0}", w.peak_temperature));
-        out += &format!("  {:<w$}{:>10}{:>8}{:>10}{:>9}{:>11}{:>9}  {}\n", j.joint, number(j.peak_torque, 3), number(j.peak_time, 2), number(j.limit_at_peak, 3), number(j.rms_torque, 3), j.continuous_torque.map_or("–".into(), |c| number(c, 3)), winding, j.limit_source);
+        let servo = match (servos, &j.servo) {
+            (false, _) => String::new(),
+            (true, Some(l)) => format!("{:>8.0}{:>8.2}", 100.0 * l.peak_duty, l.peak_current),
+            (true, None) => format!("{:>8}{:>8}", "–", "–"),
+        };
+        out += &format!("  {:<w$}{:>10}{:>8}{:>10}{:>9}{:>11}{:>9}{servo}  {}\n", j.joint, number(j.peak_torque, 3), number(j.peak_time, 2), number(j.limit_at_peak, 3), number(j.rms_torque, 3), j.continuous_torque.map_or("–".into(), |c| number(c, 3)), winding, j.limit_source);
     }
     for j in &s.joints {
         out += &joint_sentences(j);
@@ -100,6 +108,9 @@ pub fn episode_text(replayer: &Replayer, s: &EpisodeSummary) -> String {
 /// Said as a person would: which joint, how much over, how long, from when.
 fn joint_sentences(j: &JointVerdict) -> String {
     let mut out = String::new();
+    if let Some(trip) = j.servo.and_then(|l| l.protection_trip) {
+        out += &format!("  {}: {} — a real one reports an {} error; from then on it had only that\n", j.joint, trip.describe(), trip.kind.name());
+    }
     let what = if j.limit_source == "URDF effort" { "its URDF effort limit".to_string() } else { format!("its {} gives", j.limit_source) };
     let shown = 3;
     for i in j.over.iter().take(shown) {

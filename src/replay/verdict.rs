@@ -1,9 +1,12 @@
 //! Each joint's needed torque held against what its motor gives: the servo's or motor's torque at
 //! that speed through its gearbox (with `--motors`), else the URDF's effort limit; when it was over,
-//! by how much, for how long; the RMS against the continuous rating; the winding's temperature.
+//! by how much, for how long; the RMS against the continuous rating; the winding's temperature;
+//! for a serial-bus servo, the duty and current it takes and the firmware protection it trips (from
+//! then on it has what the protection leaves it).
 
 use super::inverse::Motion;
 use crate::actuator::MotorSet;
+use crate::actuator::bus_servo::Trip;
 use crate::actuator::thermal::{RunHeat, WindingSummary};
 use crate::model::Model;
 use serde::Serialize;
@@ -73,6 +76,62 @@ pub struct JointVerdict {
     pub time_over: f64,
     /// What the motion did to the motor's winding, where its thermal data are known.
     pub winding: Option<WindingSummary>,
+    /// A serial-bus servo's duty and current, and the protection it trips.
+    pub servo: Option<ServoLoad>,
+}
+
+/// What a joint's motion asked of its serial-bus servo: the duty its firmware needed (above 1:
+/// more than its PWM has) and the current its motor drew, at the servo.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct ServoLoad {
+    pub peak_duty: f64,
+    pub peak_duty_time: f64,
+    pub peak_current: f64,
+    pub rms_current: f64,
+    /// The first firmware protection the motion trips (a Feetech's overload or overcurrent).
+    pub protection_trip: Option<Trip>,
+}
+
+/// Per coordinate with a serial-bus servo model: the duty and current the motion asked of it at
+/// every sample (the servo's friction included while the joint slides), and the protection that
+/// trips.
+pub fn servo_loads(model: &Model, motors: Option<&MotorSet>, motion: &Motion) -> Vec<Option<ServoLoad>> {
+    (0..model.dof())
+        .map(|j| {
+            let drive = motors.and_then(|m| m.joints[j].as_ref())?;
+            let servo = drive.servo.as_ref()?;
+            let mut duty = Vec::with_capacity(motion.len());
+            let mut current = Vec::with_capacity(motion.len());
+            for (&tau, &speed) in motion.needed[j].iter().zip(&motion.qd[j]) {
+                let (torque, shaft) = drive.servo_torque_for(tau, speed, speed.abs() > super::inverse::SLIDING_SPEED)?;
+                // past what full duty gives (its datasheet's line) the firmware's error grows until
+                // its duty is full: the load it sees is all its PWM, and more was needed
+                let full = servo.drive(servo.firmware.family.max_duty * torque.signum(), shaft, servo.supply, true).torque.abs();
+                let needed_duty = servo.duty_for(torque, shaft);
+                duty.push(if torque.abs() > full { torque.signum() * needed_duty.abs().max(1.0) } else { needed_duty });
+                current.push(torque / servo.kt);
+            }
+            let (peak_index, peak_duty) = duty.iter().enumerate().fold((0, 0.0_f64), |(bi, b), (i, d)| if d.abs() > b { (i, d.abs()) } else { (bi, b) });
+            Some(ServoLoad {
+                peak_duty,
+                peak_duty_time: motion.time.get(peak_index).copied().unwrap_or(0.0),
+                peak_current: current.iter().fold(0.0, |a: f64, c| a.max(c.abs())),
+                rms_current: (current.iter().map(|c| c * c).sum::<f64>() / current.len().max(1) as f64).sqrt(),
+                protection_trip: servo.firmware.protection.first_trip(&motion.time, &duty, &current),
+            })
+        })
+        .collect()
+}
+
+/// From each trip on, what its joint had is what the protection leaves the servo (its
+/// protective duty, or nothing with its torque off).
+pub fn limit_after_trips(motors: Option<&MotorSet>, motion: &Motion, loads: &[Option<ServoLoad>], available: &mut [Vec<f64>]) {
+    for (j, load) in loads.iter().enumerate() {
+        let (Some(trip), Some(drive)) = (load.and_then(|l| l.protection_trip), motors.and_then(|m| m.joints[j].as_ref())) else { continue };
+        for k in (0..motion.len()).filter(|&k| motion.time[k] >= trip.time) {
+            available[j][k] = drive.available_at_duty(motion.needed[j][k], motion.qd[j][k], trip.leaves_duty).min(available[j][k]);
+        }
+    }
 }
 
 /// The largest |needed| / available over a series (1 = exactly at its limit).
@@ -93,7 +152,7 @@ pub fn available_torques(model: &Model, motors: Option<&MotorSet>, motion: &Moti
 }
 
 /// Every joint's verdict over an episode.
-pub fn judge(model: &Model, motors: Option<&MotorSet>, motion: &Motion, available: &[Vec<f64>]) -> Vec<JointVerdict> {
+pub fn judge(model: &Model, motors: Option<&MotorSet>, motion: &Motion, available: &[Vec<f64>], servos: &[Option<ServoLoad>]) -> Vec<JointVerdict> {
     let samples = motion.len();
     let interval = if samples > 1 { motion.time[samples - 1] / (samples - 1) as f64 } else { 0.0 };
     let mut heat = motors.map(|m| RunHeat::new(&m.heat(), interval)).filter(RunHeat::any);
@@ -127,6 +186,7 @@ pub fn judge(model: &Model, motors: Option<&MotorSet>, motion: &Motion, availabl
                 time_over: samples_over as f64 * interval,
                 over,
                 winding: windings.as_ref().and_then(|w| w[j]),
+                servo: servos.get(j).copied().flatten(),
             }
         })
         .collect()
