@@ -49,6 +49,9 @@ pub struct Sample<'a> {
     /// A recording's measured effort per joint beside the model's torque `u` (a replayed bag's
     /// `effort`; NaN where a joint has none); empty for a simulation.
     pub measured_effort: &'a [f64],
+    /// A real arm's position per joint beside the simulated one (a forward replay's recorded
+    /// follower; NaN where a joint has none); empty otherwise.
+    pub observed_position: &'a [f64],
     /// With collision checks: the pairs closer than 5 cm at this state, nearest first (distance ≤ 0:
     /// in contact); empty without checks.
     pub collisions: &'a [crate::collision::PairDistance],

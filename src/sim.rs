@@ -15,6 +15,37 @@ use std::time::Instant;
 /// was interrupted (`stop` set) or diverged (see [`Summary::status`]); recorders are finished in
 /// every case, so their files are whole up to the last recorded sample.
 pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], stop: Option<&AtomicBool>) -> Result<Summary, Error> {
+    simulate_beside(experiment, recorders, stop, None)
+}
+
+/// A real arm's positions to record beside a simulated one (a forward replay's follower): per
+/// coordinate, its samples at `time` (s from the run's start), None where it has none.
+pub struct Observed {
+    pub time: Vec<f64>,
+    pub positions: Vec<Option<Vec<f64>>>,
+}
+
+impl Observed {
+    /// Each coordinate's position at `t`, linear between samples (held past the ends; NaN where
+    /// it has none).
+    fn at(&self, t: f64, out: &mut [f64]) {
+        let k = self.time.partition_point(|&s| s <= t);
+        for (o, series) in out.iter_mut().zip(&self.positions) {
+            *o = match series {
+                None => f64::NAN,
+                Some(p) if k == 0 => p[0],
+                Some(p) if k >= self.time.len() => p[self.time.len() - 1],
+                Some(p) => {
+                    let (t0, t1) = (self.time[k - 1], self.time[k]);
+                    p[k - 1] + (p[k] - p[k - 1]) * (t - t0) / (t1 - t0)
+                }
+            };
+        }
+    }
+}
+
+/// [`simulate`], recording `observed` (a real arm's positions) beside the simulated arm's.
+pub fn simulate_beside(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], stop: Option<&AtomicBool>, observed: Option<&Observed>) -> Result<Summary, Error> {
     let model = &*experiment.model;
     let n = model.dof();
     let dt = experiment.dt();
@@ -25,6 +56,7 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
     let controller = experiment.controller();
     let info = RunInfo {
         measured_effort: Vec::new(),
+        observed_position: observed.map_or_else(Vec::new, |o| o.positions.iter().map(Option::is_some).collect()),
         experiment,
         plant: plant.describe(),
         trajectory: experiment.trajectory.describe(),
@@ -36,6 +68,7 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
     }
 
     let (mut q, mut v) = experiment.initial_state();
+    let mut observed_now = vec![f64::NAN; if observed.is_some() { n } else { 0 }];
     let (mut cmd, mut cmd_dot, mut u) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
     let mut saturated = vec![false; n];
     let mut torque_limit = vec![0.0; n];
@@ -134,6 +167,13 @@ pub fn simulate(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], st
             duty: &duty,
             current: &current,
             measured_effort: &[],
+            observed_position: match observed {
+                Some(o) => {
+                    o.at(t, &mut observed_now);
+                    &observed_now
+                }
+                None => &[],
+            },
             supply: &supply,
             collisions: collision_check.as_ref().map_or(&[], |(_, state, _)| state.close.as_slice()),
             tool_position: frame_pose(model, &data, model.tool_frame).translation,

@@ -90,7 +90,7 @@ fn replay_forward(root: &Path, dir: &Path, payload: f64) -> armscope::replay::fo
     let commands = source.read(0, "action").unwrap();
     let map = JointMap::builtin(source.kind(), &model, &observed).expect("the SO-101's built-in map");
     let replayer = Replayer::new(model, &ReplayOptions { payload, motors: Some(motors()), ..Default::default() }, map).unwrap();
-    let options = ForwardOptions { motors: motors(), payload, tool: None, schedule: dir.join(format!("commands_{payload}.csv")) };
+    let options = ForwardOptions { motors: motors(), payload, tool: None, schedule: dir.join(format!("commands_{payload}.csv")), recordings: None };
     forward(&replayer, &options, &commands, &observed).unwrap()
 }
 
@@ -154,6 +154,34 @@ fn forward_replay_from_the_command_line_writes_its_findings_and_needs_a_dataset(
     let doc: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
     assert_eq!(doc["episodes"][0]["joints"].as_array().unwrap().len(), 6);
     assert!(doc["episodes"][0]["joints"][1]["gap_mae"].as_f64().unwrap() < 2e-3);
+    // the recordings: the simulated arm as a run records it, the real follower beside it — at each
+    // frame's time exactly the recorded (mapped) position, between frames on the line between them
+    let (rrd, mcap) = (dir.path().join("recordings/forward_so101_follow_episode_0.rrd"), dir.path().join("recordings/forward_so101_follow_episode_0.mcap"));
+    let model = load_urdf(&so101()).unwrap();
+    let lift = model.joint_index("shoulder_lift").unwrap();
+    let observed = Source::open(&root, None).unwrap().read(0, "observation.state").unwrap();
+    let map = JointMap::builtin(Source::open(&root, None).unwrap().kind(), &model, &observed).unwrap();
+    let follower = map.apply(&model, &observed).unwrap()[lift].clone().unwrap();
+    let file = common::rrd::Rrd::open(&rrd);
+    assert!(file.verify_errors.is_empty(), "{:?}", file.verify_errors);
+    let series = file.series("/joints/shoulder_lift/observed");
+    assert_eq!(series.len(), file.series("/joints/shoulder_lift/position").len());
+    for (t, v) in &series {
+        let frame = t * 30.0;
+        let (f, w) = (frame.floor() as usize, frame - frame.floor());
+        let expected = if f + 1 < FRAMES { follower[f] + w * (follower[f + 1] - follower[f]) } else { follower[FRAMES - 1] };
+        assert!((v[0] - expected).abs() < 1e-9, "t = {t}: {} against the follower's {expected}", v[0]);
+    }
+    assert!(series.iter().filter(|(t, _)| (t * 30.0 - (t * 30.0).round()).abs() < 1e-9).count() >= FRAMES / 3, "frames on the step grid");
+    let bytes = std::fs::read(&mcap).unwrap();
+    let controller: Vec<f64> = mcap::MessageStream::new(&bytes)
+        .unwrap()
+        .map(|m| m.unwrap())
+        .filter(|m| m.channel.topic == "/controller")
+        .map(|m| <armscope::recorder::ControllerTelemetry as prost::Message>::decode(&m.data[..]).unwrap().observed_position[lift])
+        .collect();
+    assert_eq!(controller.len(), series.len());
+    assert!(controller.iter().zip(&series).all(|(a, (_, b))| (a - b[0]).abs() < 1e-12), "/controller.observed_position is the .rrd's");
     // a bag holds no commands beside the positions
     let bag = common::repo().join("tests/fixtures/ros2/joint_states_effort.mcap");
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_armscope"))

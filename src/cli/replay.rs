@@ -35,7 +35,7 @@ pub struct ReplayArgs {
     #[arg(long, value_name = "FILE")]
     pub summary_json: Option<PathBuf>,
     /// The recordings of the episode (several: of the most loaded one; NAME:
-    /// replay_SOURCE[_episode_N]).
+    /// replay_SOURCE[_episode_N]; with --forward, of the widest gap, forward_SOURCE_episode_N).
     #[command(flatten)]
     pub files: crate::flags::RecordingFiles,
     /// The MCAP's encoding, as `run --mcap-encoding`.
@@ -135,15 +135,42 @@ fn forward(args: &ReplayArgs, replayer: &Replayer, source: &crate::motion::Sourc
     // the command schedules go where the recordings go
     let dir = args.files.folder();
     std::fs::create_dir_all(&dir).map_err(|e| Error::output(&dir, e))?;
-    let mut documents = Vec::new();
-    for &index in episodes {
+    // the recordings of one episode: recordings/forward_SOURCE_episode_N.rrd/.mcap unless told
+    let wants_recordings = !(args.files.no_rrd && args.files.no_mcap);
+    let stem = args.source.file_stem().map_or("recording".into(), |s| s.to_string_lossy().into_owned());
+    let outputs = |index: i64| {
+        let name = crate::runner::file_safe(&format!("forward_{stem}_episode_{index}"));
+        let (rrd, mcap) = args.files.paths(&name);
+        crate::replay::recording::RecordingOutputs { rrd, mcap, mcap_encoding: args.mcap_encoding, name }
+    };
+    let run = |index: i64, record: bool| -> Result<crate::replay::forward::ForwardReplay, Error> {
         let commands = source.read(index, "action")?;
         let observed = source.read(index, &args.recorded.feature)?;
-        let options = ForwardOptions { motors: motors.clone(), payload: args.payload, tool: args.tool.clone(), schedule: schedule_path(&dir, index) };
+        let recordings = (record && wants_recordings).then(|| outputs(index));
+        let options = ForwardOptions { motors: motors.clone(), payload: args.payload, tool: args.tool.clone(), schedule: schedule_path(&dir, index), recordings: recordings.clone() };
         let replay = forward(replayer, &options, &commands, &observed)?;
+        for path in recordings.iter().flat_map(|r| r.rrd.iter().chain(&r.mcap)) {
+            eprintln!("armscope: wrote {}", path.display());
+        }
+        Ok(replay)
+    };
+    // a lone episode is recorded as it is replayed; of several, the one the model misses most, again
+    let several = episodes.len() > 1;
+    let mut documents = Vec::new();
+    let mut widest: Option<(f64, i64)> = None;
+    for &index in episodes {
+        let replay = run(index, !several)?;
         print!("{}", text(&replay));
         let trips: Vec<serde_json::Value> = replay.protection_trips.iter().map(|(joint, trip)| serde_json::json!({ "joint": joint, "trip": trip })).collect();
         documents.push(serde_json::json!({ "episode": index, "joints": replay.joints, "protection_trips": trips }));
+        let gap = replay.joints.iter().map(|g| g.gap_mae).fold(0.0, f64::max);
+        if widest.is_none_or(|(w, _)| gap > w) {
+            widest = Some((gap, index));
+        }
+    }
+    if let (true, true, Some((gap, index))) = (several, wants_recordings, widest) {
+        println!("recorded: episode {index}, the widest gap ({:.1} mrad mean on its worst joint)", gap * 1e3);
+        run(index, true)?;
     }
     if let Some(path) = &args.summary_json {
         let doc = serde_json::json!({ "source": args.source.display().to_string(), "forward": true, "parts_above_rad": crate::replay::forward::PARTS_ABOVE, "episodes": documents });

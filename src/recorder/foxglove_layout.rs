@@ -6,7 +6,7 @@
 use crate::dynamics::{body_poses, frame_pose_in};
 use crate::model::Model;
 use crate::spatial::Pose;
-use super::plot_colours::{FRICTION_RGB, LIMIT_RGB, MEASURED_RGB, TARGET_RGB, hex, joint_rgb};
+use super::plot_colours::{FRICTION_RGB, LIMIT_RGB, MEASURED_RGB, TARGET_RGB, hex, joint_rgb, observed_rgb};
 use super::torque_axis::TorqueAxis;
 use serde_json::{Value, json};
 
@@ -69,6 +69,8 @@ pub struct RunPlots<'a> {
     pub stepped: &'a [bool],
     /// Per joint, a replayed recording's measured effort beside the model's torque (empty: none).
     pub measured: &'a [bool],
+    /// Per joint, a forward replay's real follower beside the simulated position (empty: none).
+    pub observed: &'a [bool],
     /// Per joint, its torque plot's range.
     pub torque_axes: &'a [TorqueAxis],
     /// Per joint, its motor has thermal data: a plot of the winding temperatures.
@@ -91,13 +93,16 @@ fn split_evenly(mut panels: Vec<Value>, direction: &str) -> Value {
 /// The layout of a run of `model` from `q0` showing `plots`. Each joint's torque plot spans
 /// ±`plots.torque_axes[i].half_range` when given.
 pub fn layout_for_run(model: &Model, q0: &[f64], plots: &RunPlots) -> Value {
-    let RunPlots { motors, friction, stepped, measured, torque_axes, heated, collisions } = *plots;
+    let RunPlots { motors, friction, stepped, measured, observed, torque_axes, heated, collisions } = *plots;
     let (target, distance) = camera(model, q0);
     let names: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();
     let angles = names
         .iter()
         .enumerate()
-        .flat_map(|(i, n)| [coloured(format!("/joint_states.joints[{i}].position"), format!("{n} angle"), joint_rgb(i)), coloured(format!("/controller.target[{i}]"), format!("{n} target"), TARGET_RGB)])
+        .flat_map(|(i, n)| {
+            let real = observed.get(i).copied().unwrap_or(false).then(|| coloured(format!("/controller.observed_position[{i}]"), format!("{n} real follower"), observed_rgb(i)));
+            [coloured(format!("/joint_states.joints[{i}].position"), format!("{n} angle"), joint_rgb(i)), coloured(format!("/controller.target[{i}]"), format!("{n} target"), TARGET_RGB)].into_iter().chain(real)
+        })
         .collect();
     // one plot per joint: joints' torques differ by orders of magnitude, and each is read against
     // its own limit
@@ -234,7 +239,7 @@ mod tests {
         let axes: Vec<TorqueAxis> = (0..n).map(|i| TorqueAxis::new(0.1 * (i + 1) as f64, 35.0)).collect();
         let stepped = [false, true, false, false, false, false];
         let heated = [false, true, false, false, false, false];
-        let l = layout_for_run(&model, &vec![0.0; n], &RunPlots { motors: true, friction: true, stepped: &stepped, measured: &[], torque_axes: &axes, heated: &heated, collisions: false });
+        let l = layout_for_run(&model, &vec![0.0; n], &RunPlots { motors: true, friction: true, stepped: &stepped, measured: &[], observed: &[], torque_axes: &axes, heated: &heated, collisions: false });
         // the tree places every configured panel exactly once, and only those
         let mut ids = Vec::new();
         placed(&l["layout"], &mut ids);

@@ -460,6 +460,7 @@ impl Recorder for McapRecorder {
             current: per_joint(e.servos.is_some()),
             supply: per_joint(e.servos.is_some()),
             measured_effort: Vec::new(),
+            observed_position: Vec::new(),
         };
         self.motors = e.motors.clone();
         self.scene = scene_from_model(model).map_err(|(path, err)| Error::output(&path, err))?;
@@ -642,6 +643,7 @@ fn write_layout(run: &RunInfo, mcap: &std::path::Path, torque_axes: &[super::tor
         friction: e.joint_has_friction().contains(&true),
         stepped: &stepped,
         measured: &run.measured_effort,
+        observed: &run.observed_position,
         torque_axes,
         heated: &heated,
         collisions: e.collisions.is_some(),

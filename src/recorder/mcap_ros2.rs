@@ -200,6 +200,7 @@ pub fn controller_telemetry(t: &ControllerTelemetry, out: &mut Vec<u8>) {
     w.f64_sequence(&t.current);
     w.f64_sequence(&t.supply);
     w.f64_sequence(&t.measured_effort);
+    w.f64_sequence(&t.observed_position);
 }
 
 /// A `/controller` message of the ROS 2 encoding back (the comparison of finished runs reads it).
@@ -219,8 +220,8 @@ pub fn decode_controller_telemetry(bytes: &[u8]) -> Result<ControllerTelemetry, 
     let (motor_speed, friction) = (r.f64_sequence()?, r.f64_sequence()?);
     let stuck = flags(&mut r)?;
     let (winding_temperature, duty, current, supply) = (r.f64_sequence()?, r.f64_sequence()?, r.f64_sequence()?, r.f64_sequence()?);
-    let measured_effort = r.f64_sequence()?;
-    Ok(ControllerTelemetry { time, target, error, torque, tau_g, saturated, chatter, tool_error, tool_position, torque_limit, load_angle, lost_steps, motor_speed, friction, stuck, winding_temperature, duty, current, supply, measured_effort })
+    let (measured_effort, observed_position) = (r.f64_sequence()?, r.f64_sequence()?);
+    Ok(ControllerTelemetry { time, target, error, torque, tau_g, saturated, chatter, tool_error, tool_position, torque_limit, load_angle, lost_steps, motor_speed, friction, stuck, winding_temperature, duty, current, supply, measured_effort, observed_position })
 }
 
 impl Ros2McapRecorder {

@@ -58,6 +58,9 @@ pub struct RunInfo<'a> {
     /// Per joint, whether the samples carry a measured effort beside the model's torque (a replayed
     /// bag's `effort`); empty for a simulation.
     pub measured_effort: Vec<bool>,
+    /// Per joint, whether the samples carry a real arm's position beside the simulated one (a
+    /// forward replay's follower); empty otherwise.
+    pub observed_position: Vec<bool>,
 }
 
 impl RunInfo<'_> {

@@ -53,6 +53,16 @@ pub fn joint_rgb(j: usize) -> (u8, u8, u8) {
     JOINT_PALETTE[j % JOINT_PALETTE.len()]
 }
 
+/// A real follower's position beside joint `j`'s simulated one (a forward replay): the joint's
+/// colour halfway to white (halfway to black for the palette's light ones), so it is told apart
+/// from the joint's angle and still reads as that joint among the others.
+pub fn observed_rgb(j: usize) -> (u8, u8, u8) {
+    let (r, g, b) = joint_rgb(j);
+    let light = (r as u16 + g as u16 + b as u16) / 3 > 160;
+    let shift = |c: u8| if light { c / 2 } else { ((c as u16 + 255) / 2) as u8 };
+    (shift(r), shift(g), shift(b))
+}
+
 /// "#rrggbb", as Foxglove's layouts write a colour.
 pub fn hex((r, g, b): (u8, u8, u8)) -> String {
     format!("#{r:02x}{g:02x}{b:02x}")
@@ -77,7 +87,7 @@ mod tests {
             // saturated, chatter; a stepper's load angle, lost steps (red) and motor speed; a servo's
             // duty and current
             let plots = [
-                ("angle", vec![joint, TARGET_RGB]),
+                ("angle", vec![joint, TARGET_RGB, observed_rgb(j)]),
                 ("torque", vec![joint, GRAVITY_TORQUE_RGB, LIMIT_RGB, SATURATED_RGB, FRICTION_RGB, STUCK_RGB]),
                 ("status", vec![joint, LIMIT_RGB, CHATTER_RGB]),
                 ("stepper", vec![joint, LIMIT_RGB, MOTOR_SPEED_RGB]),

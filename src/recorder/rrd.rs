@@ -18,7 +18,7 @@ use rerun::{RecordingStream, TimeColumn};
 use super::torque_axis::TorqueAxis;
 use super::rrd_collisions::{Recolour, RrdCollisions, log_geometry};
 use super::column_pool::ColumnPool;
-use super::plot_colours::{CHATTER_RGB, CURRENT_RGB, FRICTION_RGB, GRAVITY_TORQUE_RGB, LIMIT_RGB, MEASURED_GAP_RGB, MEASURED_RGB, MOTOR_SPEED_RGB, SATURATED_RGB, STUCK_RGB, TARGET_RGB, joint_rgb};
+use super::plot_colours::{CHATTER_RGB, CURRENT_RGB, FRICTION_RGB, GRAVITY_TORQUE_RGB, LIMIT_RGB, MEASURED_GAP_RGB, MEASURED_RGB, MOTOR_SPEED_RGB, SATURATED_RGB, STUCK_RGB, TARGET_RGB, joint_rgb, observed_rgb};
 use rerun::external::arrow::buffer::{Buffer, OffsetBuffer};
 use std::collections::VecDeque;
 use std::path::PathBuf;
@@ -78,6 +78,8 @@ struct JointColumns {
     /// A replayed recording with measured effort: `joints/<joint>/measured_effort`, [measured effort,
     /// measured − model torque] per step.
     measured: Vec<f64>,
+    /// A forward replay: `joints/<joint>/observed`, the real follower's position per step.
+    observed: Vec<f64>,
 }
 
 impl JointColumns {
@@ -97,11 +99,12 @@ impl JointColumns {
             winding: Vec::new(),
             servo: Vec::new(),
             measured: Vec::new(),
+            observed: Vec::new(),
         }
     }
 
     fn clear(&mut self) {
-        for c in [&mut self.position, &mut self.torque, &mut self.status, &mut self.saturated_times, &mut self.saturated_torque, &mut self.limit, &mut self.load_angle, &mut self.lost_steps, &mut self.motor_speed, &mut self.friction, &mut self.winding, &mut self.servo, &mut self.measured] {
+        for c in [&mut self.position, &mut self.torque, &mut self.status, &mut self.saturated_times, &mut self.saturated_torque, &mut self.limit, &mut self.load_angle, &mut self.lost_steps, &mut self.motor_speed, &mut self.friction, &mut self.winding, &mut self.servo, &mut self.measured, &mut self.observed] {
             c.clear();
         }
     }
@@ -159,6 +162,8 @@ pub struct RerunRecorder {
     heated: Vec<bool>,
     /// Per joint: the samples carry a measured effort (a replayed bag's).
     measured: Vec<bool>,
+    /// Per joint: the samples carry a real follower's position (a forward replay's).
+    observed: Vec<bool>,
     /// With collision checks: what is in contact, drawn and plotted.
     collisions: Option<RrdCollisions>,
     /// Memory for the columns sent at every block, for their row ids and the trail's points.
@@ -212,6 +217,7 @@ impl RerunRecorder {
             notice_sink: None,
             heated: Vec::new(),
             measured: Vec::new(),
+            observed: Vec::new(),
             collisions: None,
             values_pool: ColumnPool::default(),
             ids_pool: ColumnPool::default(),
@@ -375,6 +381,7 @@ impl RerunRecorder {
                 ("winding_temperature", lines(&[format!("{name} winding (°C)")], &[c], &[1.5])),
                 ("servo", lines(&[format!("{name} PWM duty (−1 … 1)"), format!("{name} current (A)")], &[c, rgb(CURRENT_RGB)], &[1.5, 1.0])),
                 ("measured_effort", lines(&[format!("{name} measured effort (N·m)"), format!("{name} measured − model (N·m)")], &[rgb(MEASURED_RGB), rgb(MEASURED_GAP_RGB)], &[1.5, 1.0])),
+                ("observed", lines(&[format!("{name} real follower (rad)")], &[rgb(observed_rgb(j))], &[1.5])),
             ];
             let has_motor = self.motors.as_ref().is_some_and(|m| m.joints.get(j).is_some_and(Option::is_some));
             let recorded = |leaf: &str| match leaf {
@@ -384,6 +391,7 @@ impl RerunRecorder {
                 "winding_temperature" => self.heated[j],
                 "servo" => self.servo_driven[j],
                 "measured_effort" => self.measured[j],
+                "observed" => self.observed[j],
                 _ => true,
             };
             for (leaf, style) in styles.into_iter().filter(|(leaf, _)| recorded(leaf)) {
@@ -458,6 +466,9 @@ impl RerunRecorder {
             }
             if self.measured[j] {
                 send(&format!("{base}/measured_effort"), time.clone(), scalars(&c.measured, 2))?;
+            }
+            if self.observed[j] {
+                send(&format!("{base}/observed"), time.clone(), scalars(&c.observed, 1))?;
             }
             if self.stepped[j] {
                 send(&format!("{base}/load_angle"), time.clone(), scalars(&c.load_angle, 1))?;
@@ -719,7 +730,7 @@ pub fn blueprint(joint_names: &[String], stepped: &[bool], servo_driven: &[bool]
     let angle_views = joint_names.iter().map(|j| {
         TimeSeriesView::new(format!("{j} angle vs target"))
             .with_origin(format!("{prefix}joints/{j}"))
-            .with_contents(["$origin/position"])
+            .with_contents(["$origin/position", "$origin/observed"])
             .into()
     });
     let mut torque_ranges = Vec::new();
@@ -877,6 +888,7 @@ impl Recorder for RerunRecorder {
         self.servo_driven = e.firmware_joints();
         self.heated = e.motor_heat().iter().map(Option::is_some).collect();
         self.measured = (0..model.dof()).map(|j| run.measured_effort.get(j).copied().unwrap_or(false)).collect();
+        self.observed = (0..model.dof()).map(|j| run.observed_position.get(j).copied().unwrap_or(false)).collect();
         self.motors = e.motors.clone();
         let cap = FILE_BLOCK_STEPS + 1;
         self.times = Vec::with_capacity(cap);
@@ -957,6 +969,9 @@ impl Recorder for RerunRecorder {
             if self.measured[j] {
                 let measured = s.measured_effort[j];
                 c.measured.extend_from_slice(&[measured, measured - s.u[j]]);
+            }
+            if self.observed[j] {
+                c.observed.push(s.observed_position[j]);
             }
             if self.servo_driven[j] {
                 c.servo.extend_from_slice(&[s.duty[j], s.current[j]]);

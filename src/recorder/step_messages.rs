@@ -193,6 +193,7 @@ pub fn controller_telemetry(message: &ControllerTelemetry, out: &mut Vec<u8>) {
     packed_doubles(18, &m.current, out);
     packed_doubles(19, &m.supply, out);
     packed_doubles(20, &m.measured_effort, out);
+    packed_doubles(21, &m.observed_position, out);
 }
 
 #[cfg(test)]
@@ -297,6 +298,7 @@ mod tests {
                     current: if shift % 4 == 1 { d(5) } else { vec![] },
                     supply: if shift % 4 == 1 { d(6) } else { vec![] },
                     measured_effort: if shift % 3 == 2 { d(7) } else { vec![] },
+                    observed_position: if shift % 3 == 1 { d(8) } else { vec![] },
                 };
                 let mut ours = vec![0xCD];
                 controller_telemetry(&message, &mut ours);

@@ -80,6 +80,10 @@ pub struct ControllerTelemetry {
     /// joint has none; empty for a simulation).
     #[prost(double, repeated, tag = "20")]
     pub measured_effort: Vec<f64>,
+    /// A forward replay's real follower: its position per joint beside the simulated one, rad (NaN
+    /// where a joint has none; empty otherwise).
+    #[prost(double, repeated, tag = "21")]
+    pub observed_position: Vec<f64>,
 }
 
 impl ControllerTelemetry {
@@ -113,6 +117,8 @@ impl ControllerTelemetry {
         tel.winding_temperature.extend_from_slice(s.winding_temperature);
         tel.measured_effort.clear();
         tel.measured_effort.extend_from_slice(s.measured_effort);
+        tel.observed_position.clear();
+        tel.observed_position.extend_from_slice(s.observed_position);
         if !s.duty.is_empty() {
             tel.duty.copy_from_slice(s.duty);
             tel.current.copy_from_slice(s.current);
@@ -161,6 +167,7 @@ pub fn file_descriptor_set() -> Vec<u8> {
             field("current", 18, true, Type::Double),
             field("supply", 19, true, Type::Double),
             field("measured_effort", 20, true, Type::Double),
+            field("observed_position", 21, true, Type::Double),
         ],
         ..Default::default()
     };

@@ -53,6 +53,7 @@ struct SampleBlock {
     current: Vec<f64>,
     supply: Vec<f64>,
     measured_effort: Vec<f64>,
+    observed_position: Vec<f64>,
     /// Every sample's close pairs back to back, and where each sample's end.
     collisions: Vec<crate::collision::PairDistance>,
     collisions_end: Vec<usize>,
@@ -89,6 +90,7 @@ impl SampleBlock {
             current: Vec::new(),
             supply: Vec::new(),
             measured_effort: Vec::new(),
+            observed_position: Vec::new(),
             collisions: Vec::new(),
             collisions_end: Vec::with_capacity(capacity),
             tool: Vec::with_capacity(capacity),
@@ -124,6 +126,7 @@ impl SampleBlock {
         self.current.extend_from_slice(s.current);
         self.supply.extend_from_slice(s.supply);
         self.measured_effort.extend_from_slice(s.measured_effort);
+        self.observed_position.extend_from_slice(s.observed_position);
         self.collisions.extend_from_slice(s.collisions);
         self.collisions_end.push(self.collisions.len());
         self.tool.push(s.tool_position);
@@ -157,6 +160,7 @@ impl SampleBlock {
             current: if self.current.is_empty() { &[] } else { &self.current[a..b] },
             supply: if self.supply.is_empty() { &[] } else { &self.supply[a..b] },
             measured_effort: if self.measured_effort.is_empty() { &[] } else { &self.measured_effort[a..b] },
+            observed_position: if self.observed_position.is_empty() { &[] } else { &self.observed_position[a..b] },
             collisions: &self.collisions[if i == 0 { 0 } else { self.collisions_end[i - 1] }..self.collisions_end[i]],
             tool_position: self.tool[i],
             tool_target: self.tool_target[i],
@@ -170,7 +174,7 @@ impl Reusable for SampleBlock {
         self.k.clear();
         self.t.clear();
         self.is_final.clear();
-        for v in [&mut self.q, &mut self.v, &mut self.cmd, &mut self.cmd_dot, &mut self.u, &mut self.tau_g, &mut self.torque_limit, &mut self.load_angle, &mut self.winding_temperature, &mut self.duty, &mut self.current, &mut self.supply, &mut self.measured_effort] {
+        for v in [&mut self.q, &mut self.v, &mut self.cmd, &mut self.cmd_dot, &mut self.u, &mut self.tau_g, &mut self.torque_limit, &mut self.load_angle, &mut self.winding_temperature, &mut self.duty, &mut self.current, &mut self.supply, &mut self.measured_effort, &mut self.observed_position] {
             v.clear();
         }
         self.lost_steps.clear();

@@ -57,6 +57,8 @@ pub struct ForwardOptions {
     pub payload: f64,
     pub tool: Option<String>,
     pub schedule: PathBuf,
+    /// The recordings of the simulated arm, the real follower beside it (None: none).
+    pub recordings: Option<super::recording::RecordingOutputs>,
 }
 
 /// Follow `commands` on the simulated arm from where they start, and compare with `observed`.
@@ -85,12 +87,18 @@ pub fn forward(replayer: &Replayer, options: &ForwardOptions, commands: &Episode
     };
     let experiment = Experiment::with_model(config, model.clone())?;
     let mut capture = Capture { q: Vec::new() };
-    let summary = crate::sim::simulate(&experiment, &mut [&mut capture], None)?;
+    let mut files = options.recordings.as_ref().map_or_else(|| Ok(Vec::new()), |r| r.open())?;
+    let mut recorders: Vec<&mut dyn Recorder> = vec![&mut capture];
+    recorders.extend(files.iter_mut().map(|r| &mut **r as &mut dyn Recorder));
+    // the real follower as recorded (before smoothing), beside the simulated one
+    let t0 = command.time[0];
+    let follower = crate::sim::Observed { time: reality.time.iter().map(|t| t - t0).collect(), positions: reality.recorded.clone() };
+    let summary = crate::sim::simulate_beside(&experiment, &mut recorders, None, Some(&follower))?;
+    drop(recorders);
     if !matches!(summary.status, crate::summary::RunStatus::Completed) {
         return Err(Error::Diverged(format!("{}: the forward replay did not complete: {:?}", commands.label, summary.status)));
     }
     let dt = experiment.dt();
-    let t0 = command.time[0];
     let time: Vec<f64> = command.time.iter().map(|t| t - t0).collect();
     let mapped: Vec<usize> = (0..n).filter(|&j| command.recorded[j].is_some() && reality.recorded[j].is_some()).collect();
     let step_at = |t: f64| ((t / dt).round() as usize).min(capture.q.len() - 1);

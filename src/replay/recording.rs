@@ -22,6 +22,26 @@ pub struct RecordingOutputs {
     pub mcap_encoding: McapEncoding,
 }
 
+impl RecordingOutputs {
+    /// The recorders that write these files (their folders made).
+    pub fn open(&self) -> Result<Vec<Box<dyn Recorder>>, Error> {
+        let mut recorders: Vec<Box<dyn Recorder>> = Vec::new();
+        if let Some(path) = &self.rrd {
+            crate::runner::create_parent(path)?;
+            recorders.push(Box::new(RerunRecorder::new(RerunOptions { file: Some(path.clone()), live: None, name: self.name.clone(), compress: false })));
+        }
+        if let Some(path) = &self.mcap {
+            crate::runner::create_parent(path)?;
+            let options = McapOptions { file: Some(path.clone()), live: None, compress: false };
+            recorders.push(match self.mcap_encoding {
+                McapEncoding::Foxglove => Box::new(McapRecorder::new(options)),
+                McapEncoding::Ros2 => Box::new(Ros2McapRecorder::new(options)),
+            });
+        }
+        Ok(recorders)
+    }
+}
+
 /// Write one replayed episode's recordings.
 pub fn record(replayer: &Replayer, replay: &EpisodeReplay, outputs: &RecordingOutputs) -> Result<(), Error> {
     let motion = &replay.motion;
@@ -51,25 +71,14 @@ pub fn record(replayer: &Replayer, replay: &EpisodeReplay, outputs: &RecordingOu
     };
     let info = RunInfo {
         measured_effort: motion.measured.iter().map(Option::is_some).collect(),
+        observed_position: Vec::new(),
         experiment: &experiment,
         plant: "a recorded motion, replayed by inverse dynamics (no simulation)".into(),
         trajectory: format!("{} as recorded", motion.label),
         commanded_tool_path: tool_path,
         torque_axes: crate::recorder::torque_axis::LazyAxes::of(&experiment),
     };
-    let mut recorders: Vec<Box<dyn Recorder>> = Vec::new();
-    if let Some(path) = &outputs.rrd {
-        crate::runner::create_parent(path)?;
-        recorders.push(Box::new(RerunRecorder::new(RerunOptions { file: Some(path.clone()), live: None, name: outputs.name.clone(), compress: false })));
-    }
-    if let Some(path) = &outputs.mcap {
-        crate::runner::create_parent(path)?;
-        let options = McapOptions { file: Some(path.clone()), live: None, compress: false };
-        recorders.push(match outputs.mcap_encoding {
-            McapEncoding::Foxglove => Box::new(McapRecorder::new(options)),
-            McapEncoding::Ros2 => Box::new(Ros2McapRecorder::new(options)),
-        });
-    }
+    let mut recorders = outputs.open()?;
     for r in recorders.iter_mut() {
         r.start(&info)?;
     }
@@ -127,6 +136,7 @@ pub fn record(replayer: &Replayer, replay: &EpisodeReplay, outputs: &RecordingOu
             current: &[],
             supply: &[],
             measured_effort: &measured,
+            observed_position: &[],
             collisions: &[],
             tool_position,
             tool_target,
