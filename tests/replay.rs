@@ -331,12 +331,7 @@ fn the_replay_records_the_arm_needed_and_available_torques_like_a_run() {
     let count = mcap::MessageStream::new(&bytes).unwrap().filter(|m| m.as_ref().unwrap().channel.topic == "/joint_states").count();
     assert_eq!(count, rows);
     let lift = so101_joint_index("shoulder_lift");
-    let controller: Vec<f64> = mcap::MessageStream::new(&bytes)
-        .unwrap()
-        .map(|m| m.unwrap())
-        .filter(|m| m.channel.topic == "/controller")
-        .map(|m| <armscope::recorder::ControllerTelemetry as prost::Message>::decode(&m.data[..]).unwrap().measured_effort[lift])
-        .collect();
+    let controller: Vec<f64> = common::controller_messages(&mcap).iter().map(|m| m.measured_effort[lift]).collect();
     assert_eq!(controller.len(), rows);
     assert!(controller.iter().zip(effort).all(|(a, b)| (a - b).abs() < 1e-9), "/controller.measured_effort is the bag's effort");
 }
@@ -382,11 +377,9 @@ fn a_feetech_protection_trips_where_the_exact_motion_trips_it() {
     let servo = drive.servo.as_ref().unwrap();
     let (mut duty, mut current) = (Vec::new(), Vec::new());
     for (k, &t) in time.iter().enumerate() {
-        let speed = a_long_hold_at_reach()[lift].qd(t);
-        let (torque, shaft) = drive.servo_torque_for(truth[lift][k], speed, speed.abs() > armscope::replay::inverse::SLIDING_SPEED).unwrap();
-        let full = servo.drive(servo.firmware.family.max_duty * torque.signum(), shaft, servo.supply, true).torque.abs();
-        duty.push(if torque.abs() > full { 1.0 } else { servo.duty_for(torque, shaft) });
-        current.push(torque / servo.kt);
+        let (d, i) = armscope::replay::verdict::servo_demand(drive, truth[lift][k], a_long_hold_at_reach()[lift].qd(t)).unwrap();
+        duty.push(d);
+        current.push(i);
     }
     let exact = servo.firmware.protection.first_trip(time, &duty, &current).expect("the exact motion trips it");
     let frame = 1.0 / 30.0;

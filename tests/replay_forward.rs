@@ -173,13 +173,7 @@ fn forward_replay_from_the_command_line_writes_its_findings_and_needs_a_dataset(
         assert!((v[0] - expected).abs() < 1e-9, "t = {t}: {} against the follower's {expected}", v[0]);
     }
     assert!(series.iter().filter(|(t, _)| (t * 30.0 - (t * 30.0).round()).abs() < 1e-9).count() >= FRAMES / 3, "frames on the step grid");
-    let bytes = std::fs::read(&mcap).unwrap();
-    let controller: Vec<f64> = mcap::MessageStream::new(&bytes)
-        .unwrap()
-        .map(|m| m.unwrap())
-        .filter(|m| m.channel.topic == "/controller")
-        .map(|m| <armscope::recorder::ControllerTelemetry as prost::Message>::decode(&m.data[..]).unwrap().observed_position[lift])
-        .collect();
+    let controller: Vec<f64> = common::controller_messages(&mcap).iter().map(|m| m.observed_position[lift]).collect();
     assert_eq!(controller.len(), series.len());
     assert!(controller.iter().zip(&series).all(|(a, (_, b))| (a - b[0]).abs() < 1e-12), "/controller.observed_position is the .rrd's");
     // a bag holds no commands beside the positions

@@ -103,13 +103,9 @@ pub fn servo_loads(model: &Model, motors: Option<&MotorSet>, motion: &Motion) ->
             let mut duty = Vec::with_capacity(motion.len());
             let mut current = Vec::with_capacity(motion.len());
             for (&tau, &speed) in motion.needed[j].iter().zip(&motion.qd[j]) {
-                let (torque, shaft) = drive.servo_torque_for(tau, speed, speed.abs() > super::inverse::SLIDING_SPEED)?;
-                // past what full duty gives (its datasheet's line) the firmware's error grows until
-                // its duty is full: the load it sees is all its PWM, and more was needed
-                let full = servo.drive(servo.firmware.family.max_duty * torque.signum(), shaft, servo.supply, true).torque.abs();
-                let needed_duty = servo.duty_for(torque, shaft);
-                duty.push(if torque.abs() > full { torque.signum() * needed_duty.abs().max(1.0) } else { needed_duty });
-                current.push(torque / servo.kt);
+                let (d, i) = servo_demand(drive, tau, speed)?;
+                duty.push(d);
+                current.push(i);
             }
             let (peak_index, peak_duty) = duty.iter().enumerate().fold((0, 0.0_f64), |(bi, b), (i, d)| if d.abs() > b { (i, d.abs()) } else { (bi, b) });
             Some(ServoLoad {
@@ -121,6 +117,19 @@ pub fn servo_loads(model: &Model, motors: Option<&MotorSet>, motion: &Motion) ->
             })
         })
         .collect()
+}
+
+/// The duty (1 = 100 %) and current (A) a joint torque `tau` at joint speed `speed` asks of the
+/// joint's servo, its friction included while the joint slides; None without a servo model. Past
+/// what full duty gives (its datasheet's line) the firmware's error grows until its duty is full:
+/// the load it sees is all its PWM, and more was needed (at least 1).
+pub fn servo_demand(drive: &crate::actuator::DriveTrain, tau: f64, speed: f64) -> Option<(f64, f64)> {
+    let servo = drive.servo.as_ref()?;
+    let (torque, shaft) = drive.servo_torque_for(tau, speed, speed.abs() > super::inverse::SLIDING_SPEED)?;
+    let full = servo.drive(servo.firmware.family.max_duty * torque.signum(), shaft, servo.supply, true).torque.abs();
+    let needed = servo.duty_for(torque, shaft);
+    let duty = if torque.abs() > full { torque.signum() * needed.abs().max(1.0) } else { needed };
+    Some((duty, torque / servo.kt))
 }
 
 /// From each trip on, what its joint had is what the protection leaves the servo (its

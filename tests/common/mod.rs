@@ -77,3 +77,14 @@ pub fn armscope(args: &[&str]) -> i32 {
     }
     armscope::cli::main_with_args(argv)
 }
+
+/// Every `/controller` message of a Foxglove-encoded armscope MCAP, decoded.
+pub fn controller_messages(mcap: &Path) -> Vec<armscope::recorder::ControllerTelemetry> {
+    let bytes = std::fs::read(mcap).unwrap();
+    mcap::MessageStream::new(&bytes)
+        .unwrap()
+        .map(|m| m.unwrap())
+        .filter(|m| m.channel.topic == "/controller")
+        .map(|m| <armscope::recorder::ControllerTelemetry as prost::Message>::decode(&m.data[..]).unwrap())
+        .collect()
+}
