@@ -176,7 +176,7 @@ fn forward_replay_from_the_command_line_writes_its_findings_and_needs_a_dataset(
     let controller: Vec<f64> = common::controller_messages(&mcap).iter().map(|m| m.observed_position[lift]).collect();
     assert_eq!(controller.len(), series.len());
     assert!(controller.iter().zip(&series).all(|(a, (_, b))| (a - b[0]).abs() < 1e-12), "/controller.observed_position is the .rrd's");
-    // a bag holds no commands beside the positions
+    // a bag of joint states alone holds no commands to follow
     let bag = common::repo().join("tests/fixtures/ros2/joint_states_effort.mcap");
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_armscope"))
         .args(["replay", bag.to_str().unwrap(), "--urdf", so101().to_str().unwrap(), "--motors", motors().to_str().unwrap(), "--forward", "--no-rrd", "--no-mcap"])

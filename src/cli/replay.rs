@@ -35,7 +35,7 @@ pub struct ReplayArgs {
     #[arg(long, value_name = "FILE")]
     pub summary_json: Option<PathBuf>,
     /// The recordings of the episode (several: of the most loaded one; NAME:
-    /// replay_SOURCE[_episode_N]; with --forward, of the widest gap, forward_SOURCE_episode_N).
+    /// replay_SOURCE[_episode_N]; with --forward, of the widest gap, forward_SOURCE[_episode_N]).
     #[command(flatten)]
     pub files: crate::flags::RecordingFiles,
     /// The MCAP's encoding, as `run --mcap-encoding`.
@@ -44,12 +44,18 @@ pub struct ReplayArgs {
     /// Episodes at once (default: all cores).
     #[arg(long)]
     pub jobs: Option<usize>,
-    /// Forward replay instead: drive the simulated arm with each episode's commands (`action`)
-    /// through each joint's motor (a bus servo through its firmware loop; needs --motors), starting
-    /// where the commands start, and compare it with what the follower did (--feature, by default
-    /// `observation.state`): the tracking of reality and of the model, and the gap between them.
+    /// Forward replay instead: drive the simulated arm with each episode's commands (a dataset's
+    /// `action`, a bag's trajectory controller) through each joint's motor (a bus servo through its
+    /// firmware loop; needs --motors), starting where the commands start, and compare it with what
+    /// the follower did (--feature, by default `observation.state`; a bag's joint states): the
+    /// tracking of reality and of the model, and the gap between them.
     #[arg(long, requires = "motors")]
     pub forward: bool,
+    /// With --forward on a ROS 2 bag: the commands' topic, a trajectory controller's state
+    /// (control_msgs/msg/JointTrajectoryControllerState: its set point) or the trajectories it was
+    /// sent (trajectory_msgs/msg/JointTrajectory); default: the only one, a controller state first.
+    #[arg(long, value_name = "TOPIC", requires = "forward")]
+    pub command_topic: Option<String>,
 }
 
 /// `armscope replay`.
@@ -128,24 +134,27 @@ pub fn replay(args: &ReplayArgs) -> Result<i32, Error> {
 /// `replay --forward`: each episode's commands through the simulated arm's motors, against the follower.
 fn forward(args: &ReplayArgs, replayer: &Replayer, source: &crate::motion::Source, episodes: &[i64]) -> Result<i32, Error> {
     use crate::replay::forward::{ForwardOptions, forward, schedule_path, text};
-    if source.kind() != crate::motion::SourceKind::LeRobot {
-        return Err(Error::flag("--forward", format!("{}: needs a LeRobot dataset, whose episodes hold the commands (action) beside what the follower did", args.source.display())));
-    }
     let motors = args.motors.clone().ok_or_else(|| Error::flag("--forward", "needs --motors: the servos that follow the commands"))?;
     // the command schedules go where the recordings go
     let dir = args.files.folder();
     std::fs::create_dir_all(&dir).map_err(|e| Error::output(&dir, e))?;
-    // the recordings of one episode: recordings/forward_SOURCE_episode_N.rrd/.mcap unless told
+    // the recordings of one episode: recordings/forward_SOURCE[_episode_N].rrd/.mcap unless told
     let wants_recordings = !(args.files.no_rrd && args.files.no_mcap);
+    let dataset = source.kind() == crate::motion::SourceKind::LeRobot;
     let stem = args.source.file_stem().map_or("recording".into(), |s| s.to_string_lossy().into_owned());
     let outputs = |index: i64| {
-        let name = crate::runner::file_safe(&format!("forward_{stem}_episode_{index}"));
+        let name = crate::runner::file_safe(&if dataset { format!("forward_{stem}_episode_{index}") } else { format!("forward_{stem}") });
         let (rrd, mcap) = args.files.paths(&name);
         crate::replay::recording::RecordingOutputs { rrd, mcap, mcap_encoding: args.mcap_encoding, name }
     };
+    let several = episodes.len() > 1;
     let run = |index: i64, record: bool| -> Result<crate::replay::forward::ForwardReplay, Error> {
-        let commands = source.read(index, "action")?;
-        let observed = source.read(index, &args.recorded.feature)?;
+        let (commands, observed) = source.read_forward(index, &args.recorded.feature, args.command_topic.as_deref())?;
+        if !record || !several {
+            for notice in &commands.notices {
+                eprintln!("armscope: notice: {notice}");
+            }
+        }
         let recordings = (record && wants_recordings).then(|| outputs(index));
         let options = ForwardOptions { motors: motors.clone(), payload: args.payload, tool: args.tool.clone(), schedule: schedule_path(&dir, index), recordings: recordings.clone() };
         let replay = forward(replayer, &options, &commands, &observed)?;
@@ -155,14 +164,13 @@ fn forward(args: &ReplayArgs, replayer: &Replayer, source: &crate::motion::Sourc
         Ok(replay)
     };
     // a lone episode is recorded as it is replayed; of several, the one the model misses most, again
-    let several = episodes.len() > 1;
     let mut documents = Vec::new();
     let mut widest: Option<(f64, i64)> = None;
     for &index in episodes {
         let replay = run(index, !several)?;
         print!("{}", text(&replay));
         let trips: Vec<serde_json::Value> = replay.protection_trips.iter().map(|(joint, trip)| serde_json::json!({ "joint": joint, "trip": trip })).collect();
-        documents.push(serde_json::json!({ "episode": index, "joints": replay.joints, "protection_trips": trips }));
+        documents.push(serde_json::json!({ "episode": index, "joints": replay.joints, "protection_trips": trips, "uncommanded": replay.uncommanded }));
         let gap = replay.joints.iter().map(|g| g.gap_mae).fold(0.0, f64::max);
         if widest.is_none_or(|(w, _)| gap > w) {
             widest = Some((gap, index));

@@ -23,29 +23,9 @@ impl Bag {
     pub fn open(path: &Path, topic: Option<&str>) -> Result<Self, Error> {
         let fail = |m: String| Error::flag(path.display().to_string(), m);
         let bytes = std::fs::read(path).map_err(|e| fail(e.to_string()))?;
-        let summary = mcap::Summary::read(&bytes).map_err(|e| fail(e.to_string()))?;
-        let mut topics: Vec<String> = Vec::new();
-        let mut all: Vec<String> = Vec::new();
-        let channels: Vec<_> = match &summary {
-            Some(s) => s.channels.values().cloned().collect(),
-            // no summary section: walk the messages for their channels
-            None => {
-                let mut seen = BTreeMap::new();
-                for m in mcap::MessageStream::new(&bytes).map_err(|e| fail(e.to_string()))? {
-                    let m = m.map_err(|e| fail(e.to_string()))?;
-                    seen.entry(m.channel.id).or_insert(m.channel.clone());
-                }
-                seen.into_values().collect()
-            }
-        };
-        for channel in &channels {
-            all.push(channel.topic.clone());
-            if channel.schema.as_ref().is_some_and(|s| s.name == ROS2_JOINT_STATE || s.name == FOXGLOVE_JOINT_STATES) {
-                topics.push(channel.topic.clone());
-            }
-        }
-        topics.sort();
-        topics.dedup();
+        let channels = channels(path, &bytes)?;
+        let all: Vec<String> = channels.iter().map(|c| c.topic.clone()).collect();
+        let topics = topics_of(&channels, &[ROS2_JOINT_STATE, FOXGLOVE_JOINT_STATES]);
         let chosen = match topic {
             Some(t) if topics.iter().any(|x| x == t) => t.to_string(),
             Some(t) => return Err(Error::flag("--topic", format!("{}: no joint states on '{t}' (joint-state topics: {})", path.display(), list(&topics)))),
@@ -59,6 +39,11 @@ impl Bag {
 
     /// The topic's messages as one episode: a column per joint named in the first message.
     pub fn read(&self) -> Result<Episode, Error> {
+        Ok(self.read_stamped()?.1)
+    }
+
+    /// [`Bag::read`], and each sample's stamp (ns since the epoch, or since the bag's clock's zero).
+    pub(super) fn read_stamped(&self) -> Result<(Vec<i64>, Episode), Error> {
         let fail = |m: String| Error::flag(self.path.display().to_string(), m);
         let bytes = std::fs::read(&self.path).map_err(|e| fail(e.to_string()))?;
         let mut names: Vec<String> = Vec::new();
@@ -126,10 +111,36 @@ impl Bag {
         let columns = names.iter().cloned().zip(positions).map(|(name, values)| Column { name, values }).collect();
         let effort = if has_effort { names.iter().cloned().zip(efforts).map(|(name, values)| Column { name, values }).collect() } else { Vec::new() };
         let label = self.path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-        Ok(Episode { label, index: None, time, columns, effort, notices })
+        Ok((stamps, Episode { label, index: None, time, columns, effort, notices }))
     }
 }
 
-fn list(items: &[String]) -> String {
+
+/// Every channel of a bag: from its summary, else by walking its messages.
+pub(super) fn channels(path: &Path, bytes: &[u8]) -> Result<Vec<std::sync::Arc<mcap::Channel<'static>>>, Error> {
+    let fail = |m: String| Error::flag(path.display().to_string(), m);
+    let summary = mcap::Summary::read(bytes).map_err(|e| fail(e.to_string()))?;
+    Ok(match summary {
+        Some(s) => s.channels.values().cloned().collect(),
+        None => {
+            let mut seen = BTreeMap::new();
+            for m in mcap::MessageStream::new(bytes).map_err(|e| fail(e.to_string()))? {
+                let m = m.map_err(|e| fail(e.to_string()))?;
+                seen.entry(m.channel.id).or_insert(m.channel.clone());
+            }
+            seen.into_values().collect()
+        }
+    })
+}
+
+/// The topics (sorted, once each) whose schema is one of `schemas`.
+pub(super) fn topics_of(channels: &[std::sync::Arc<mcap::Channel<'static>>], schemas: &[&str]) -> Vec<String> {
+    let mut topics: Vec<String> = channels.iter().filter(|c| c.schema.as_ref().is_some_and(|s| schemas.contains(&s.name.as_str()))).map(|c| c.topic.clone()).collect();
+    topics.sort();
+    topics.dedup();
+    topics
+}
+
+pub(super) fn list(items: &[String]) -> String {
     if items.is_empty() { "none".into() } else { items.join(", ") }
 }

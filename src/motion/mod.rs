@@ -1,9 +1,11 @@
 //! Recorded motion of a real arm, read from where people keep it: LeRobot datasets (parquet), ROS 2
 //! bags and armscope recordings (`.mcap`), CSV tables. Each source gives episodes: sample times and
 //! named columns of values in the source's own units; [`joint_map`] turns them into the URDF's
-//! coordinates.
+//! coordinates. The commands an arm followed come beside its positions: a dataset's `action`, a bag's
+//! trajectory controller ([`commands`]).
 
 pub mod bag;
+pub mod commands;
 pub mod csv;
 pub mod joint_map;
 pub mod lerobot;
@@ -105,6 +107,17 @@ impl Source {
             Source::LeRobot(d) => d.read_episode(episode, feature),
             Source::Bag(b) => b.read(),
             Source::Csv(path) => csv::read(path),
+        }
+    }
+
+    /// An episode's commands and what the follower did, sampled at the same times (for the forward
+    /// replay): a LeRobot episode's `action` beside its `feature`; a bag's trajectory-controller
+    /// commands (on `command_topic`, else the one command topic there is) at its joint states' stamps.
+    pub fn read_forward(&self, episode: i64, feature: &str, command_topic: Option<&str>) -> Result<(Episode, Episode), Error> {
+        match self {
+            Source::LeRobot(d) => Ok((d.read_episode(episode, "action")?, d.read_episode(episode, feature)?)),
+            Source::Bag(b) => commands::read_forward(b, command_topic),
+            Source::Csv(path) => Err(Error::flag("--forward", format!("{}: a table holds no commands beside the positions; a LeRobot dataset (action) or a ROS 2 bag with a trajectory controller's commands does", path.display()))),
         }
     }
 

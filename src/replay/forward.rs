@@ -1,6 +1,7 @@
-//! Forward replay: an episode's commands (LeRobot's `action`, the leader's positions) followed by the
-//! simulated arm through each joint's motor — a bus servo through its firmware loop — and held against
-//! what the real follower did (`observation.state`): the sim-to-real gap of the whole arm, per joint.
+//! Forward replay: an episode's commands (LeRobot's `action`, the leader's positions; a ROS 2 bag's
+//! trajectory-controller set points) followed by the simulated arm through each joint's motor — a bus
+//! servo through its firmware loop — and held against what the real follower did
+//! (`observation.state`, the bag's joint states): the sim-to-real gap of the whole arm, per joint.
 
 use super::{Replayer, inverse_replay, schedule};
 use crate::config::RunConfig;
@@ -48,6 +49,8 @@ pub struct ForwardReplay {
     /// The firmware protections the simulated servos tripped, by joint (a Feetech's overload or
     /// overcurrent): where the model's follower gave up.
     pub protection_trips: Vec<(String, crate::actuator::bus_servo::Trip)>,
+    /// The recorded joints no command named: sent where the real joint was, not compared.
+    pub uncommanded: Vec<String>,
 }
 
 /// What the run needs beyond the replayer: the motor file (required: the joints' servos), payload and
@@ -64,10 +67,15 @@ pub struct ForwardOptions {
 /// Follow `commands` on the simulated arm from where they start, and compare with `observed`.
 pub fn forward(replayer: &Replayer, options: &ForwardOptions, commands: &Episode, observed: &Episode) -> Result<ForwardReplay, Error> {
     let model = &replayer.base_model;
-    let command = inverse_replay(&replayer.model, &replayer.map, commands, &replayer.hold)?;
+    let mut command = inverse_replay(&replayer.model, &replayer.map.only_columns_of(commands), commands, &replayer.hold)?;
     let reality = inverse_replay(&replayer.model, &replayer.map, observed, &replayer.hold)?;
     if command.len() != reality.len() || command.time.iter().zip(&reality.time).any(|(a, b)| (a - b).abs() > 1e-9) {
         return Err(Error::flag(commands.label.clone(), format!("its commands ({} frames) and observations ({} frames) are not sampled at the same times", command.len(), reality.len())));
+    }
+    // a joint no command names (a bag's other controller) is sent where the real joint was
+    let uncommanded: Vec<usize> = (0..model.dof()).filter(|&j| command.recorded[j].is_none() && reality.recorded[j].is_some()).collect();
+    for &j in &uncommanded {
+        command.q[j] = reality.q[j].clone();
     }
     schedule::write(&options.schedule, &command)?;
     // the run starts where the commands start: a servo's firmware holds its goal there, sagged under
@@ -101,6 +109,9 @@ pub fn forward(replayer: &Replayer, options: &ForwardOptions, commands: &Episode
     let dt = experiment.dt();
     let time: Vec<f64> = command.time.iter().map(|t| t - t0).collect();
     let mapped: Vec<usize> = (0..n).filter(|&j| command.recorded[j].is_some() && reality.recorded[j].is_some()).collect();
+    if mapped.is_empty() {
+        return Err(Error::flag(commands.label.clone(), format!("its commands name none of the recorded joints (commands: {})", commands.column_names().join(", "))));
+    }
     let step_at = |t: f64| ((t / dt).round() as usize).min(capture.q.len() - 1);
     let (mut commanded, mut observed, mut simulated, mut joints) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for &j in &mapped {
@@ -139,7 +150,8 @@ pub fn forward(replayer: &Replayer, options: &ForwardOptions, commands: &Episode
         simulated.push(s);
     }
     let protection_trips = summary.servos.iter().enumerate().filter_map(|(j, s)| Some((model.joints[j].name.clone(), s.as_ref()?.protection_trip?))).collect();
-    Ok(ForwardReplay { label: commands.label.clone(), time, commanded, observed, simulated, joints, protection_trips })
+    let uncommanded = uncommanded.iter().map(|&j| model.joints[j].name.clone()).collect();
+    Ok(ForwardReplay { label: commands.label.clone(), time, commanded, observed, simulated, joints, protection_trips, uncommanded })
 }
 
 /// The run's joint positions at every control step.
@@ -178,6 +190,9 @@ pub fn text(replay: &ForwardReplay) -> String {
             g.gap_max * 1e3,
             g.gap_max_at
         );
+    }
+    for joint in &replay.uncommanded {
+        out += &format!("  {joint}: no command; sent where the real joint was, not compared\n");
     }
     for (joint, trip) in &replay.protection_trips {
         out += &format!("  {joint}: in the model {}\n", trip.describe());

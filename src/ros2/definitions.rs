@@ -3,8 +3,9 @@
 //! after a line of 80 `=` and `MSG: pkg/Type`, as rosbag2 writes them
 //! (`rosbag2_cpp`'s `LocalMessageDefinitionSource`, documented in rosbag2's
 //! `docs/message_definition_encoding.md`). The standard types' field lines are those of ROS 2
-//! Humble's common_interfaces and rcl_interfaces (Humble and Jazzy agree on all of them); armscope's
-//! own are `assets/ros2/armscope_msgs/msg/*.msg`.
+//! Humble's common_interfaces and rcl_interfaces (Humble and Jazzy agree on all of them) and of
+//! control_msgs' Humble branch (a bag's own schema says how its controller states are laid out:
+//! [`super::trajectory`]); armscope's own are `assets/ros2/armscope_msgs/msg/*.msg`.
 
 /// A type's own definition and the types its fields use.
 struct Definition {
@@ -60,6 +61,33 @@ string mesh_resource\nMeshFile mesh_file\nbool mesh_use_embedded_materials\n",
         ],
     },
     Definition { name: "visualization_msgs/msg/MarkerArray", text: "Marker[] markers\n", uses: &["visualization_msgs/msg/Marker"] },
+    Definition { name: "geometry_msgs/msg/Twist", text: "Vector3 linear\nVector3 angular\n", uses: &["geometry_msgs/msg/Vector3"] },
+    Definition {
+        name: "trajectory_msgs/msg/JointTrajectoryPoint",
+        text: "float64[] positions\nfloat64[] velocities\nfloat64[] accelerations\nfloat64[] effort\nbuiltin_interfaces/Duration time_from_start\n",
+        uses: &["builtin_interfaces/msg/Duration"],
+    },
+    Definition {
+        name: "trajectory_msgs/msg/MultiDOFJointTrajectoryPoint",
+        text: "geometry_msgs/Transform[] transforms\ngeometry_msgs/Twist[] velocities\ngeometry_msgs/Twist[] accelerations\nbuiltin_interfaces/Duration time_from_start\n",
+        uses: &["geometry_msgs/msg/Transform", "geometry_msgs/msg/Twist", "builtin_interfaces/msg/Duration"],
+    },
+    Definition {
+        name: "trajectory_msgs/msg/JointTrajectory",
+        text: "std_msgs/Header header\nstring[] joint_names\nJointTrajectoryPoint[] points\n",
+        uses: &["std_msgs/msg/Header", "trajectory_msgs/msg/JointTrajectoryPoint"],
+    },
+    // control_msgs' humble branch (its comments left out)
+    Definition {
+        name: "control_msgs/msg/JointTrajectoryControllerState",
+        text: "std_msgs/Header header\nstring[] joint_names\ntrajectory_msgs/JointTrajectoryPoint reference\n\
+trajectory_msgs/JointTrajectoryPoint feedback\ntrajectory_msgs/JointTrajectoryPoint error\ntrajectory_msgs/JointTrajectoryPoint output\n\
+trajectory_msgs/JointTrajectoryPoint desired\ntrajectory_msgs/JointTrajectoryPoint actual\nstring[] multi_dof_joint_names\n\
+trajectory_msgs/MultiDOFJointTrajectoryPoint multi_dof_reference\ntrajectory_msgs/MultiDOFJointTrajectoryPoint multi_dof_feedback\n\
+trajectory_msgs/MultiDOFJointTrajectoryPoint multi_dof_error\ntrajectory_msgs/MultiDOFJointTrajectoryPoint multi_dof_output\n\
+trajectory_msgs/MultiDOFJointTrajectoryPoint multi_dof_desired\ntrajectory_msgs/MultiDOFJointTrajectoryPoint multi_dof_actual\n",
+        uses: &["std_msgs/msg/Header", "trajectory_msgs/msg/JointTrajectoryPoint", "trajectory_msgs/msg/MultiDOFJointTrajectoryPoint"],
+    },
     Definition { name: "armscope_msgs/msg/ControllerTelemetry", text: include_str!("../../assets/ros2/armscope_msgs/msg/ControllerTelemetry.msg"), uses: &[] },
     Definition { name: "armscope_msgs/msg/CollisionState", text: include_str!("../../assets/ros2/armscope_msgs/msg/CollisionState.msg"), uses: &[] },
 ];
