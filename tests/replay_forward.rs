@@ -6,11 +6,8 @@
 
 mod common;
 
-use armscope::config::RunConfig;
-use armscope::experiment::Experiment;
 use armscope::model::load_urdf;
 use armscope::motion::{JointMap, Source};
-use armscope::recorder::{Recorder, RunInfo};
 use armscope::replay::forward::{ForwardOptions, forward};
 use armscope::replay::{ReplayOptions, Replayer};
 use common::lerobot::{Sines, Spec, Storage};
@@ -20,57 +17,21 @@ const PAYLOAD: f64 = 0.2;
 const FRAMES: usize = 6 * 30 + 1;
 
 fn so101() -> PathBuf {
-    common::repo().join("tests/fixtures/robots/so101.urdf")
+    common::follower::so101()
 }
 
 fn motors() -> PathBuf {
-    common::repo().join("assets/motors/so101.toml")
+    common::follower::so101_motors()
 }
 
-fn commands() -> Vec<Sines> {
-    let s = |center: f64, a: f64, w: f64| Sines { center, terms: vec![(a, w, 0.3)] };
-    vec![s(0.0, 0.5, 1.2), s(0.3, 0.4, 1.0), s(-0.4, 0.4, 1.3), s(0.2, 0.4, 1.5), s(0.0, 0.6, 1.1), s(0.8, 0.3, 1.0)]
-}
-
-struct Capture(Vec<Vec<f64>>);
-
-impl Recorder for Capture {
-    fn start(&mut self, _: &RunInfo) -> Result<(), armscope::Error> {
-        Ok(())
-    }
-    fn record(&mut self, sample: &armscope::sample::Sample) -> Result<(), armscope::Error> {
-        self.0.push(sample.q.to_vec());
-        Ok(())
-    }
-    fn finish(&mut self, _: &RunInfo, _: &armscope::summary::Summary) -> Result<(), armscope::Error> {
-        Ok(())
-    }
-}
-
-/// The "real" follower: the arm simulated along the exact commands (sampled every millisecond) with
-/// `payload` at the tool, at the frames.
+/// The "real" follower at the frames: the arm simulated along the exact commands with `payload`.
 fn follower(dir: &Path, motion: &[Sines], payload: f64) -> Vec<Vec<f64>> {
-    let schedule = dir.join("exact_commands.csv");
-    let mut text = String::from("t,q1,q2,q3,q4,q5,q6\n");
-    for k in 0..=6000 {
-        let t = k as f64 * 1e-3;
-        text += &format!("{t:?}");
-        for m in motion {
-            text += &format!(",{:?}", m.q(t));
-        }
-        text.push('\n');
-    }
-    std::fs::write(&schedule, text).unwrap();
-    let start: Vec<String> = motion.iter().map(|m| format!("{:?}", m.q(0.0))).collect();
-    let config = RunConfig { urdf: so101(), motors: Some(motors()), payload, trajectory: Some(schedule), duration: 6.0, q0: Some(start.join(",")), ..RunConfig::default() };
-    let experiment = Experiment::prepare(config).unwrap();
-    let mut capture = Capture(Vec::new());
-    armscope::sim::simulate(&experiment, &mut [&mut capture], None).unwrap();
-    (0..FRAMES).map(|f| capture.0[(f as f64 / 30.0 / 1e-3).round() as usize].clone()).collect()
+    let every_ms = common::follower::follow(dir, motion, payload, 6.0);
+    (0..FRAMES).map(|f| every_ms[(f as f64 / 30.0 / 1e-3).round() as usize].clone()).collect()
 }
 
 fn dataset(dir: &Path) -> PathBuf {
-    dataset_of(dir, "so101_follow", &commands(), PAYLOAD)
+    dataset_of(dir, "so101_follow", &common::follower::so101_commands(), PAYLOAD)
 }
 
 fn dataset_of(dir: &Path, name: &str, motion: &[Sines], payload: f64) -> PathBuf {

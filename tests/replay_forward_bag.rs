@@ -8,11 +8,8 @@
 
 mod common;
 
-use armscope::config::RunConfig;
-use armscope::experiment::Experiment;
 use armscope::model::load_urdf;
 use armscope::motion::{JointMap, Source};
-use armscope::recorder::{Recorder, RunInfo};
 use armscope::replay::forward::{ForwardOptions, ForwardReplay, forward};
 use armscope::replay::{ReplayOptions, Replayer};
 use armscope::ros2::Message;
@@ -31,53 +28,21 @@ const LEAD_IN: f64 = 0.3;
 const JOINTS: [&str; 6] = ["shoulder_pan", "shoulder_lift", "elbow_flex", "wrist_flex", "wrist_roll", "gripper"];
 
 fn so101() -> PathBuf {
-    common::repo().join("tests/fixtures/robots/so101.urdf")
+    common::follower::so101()
 }
 
 fn motors() -> PathBuf {
-    common::repo().join("assets/motors/so101.toml")
+    common::follower::so101_motors()
 }
 
 fn commands() -> Vec<Sines> {
-    let s = |center: f64, a: f64, w: f64| Sines { center, terms: vec![(a, w, 0.3)] };
-    vec![s(0.0, 0.5, 1.2), s(0.3, 0.4, 1.0), s(-0.4, 0.4, 1.3), s(0.2, 0.4, 1.5), s(0.0, 0.6, 1.1), s(0.8, 0.3, 1.0)]
+    common::follower::so101_commands()
 }
 
-struct Capture(Vec<Vec<f64>>);
-
-impl Recorder for Capture {
-    fn start(&mut self, _: &RunInfo) -> Result<(), armscope::Error> {
-        Ok(())
-    }
-    fn record(&mut self, sample: &armscope::sample::Sample) -> Result<(), armscope::Error> {
-        self.0.push(sample.q.to_vec());
-        Ok(())
-    }
-    fn finish(&mut self, _: &RunInfo, _: &armscope::summary::Summary) -> Result<(), armscope::Error> {
-        Ok(())
-    }
-}
-
-/// The "real" follower: the arm simulated along the exact commands (every millisecond) with
-/// `payload` at the tool; its positions every millisecond.
+/// The "real" follower: the arm simulated along the exact commands with `payload` at the tool; its
+/// positions every millisecond.
 fn follower(dir: &Path, payload: f64) -> Vec<Vec<f64>> {
-    let schedule = dir.join("exact_commands.csv");
-    let mut text = String::from("t,q1,q2,q3,q4,q5,q6\n");
-    for k in 0..=(SECONDS * 1e3) as usize {
-        let t = k as f64 * 1e-3;
-        text += &format!("{t:?}");
-        for m in commands() {
-            text += &format!(",{:?}", m.q(t));
-        }
-        text.push('\n');
-    }
-    std::fs::write(&schedule, text).unwrap();
-    let start: Vec<String> = commands().iter().map(|m| format!("{:?}", m.q(0.0))).collect();
-    let config = RunConfig { urdf: so101(), motors: Some(motors()), payload, trajectory: Some(schedule), duration: SECONDS, q0: Some(start.join(",")), ..RunConfig::default() };
-    let experiment = Experiment::prepare(config).unwrap();
-    let mut capture = Capture(Vec::new());
-    armscope::sim::simulate(&experiment, &mut [&mut capture], None).unwrap();
-    capture.0
+    common::follower::follow(dir, &commands(), payload, SECONDS)
 }
 
 /// How the bag carries the commands.

@@ -4,6 +4,7 @@
 use std::io::Read;
 use std::path::{Path, PathBuf};
 
+pub mod follower;
 pub mod lerobot;
 pub mod random_tree;
 pub mod rrd;
