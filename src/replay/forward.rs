@@ -94,30 +94,30 @@ pub fn forward(replayer: &Replayer, options: &ForwardOptions, commands: &Episode
         ..RunConfig::default()
     };
     let experiment = Experiment::with_model(config, model.clone())?;
-    let mut capture = Capture { q: Vec::new() };
+    let dt = experiment.dt();
+    let t0 = command.time[0];
+    let time: Vec<f64> = command.time.iter().map(|t| t - t0).collect();
+    let mut capture = Capture::at_steps(time.iter().map(|t| (t / dt).round() as usize).collect());
     let mut files = options.recordings.as_ref().map_or_else(|| Ok(Vec::new()), |r| r.open())?;
     let mut recorders: Vec<&mut dyn Recorder> = vec![&mut capture];
     recorders.extend(files.iter_mut().map(|r| &mut **r as &mut dyn Recorder));
     // the real follower as recorded (before smoothing), beside the simulated one
-    let t0 = command.time[0];
     let follower = crate::sim::Observed { time: reality.time.iter().map(|t| t - t0).collect(), positions: reality.recorded.clone() };
     let summary = crate::sim::simulate_beside(&experiment, &mut recorders, None, Some(&follower))?;
     drop(recorders);
     if !matches!(summary.status, crate::summary::RunStatus::Completed) {
         return Err(Error::Diverged(format!("{}: the forward replay did not complete: {:?}", commands.label, summary.status)));
     }
-    let dt = experiment.dt();
-    let time: Vec<f64> = command.time.iter().map(|t| t - t0).collect();
+    let simulated_at = capture.finish();
     let mapped: Vec<usize> = (0..n).filter(|&j| command.recorded[j].is_some() && reality.recorded[j].is_some()).collect();
     if mapped.is_empty() {
         return Err(Error::flag(commands.label.clone(), format!("its commands name none of the recorded joints (commands: {})", commands.column_names().join(", "))));
     }
-    let step_at = |t: f64| ((t / dt).round() as usize).min(capture.q.len() - 1);
     let (mut commanded, mut observed, mut simulated, mut joints) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for &j in &mapped {
         let c: Vec<f64> = command.recorded[j].clone().unwrap_or_default();
         let o: Vec<f64> = reality.recorded[j].clone().unwrap_or_default();
-        let s: Vec<f64> = time.iter().map(|&t| capture.q[step_at(t)][j]).collect();
+        let s: Vec<f64> = simulated_at.iter().map(|q| q[j]).collect();
         let stats = |a: &[f64], b: &[f64]| -> (f64, f64, usize) {
             let mut worst = (0.0f64, 0usize);
             let mut sum = 0.0;
@@ -154,9 +154,27 @@ pub fn forward(replayer: &Replayer, options: &ForwardOptions, commands: &Episode
     Ok(ForwardReplay { label: commands.label.clone(), time, commanded, observed, simulated, joints, protection_trips, uncommanded })
 }
 
-/// The run's joint positions at every control step.
+/// The run's joint positions at the control steps nearest the episode's frames (only those: memory
+/// goes with the frames, not with the control rate).
 struct Capture {
+    /// Per frame, its control step (non-decreasing).
+    wanted: Vec<usize>,
     q: Vec<Vec<f64>>,
+    last: Vec<f64>,
+}
+
+impl Capture {
+    fn at_steps(wanted: Vec<usize>) -> Self {
+        Self { q: Vec::with_capacity(wanted.len()), wanted, last: Vec::new() }
+    }
+
+    /// Per frame, the positions there; frames past the run's last step get its last positions.
+    fn finish(mut self) -> Vec<Vec<f64>> {
+        while self.q.len() < self.wanted.len() {
+            self.q.push(self.last.clone());
+        }
+        self.q
+    }
 }
 
 impl Recorder for Capture {
@@ -164,7 +182,11 @@ impl Recorder for Capture {
         Ok(())
     }
     fn record(&mut self, sample: &Sample) -> Result<(), Error> {
-        self.q.push(sample.q.to_vec());
+        while self.q.len() < self.wanted.len() && self.wanted[self.q.len()] <= sample.k {
+            self.q.push(sample.q.to_vec());
+        }
+        self.last.clear();
+        self.last.extend_from_slice(sample.q);
         Ok(())
     }
     fn finish(&mut self, _run: &RunInfo, _summary: &Summary) -> Result<(), Error> {
