@@ -151,3 +151,35 @@ fn forward_replay_from_the_command_line_writes_its_findings_and_needs_a_dataset(
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_armscope")).args(["replay", root.to_str().unwrap(), "--urdf", so101().to_str().unwrap(), "--forward"]).output().unwrap();
     assert_eq!(out.status.code(), Some(2));
 }
+
+#[test]
+fn a_datasets_episodes_are_replayed_forward_together_the_widest_gap_first_and_recorded() {
+    // two episodes of the same commands: in episode 0 the follower carried the 0.2 kg the replay is
+    // told of, in episode 1 it carried 0.5 kg — the model misses episode 1 by more
+    let dir = tempfile::tempdir().unwrap();
+    let model = load_urdf(&so101()).unwrap();
+    let gripper = &model.joints[model.joint_index("gripper").unwrap()];
+    let mut storage: Vec<Storage> = (0..5).map(|_| Storage::Degrees { sign: 1.0, offset: 0.0 }).collect();
+    storage.push(Storage::Range0To100 { lower: gripper.lower, upper: gripper.upper });
+    let motion = common::follower::so101_commands();
+    let root = dir.path().join("so101_two_loads");
+    let observed = vec![follower(dir.path(), &motion, PAYLOAD), follower(dir.path(), &motion, 0.5)];
+    Spec { fps: 30.0, frames: FRAMES, episodes: vec![motion.clone(), motion], storage, observed: Some(observed) }.write_v3(&root);
+    let json = dir.path().join("forward.json");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_armscope"))
+        .args(["replay", root.to_str().unwrap(), "--urdf", so101().to_str().unwrap(), "--motors", motors().to_str().unwrap(), "--payload", "0.2", "--forward", "--jobs", "2", "--no-rrd", "--summary-json", json.to_str().unwrap()])
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let doc: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let order: Vec<i64> = doc["episodes"].as_array().unwrap().iter().map(|e| e["episode"].as_i64().unwrap()).collect();
+    assert_eq!(order, [1, 0], "the widest gap first");
+    let lift_gap = |e: usize| doc["episodes"][e]["joints"][1]["gap_mae"].as_f64().unwrap();
+    assert!(lift_gap(0) > 3.0 * lift_gap(1), "shoulder_lift: {:.2} mrad with 0.5 kg carried, {:.2} with the 0.2 kg told", lift_gap(0) * 1e3, lift_gap(1) * 1e3);
+    assert!(stdout.find("episode 1 (widest gap").unwrap() < stdout.find("episode 0 (widest gap").unwrap(), "{stdout}");
+    assert!(stdout.contains("recorded: episode 1, the widest gap"), "{stdout}");
+    assert!(dir.path().join("recordings/forward_so101_two_loads_episode_1.mcap").exists());
+    assert!(!dir.path().join("recordings/forward_so101_two_loads_episode_0.mcap").exists());
+}

@@ -133,7 +133,7 @@ pub fn replay(args: &ReplayArgs) -> Result<i32, Error> {
 
 /// `replay --forward`: each episode's commands through the simulated arm's motors, against the follower.
 fn forward(args: &ReplayArgs, replayer: &Replayer, source: &crate::motion::Source, episodes: &[i64]) -> Result<i32, Error> {
-    use crate::replay::forward::{ForwardOptions, forward, schedule_path, text};
+    use crate::replay::forward::{ForwardOptions, forward, forward_episodes, schedule_path};
     let motors = args.motors.clone().ok_or_else(|| Error::flag("--forward", "needs --motors: the servos that follow the commands"))?;
     // the command schedules go where the recordings go
     let dir = args.files.folder();
@@ -147,39 +147,44 @@ fn forward(args: &ReplayArgs, replayer: &Replayer, source: &crate::motion::Sourc
         let (rrd, mcap) = args.files.paths(&name);
         crate::replay::recording::RecordingOutputs { rrd, mcap, mcap_encoding: args.mcap_encoding, name }
     };
+    // a lone episode is recorded as it is replayed; of several, the one the model misses most, again
     let several = episodes.len() > 1;
-    let run = |index: i64, record: bool| -> Result<crate::replay::forward::ForwardReplay, Error> {
-        let (commands, observed) = source.read_forward(index, &args.recorded.feature, args.command_topic.as_deref())?;
-        if !record || !several {
-            for notice in &commands.notices {
-                eprintln!("armscope: notice: {notice}");
-            }
-        }
-        let recordings = (record && wants_recordings).then(|| outputs(index));
-        let options = ForwardOptions { motors: motors.clone(), payload: args.payload, tool: args.tool.clone(), schedule: schedule_path(&dir, index), recordings: recordings.clone() };
-        let replay = forward(replayer, &options, &commands, &observed)?;
-        for path in recordings.iter().flat_map(|r| r.rrd.iter().chain(&r.mcap)) {
+    let options = |index: i64, record: bool| ForwardOptions {
+        motors: motors.clone(),
+        payload: args.payload,
+        tool: args.tool.clone(),
+        schedule: schedule_path(&dir, index),
+        recordings: (record && wants_recordings).then(|| outputs(index)),
+    };
+    let wrote = |options: &ForwardOptions| {
+        for path in options.recordings.iter().flat_map(|r| r.rrd.iter().chain(&r.mcap)) {
             eprintln!("armscope: wrote {}", path.display());
         }
-        Ok(replay)
     };
-    // a lone episode is recorded as it is replayed; of several, the one the model misses most, again
-    let mut documents = Vec::new();
-    let mut widest: Option<(f64, i64)> = None;
-    for &index in episodes {
-        let replay = run(index, !several)?;
-        print!("{}", text(&replay));
-        let trips: Vec<serde_json::Value> = replay.protection_trips.iter().map(|(joint, trip)| serde_json::json!({ "joint": joint, "trip": trip })).collect();
-        documents.push(serde_json::json!({ "episode": index, "joints": replay.joints, "protection_trips": trips, "uncommanded": replay.uncommanded }));
-        let gap = replay.joints.iter().map(|g| g.gap_mae).fold(0.0, f64::max);
-        if widest.is_none_or(|(w, _)| gap > w) {
-            widest = Some((gap, index));
+    let jobs = args.jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
+    let summaries = forward_episodes(replayer, source, episodes, &args.recorded.feature, args.command_topic.as_deref(), jobs, &|index| options(index, !several))?;
+    for s in &summaries {
+        for notice in &s.notices {
+            eprintln!("armscope: notice: {notice}");
         }
     }
-    if let (true, true, Some((gap, index))) = (several, wants_recordings, widest) {
-        println!("recorded: episode {index}, the widest gap ({:.1} mrad mean on its worst joint)", gap * 1e3);
-        run(index, true)?;
+    if !several {
+        wrote(&options(episodes[0], true));
     }
+    for s in &summaries {
+        if several {
+            println!("episode {} (widest gap {:.1} mrad mean)", s.index, s.widest_gap * 1e3);
+        }
+        print!("{}", s.text);
+    }
+    if let (true, true, Some(widest)) = (several, wants_recordings, summaries.first()) {
+        println!("recorded: episode {}, the widest gap ({:.1} mrad mean on its worst joint)", widest.index, widest.widest_gap * 1e3);
+        let options = options(widest.index, true);
+        let (commands, observed) = source.read_forward(widest.index, &args.recorded.feature, args.command_topic.as_deref())?;
+        forward(replayer, &options, &commands, &observed)?;
+        wrote(&options);
+    }
+    let documents: Vec<&serde_json::Value> = summaries.iter().map(|s| &s.document).collect();
     if let Some(path) = &args.summary_json {
         let doc = serde_json::json!({ "source": args.source.display().to_string(), "forward": true, "parts_above_rad": crate::replay::forward::PARTS_ABOVE, "episodes": documents });
         let text = serde_json::to_string_pretty(&doc).map_err(|e| Error::output(path, e))?;

@@ -222,6 +222,58 @@ pub fn text(replay: &ForwardReplay) -> String {
     out
 }
 
+/// One episode's forward replay as a batch keeps it: its findings, not its frames.
+#[derive(Clone, Debug)]
+pub struct ForwardSummary {
+    pub index: i64,
+    /// The largest mean gap of any joint, rad (m): how far the model misses this episode.
+    pub widest_gap: f64,
+    /// [`text`] of the replay.
+    pub text: String,
+    /// The episode's findings as `--summary-json` writes them.
+    pub document: serde_json::Value,
+    /// What reading the episode assumed, one line each.
+    pub notices: Vec<String>,
+}
+
+impl ForwardSummary {
+    pub fn of(index: i64, replay: &ForwardReplay, notices: Vec<String>) -> Self {
+        let trips: Vec<serde_json::Value> = replay.protection_trips.iter().map(|(joint, trip)| serde_json::json!({ "joint": joint, "trip": trip })).collect();
+        let document = serde_json::json!({ "episode": index, "joints": replay.joints, "protection_trips": trips, "uncommanded": replay.uncommanded });
+        let widest_gap = replay.joints.iter().map(|g| g.gap_mae).fold(0.0, f64::max);
+        Self { index, widest_gap, text: text(replay), document, notices }
+    }
+}
+
+/// Replay `episodes` of `source` forward on `jobs` threads, each reduced to its summary as it goes
+/// (`options` gives an episode's; its recordings, if any, are written as it runs). The summaries
+/// come back the widest gap first.
+pub fn forward_episodes(
+    replayer: &Replayer,
+    source: &crate::motion::Source,
+    episodes: &[i64],
+    feature: &str,
+    command_topic: Option<&str>,
+    jobs: usize,
+    options: &(dyn Fn(i64) -> ForwardOptions + Sync),
+) -> Result<Vec<ForwardSummary>, Error> {
+    use rayon::prelude::*;
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(jobs.max(1)).build().map_err(|e| Error::flag("--jobs", e.to_string()))?;
+    let results: Vec<Result<ForwardSummary, Error>> = pool.install(|| {
+        episodes
+            .par_iter()
+            .map(|&index| {
+                let (commands, observed) = source.read_forward(index, feature, command_topic)?;
+                let replay = forward(replayer, &options(index), &commands, &observed)?;
+                Ok(ForwardSummary::of(index, &replay, commands.notices))
+            })
+            .collect()
+    });
+    let mut summaries = results.into_iter().collect::<Result<Vec<_>, Error>>()?;
+    summaries.sort_by(|a, b| b.widest_gap.total_cmp(&a.widest_gap));
+    Ok(summaries)
+}
+
 /// Where the command schedule of episode `index` is written beside the run's other outputs.
 pub fn schedule_path(dir: &Path, index: i64) -> PathBuf {
     dir.join(format!("forward_commands_episode_{index}.csv"))
