@@ -209,6 +209,9 @@ fn forward_replay_of_a_bag_from_the_command_line_names_its_recordings_and_its_to
     assert!(stdout.contains("gripper: no command; sent where the real joint was, not compared"), "{stdout}");
     assert!(stderr.contains("commands from control_msgs/msg/JointTrajectoryControllerState's reference on /arm_controller/controller_state"), "{stderr}");
     assert!(dir.path().join("recordings/forward_arm_run.mcap").exists());
+    // the schedule the simulated arm followed, beside its recordings: t and a column per joint
+    let schedule = common::read_csv(&dir.path().join("recordings/forward_arm_run_commands.csv"));
+    assert_eq!((schedule.header.len(), schedule.column("t").len()), (7, 601));
     let doc: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
     assert!(doc["episodes"][0]["joints"][1]["gap_mae"].as_f64().unwrap() < 2e-3);
     assert_eq!(doc["episodes"][0]["uncommanded"], serde_json::json!(["gripper"]));

@@ -142,8 +142,9 @@ fn forward(args: &ReplayArgs, replayer: &Replayer, source: &crate::motion::Sourc
     let wants_recordings = !(args.files.no_rrd && args.files.no_mcap);
     let dataset = source.kind() == crate::motion::SourceKind::LeRobot;
     let stem = args.source.file_stem().map_or("recording".into(), |s| s.to_string_lossy().into_owned());
+    let name_of = |index: i64| crate::runner::file_safe(&if dataset { format!("forward_{stem}_episode_{index}") } else { format!("forward_{stem}") });
     let outputs = |index: i64| {
-        let name = crate::runner::file_safe(&if dataset { format!("forward_{stem}_episode_{index}") } else { format!("forward_{stem}") });
+        let name = name_of(index);
         let (rrd, mcap) = args.files.paths(&name);
         crate::replay::recording::RecordingOutputs { rrd, mcap, mcap_encoding: args.mcap_encoding, name }
     };
@@ -153,7 +154,7 @@ fn forward(args: &ReplayArgs, replayer: &Replayer, source: &crate::motion::Sourc
         motors: motors.clone(),
         payload: args.payload,
         tool: args.tool.clone(),
-        schedule: schedule_path(&dir, index),
+        schedule: schedule_path(&dir, &name_of(index)),
         recordings: (record && wants_recordings).then(|| outputs(index)),
     };
     let wrote = |options: &ForwardOptions| {

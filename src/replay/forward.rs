@@ -274,7 +274,8 @@ pub fn forward_episodes(
     Ok(summaries)
 }
 
-/// Where the command schedule of episode `index` is written beside the run's other outputs.
-pub fn schedule_path(dir: &Path, index: i64) -> PathBuf {
-    dir.join(format!("forward_commands_episode_{index}.csv"))
+/// Where the command schedule of the recording `name` (`forward_SOURCE[_episode_N]`) is written
+/// beside its other outputs.
+pub fn schedule_path(dir: &Path, name: &str) -> PathBuf {
+    dir.join(format!("{name}_commands.csv"))
 }
