@@ -14,7 +14,8 @@ use armscope::replay::forward::{ForwardOptions, ForwardReplay, forward};
 use armscope::replay::{ReplayOptions, Replayer};
 use armscope::ros2::Message;
 use armscope::ros2::messages::{Header, JointState, Time};
-use armscope::ros2::trajectory::{JointTrajectory, JointTrajectoryControllerState, JointTrajectoryPoint};
+use armscope::motion::commands::CommandSource;
+use armscope::ros2::trajectory::{Float64MultiArray, JointTrajectory, JointTrajectoryControllerState, JointTrajectoryPoint};
 use common::lerobot::Sines;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -55,7 +56,13 @@ enum CommandsAs {
     /// is the command now, two more plan ahead to a goal 0.2 rad off that the next message replaces
     /// before it is reached.
     Trajectory,
+    /// A forward position controller's Float64MultiArray at 100 Hz, its joints in the controller's
+    /// order (not the joint states'): [`ARRAY_JOINTS`].
+    PositionArray,
 }
+
+/// The forward controller's joint order in the `PositionArray` bag.
+const ARRAY_JOINTS: [&str; 6] = ["gripper", "wrist_roll", "wrist_flex", "elbow_flex", "shoulder_lift", "shoulder_pan"];
 
 fn nanos(t: f64) -> i64 {
     EPOCH + (t * 1e9).round() as i64
@@ -77,6 +84,7 @@ fn bag(dir: &Path, name: &str, follower: &[Vec<f64>], commands_as: CommandsAs) -
     let controller = match commands_as {
         CommandsAs::ControllerState => channel(&mut writer, "/arm_controller/controller_state", JointTrajectoryControllerState::NAME),
         CommandsAs::Trajectory => channel(&mut writer, "/arm_controller/joint_trajectory", JointTrajectory::NAME),
+        CommandsAs::PositionArray => channel(&mut writer, "/forward_position_controller/commands", Float64MultiArray::NAME),
     };
     // (log time, channel, message): written in log-time order as a recorder writes them
     let mut messages: Vec<(i64, u16, Vec<u8>)> = Vec::new();
@@ -121,6 +129,13 @@ fn bag(dir: &Path, name: &str, follower: &[Vec<f64>], commands_as: CommandsAs) -
                 messages.push((nanos(t), controller, message.to_bytes()));
             }
         }
+        CommandsAs::PositionArray => {
+            for k in 0..=(SECONDS * 100.0) as i64 {
+                let t = k as f64 / 100.0;
+                let data = ARRAY_JOINTS.iter().map(|name| commands()[JOINTS.iter().position(|j| j == name).unwrap()].q(t)).collect();
+                messages.push((nanos(t), controller, Float64MultiArray { data, ..Default::default() }.to_bytes()));
+            }
+        }
     }
     messages.sort_by_key(|(t, _, _)| *t);
     for (sequence, (log_time, channel_id, data)) in messages.iter().enumerate() {
@@ -131,10 +146,10 @@ fn bag(dir: &Path, name: &str, follower: &[Vec<f64>], commands_as: CommandsAs) -
     path
 }
 
-fn replay_forward(bag: &Path, dir: &Path, payload: f64) -> (ForwardReplay, Vec<String>) {
+fn replay_forward(bag: &Path, dir: &Path, payload: f64, from: &CommandSource) -> (ForwardReplay, Vec<String>) {
     let model = load_urdf(&so101()).unwrap();
     let source = Source::open(bag, None).unwrap();
-    let (commands, observed) = source.read_forward(0, "observation.state", None).unwrap();
+    let (commands, observed) = source.read_forward(0, "observation.state", from).unwrap();
     let map = JointMap::builtin(source.kind(), &model, &observed).expect("a bag's columns are named by joint");
     let replayer = Replayer::new(model, &ReplayOptions { payload, motors: Some(motors()), ..Default::default() }, map).unwrap();
     let options = ForwardOptions { motors: motors(), payload, tool: None, schedule: dir.join(format!("commands_{payload}.csv")), recordings: None };
@@ -149,10 +164,14 @@ fn gap(replay: &ForwardReplay, joint: &str) -> f64 {
 fn a_bags_trajectory_controller_commands_drive_the_arm_to_its_recorded_follower() {
     let dir = tempfile::tempdir().unwrap();
     let real = follower(dir.path(), PAYLOAD);
-    for commands_as in [CommandsAs::ControllerState, CommandsAs::Trajectory] {
-        let name = if commands_as == CommandsAs::ControllerState { "controller_state.mcap" } else { "joint_trajectory.mcap" };
+    for commands_as in [CommandsAs::ControllerState, CommandsAs::Trajectory, CommandsAs::PositionArray] {
+        let (name, from) = match commands_as {
+            CommandsAs::ControllerState => ("controller_state.mcap", CommandSource::default()),
+            CommandsAs::Trajectory => ("joint_trajectory.mcap", CommandSource::default()),
+            CommandsAs::PositionArray => ("position_array.mcap", CommandSource { topic: None, joints: Some(ARRAY_JOINTS.map(String::from).to_vec()) }),
+        };
         let path = bag(dir.path(), name, &real, commands_as);
-        let (same, notices) = replay_forward(&path, dir.path(), PAYLOAD);
+        let (same, notices) = replay_forward(&path, dir.path(), PAYLOAD, &from);
         // the gripper is another controller's in the controller-state bag: sent where the real one
         // was, and not compared
         let compared = if commands_as == CommandsAs::ControllerState { 5 } else { 6 };
@@ -174,6 +193,12 @@ fn a_bags_trajectory_controller_commands_drive_the_arm_to_its_recorded_follower(
                 assert!(notices.iter().any(|n| n.contains("JointTrajectoryControllerState's reference")), "{notices:?}");
                 assert!(notices.iter().any(|n| n.contains("no command for gripper")), "{notices:?}");
             }
+            CommandsAs::PositionArray => {
+                assert!(notices.iter().any(|n| n.contains("Float64MultiArrays for gripper, wrist_roll") && n.contains("each held until the next")), "{notices:?}");
+                // in the controller's order, each joint got its own command
+                let exact: Vec<f64> = same.time.iter().map(|&t| commands()[0].q(t)).collect();
+                assert!(same.commanded[0].iter().zip(&exact).all(|(c, e)| (c - e).abs() < 1e-12), "shoulder_pan's command is the array's last value");
+            }
             CommandsAs::Trajectory => {
                 // the look-ahead points each newer message replaces were never followed
                 let commanded_lift = &same.commanded[1];
@@ -185,8 +210,8 @@ fn a_bags_trajectory_controller_commands_drive_the_arm_to_its_recorded_follower(
     }
     // 0.2 kg left out: the shoulder that holds it sags less in the model than in reality
     let path = dir.path().join("controller_state.mcap");
-    let (same, _) = replay_forward(&path, dir.path(), PAYLOAD);
-    let (without, _) = replay_forward(&path, dir.path(), 0.0);
+    let (same, _) = replay_forward(&path, dir.path(), PAYLOAD, &CommandSource::default());
+    let (without, _) = replay_forward(&path, dir.path(), 0.0, &CommandSource::default());
     assert!(gap(&without, "shoulder_lift") > 3.0 * gap(&same, "shoulder_lift") + 1e-3, "shoulder_lift: gap {:.2} mrad without the payload, {:.2} with it", gap(&without, "shoulder_lift") * 1e3, gap(&same, "shoulder_lift") * 1e3);
 }
 
@@ -246,22 +271,32 @@ fn every_distributions_controller_state_and_a_trajectory_give_the_set_points_an_
         ("/humble_controller/controller_state", "JointTrajectoryControllerState's desired"),
         ("/jazzy_controller/controller_state", "JointTrajectoryControllerState's reference"),
         ("/arm_controller/joint_trajectory", "JointTrajectory's points"),
+        ("/forward_position_controller/commands", "Float64MultiArrays for wrist_roll, wrist_flex"),
     ] {
-        let commands = armscope::motion::commands::read(&bag, Some(topic)).unwrap();
-        assert!(commands.what.ends_with(what), "{topic}: {}", commands.what);
-        assert_eq!(commands.joints, JOINTS[..5], "{topic}");
+        // the array's joints in its controller's order (reversed), as the user gives them
+        let array = topic.starts_with("/forward");
+        let joints: Vec<String> = if array { JOINTS[..5].iter().rev().map(|s| s.to_string()).collect() } else { JOINTS[..5].iter().map(|s| s.to_string()).collect() };
+        let commands = armscope::motion::commands::read(&bag, &CommandSource { topic: Some(topic.to_string()), joints: array.then(|| joints.clone()) }).unwrap();
+        assert!(commands.what.contains(what), "{topic}: {}", commands.what);
+        assert_eq!(commands.joints, joints, "{topic}");
         assert_eq!(commands.stamps.len(), 201, "{topic}");
         for (k, &stamp) in commands.stamps.iter().enumerate() {
             // stamped (or, zero-stamped, logged) every 10 ms from the epoch
             assert_eq!(stamp, epoch + k as i64 * 10_000_000, "{topic}");
             let t = (stamp - epoch) as f64 * 1e-9;
-            for (j, joint) in commands.positions.iter().enumerate() {
+            for (c, joint) in commands.positions.iter().enumerate() {
+                let j = JOINTS.iter().position(|name| *name == commands.joints[c]).unwrap();
                 let set_point = 0.1 * j as f64 + 0.3 * (1.3 * t + j as f64).sin();
                 assert!((joint[k] - set_point).abs() < 1e-12, "{topic}: joint {j} at {t} s: {} against {set_point}", joint[k]);
             }
         }
     }
-    // four command topics: which one is for the user to say
-    let err = armscope::motion::commands::read(&bag, None).unwrap_err().to_string();
+    // five command topics: which one is for the user to say
+    let err = armscope::motion::commands::read(&bag, &CommandSource::default()).unwrap_err().to_string();
     assert!(err.contains("--command-topic") && err.contains("several command topics"), "{err}");
+    // an array names no joints: without them, or with too few, one line naming the flag
+    let arrays = |joints: Option<Vec<String>>| armscope::motion::commands::read(&bag, &CommandSource { topic: Some("/forward_position_controller/commands".into()), joints }).unwrap_err().to_string();
+    assert!(arrays(None).contains("--command-joints"), "{}", arrays(None));
+    let too_few = arrays(Some(vec!["shoulder_pan".into()]));
+    assert!(too_few.contains("--command-joints") && too_few.contains("sends 5 positions"), "{too_few}");
 }

@@ -52,10 +52,16 @@ pub struct ReplayArgs {
     #[arg(long, requires = "motors")]
     pub forward: bool,
     /// With --forward on a ROS 2 bag: the commands' topic, a trajectory controller's state
-    /// (control_msgs/msg/JointTrajectoryControllerState: its set point) or the trajectories it was
-    /// sent (trajectory_msgs/msg/JointTrajectory); default: the only one, a controller state first.
+    /// (control_msgs/msg/JointTrajectoryControllerState: its set point), the trajectories it was
+    /// sent (trajectory_msgs/msg/JointTrajectory) or a forward command controller's positions
+    /// (std_msgs/msg/Float64MultiArray, with --command-joints); default: the only one, a controller
+    /// state first, then a trajectory.
     #[arg(long, value_name = "TOPIC", requires = "forward")]
     pub command_topic: Option<String>,
+    /// With --forward on a bag whose commands are Float64MultiArrays: the joints they hold, in the
+    /// controller's order (comma list, as the joint states name them).
+    #[arg(long, value_name = "JOINTS", value_delimiter = ',', num_args = 1, requires = "forward")]
+    pub command_joints: Option<Vec<String>>,
 }
 
 /// `armscope replay`.
@@ -163,7 +169,8 @@ fn forward(args: &ReplayArgs, replayer: &Replayer, source: &crate::motion::Sourc
         }
     };
     let jobs = args.jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
-    let summaries = forward_episodes(replayer, source, episodes, &args.recorded.feature, args.command_topic.as_deref(), jobs, &|index| options(index, !several))?;
+    let commands = crate::motion::commands::CommandSource { topic: args.command_topic.clone(), joints: args.command_joints.clone() };
+    let summaries = forward_episodes(replayer, source, episodes, &args.recorded.feature, &commands, jobs, &|index| options(index, !several))?;
     for s in &summaries {
         for notice in &s.notices {
             eprintln!("armscope: notice: {notice}");
@@ -181,7 +188,7 @@ fn forward(args: &ReplayArgs, replayer: &Replayer, source: &crate::motion::Sourc
     if let (true, true, Some(widest)) = (several, wants_recordings, summaries.first()) {
         println!("recorded: episode {}, the widest gap ({:.1} mrad mean on its worst joint)", widest.index, widest.widest_gap * 1e3);
         let options = options(widest.index, true);
-        let (commands, observed) = source.read_forward(widest.index, &args.recorded.feature, args.command_topic.as_deref())?;
+        let (commands, observed) = source.read_forward(widest.index, &args.recorded.feature, &commands)?;
         forward(replayer, &options, &commands, &observed)?;
         wrote(&options);
     }

@@ -2,17 +2,29 @@
 //! (`control_msgs/msg/JointTrajectoryControllerState`: the set point at each update, `reference`,
 //! else `desired`) or what it was sent (`trajectory_msgs/msg/JointTrajectory`: each message's points
 //! from its stamp on, a newer message replacing what an older one planned from the newer's start,
-//! the last point held after it). Set points are joined by straight lines and sampled at the joint
-//! states' stamps, so that the commands and the follower come as one episode each at the same times.
+//! the last point held after it) or what a forward command controller was sent
+//! (`std_msgs/msg/Float64MultiArray`: a position per joint in the controller's joint order, which the
+//! message does not carry and the user gives; at its log time, held until the next). Set points are
+//! joined by straight lines (a forward controller's held) and sampled at the joint states' stamps, so
+//! that the commands and the follower come as one episode each at the same times.
 
 use super::bag::{Bag, channels, list, topics_of};
 use super::{Column, Episode, check_increasing};
 use crate::error::Error;
 use crate::ros2::messages::Message as _;
-use crate::ros2::trajectory::{ControllerStateLayout, JointTrajectory};
+use crate::ros2::trajectory::{ControllerStateLayout, Float64MultiArray, JointTrajectory};
 
 const CONTROLLER_STATE: &str = "control_msgs/msg/JointTrajectoryControllerState";
 const TRAJECTORY: &str = "trajectory_msgs/msg/JointTrajectory";
+const POSITION_ARRAY: &str = "std_msgs/msg/Float64MultiArray";
+
+/// Where a bag's commands are: the topic (None: the one there is) and, for a forward command
+/// controller's arrays, the joints in the controller's order.
+#[derive(Clone, Debug, Default)]
+pub struct CommandSource {
+    pub topic: Option<String>,
+    pub joints: Option<Vec<String>>,
+}
 
 /// A controller's set points: when (ns, as the joint states are stamped) and, per joint, where.
 #[derive(Clone, Debug)]
@@ -27,6 +39,9 @@ pub struct Commands {
     /// Whether the last set point holds after it (a trajectory's end) or the commands stop there (a
     /// controller's last update).
     pub held_after_end: bool,
+    /// Whether each set point holds until the next (a forward controller's command) rather than
+    /// leading to it on a line (a trajectory's interpolation, a controller's samples of one).
+    pub stepwise: bool,
     pub notices: Vec<String>,
 }
 
@@ -35,29 +50,43 @@ pub struct Commands {
 fn choose_topic(bag: &Bag, channels: &[std::sync::Arc<mcap::Channel<'static>>], asked: Option<&str>) -> Result<(String, &'static str), Error> {
     let states = topics_of(channels, &[CONTROLLER_STATE]);
     let trajectories = topics_of(channels, &[TRAJECTORY]);
-    let kind = |t: &str| if states.iter().any(|s| s == t) { Some(CONTROLLER_STATE) } else if trajectories.iter().any(|s| s == t) { Some(TRAJECTORY) } else { None };
-    let candidates: Vec<String> = states.iter().chain(&trajectories).cloned().collect();
+    let arrays = topics_of(channels, &[POSITION_ARRAY]);
+    let kind = |t: &str| [(&states, CONTROLLER_STATE), (&trajectories, TRAJECTORY), (&arrays, POSITION_ARRAY)].into_iter().find(|(topics, _)| topics.iter().any(|s| s == t)).map(|(_, k)| k);
+    let candidates: Vec<String> = states.iter().chain(&trajectories).chain(&arrays).cloned().collect();
     let path = bag.path.display();
     match asked {
-        Some(t) => kind(t).map(|k| (t.to_string(), k)).ok_or_else(|| Error::flag("--command-topic", format!("{path}: no {CONTROLLER_STATE} or {TRAJECTORY} on '{t}' (command topics: {})", list(&candidates)))),
-        None => match (states.as_slice(), trajectories.as_slice()) {
-            ([one], _) => Ok((one.clone(), CONTROLLER_STATE)),
-            ([], [one]) => Ok((one.clone(), TRAJECTORY)),
-            ([], []) => Err(Error::flag(
+        Some(t) => kind(t).map(|k| (t.to_string(), k)).ok_or_else(|| Error::flag("--command-topic", format!("{path}: no {CONTROLLER_STATE}, {TRAJECTORY} or {POSITION_ARRAY} on '{t}' (command topics: {})", list(&candidates)))),
+        None => match (states.as_slice(), trajectories.as_slice(), arrays.as_slice()) {
+            ([one], _, _) => Ok((one.clone(), CONTROLLER_STATE)),
+            ([], [one], _) => Ok((one.clone(), TRAJECTORY)),
+            ([], [], [one]) => Ok((one.clone(), POSITION_ARRAY)),
+            ([], [], []) => Err(Error::flag(
                 "--forward",
-                format!("{path}: no commands to follow: a forward replay of a bag needs a trajectory controller's {CONTROLLER_STATE} or the {TRAJECTORY} it was sent (topics: {})", list(&channels.iter().map(|c| c.topic.clone()).collect::<Vec<_>>())),
+                format!(
+                    "{path}: no commands to follow: a forward replay of a bag needs a trajectory controller's {CONTROLLER_STATE}, the {TRAJECTORY} it was sent or a forward command controller's {POSITION_ARRAY} (topics: {})",
+                    list(&channels.iter().map(|c| c.topic.clone()).collect::<Vec<_>>())
+                ),
             )),
             _ => Err(Error::flag("--command-topic", format!("{path}: several command topics, choose one: {}", candidates.join(", ")))),
         },
     }
 }
 
-/// Read the commands on `asked` (or the one command topic there is) in `bag`.
-pub fn read(bag: &Bag, asked: Option<&str>) -> Result<Commands, Error> {
+/// Read the commands `from` asks for (or on the one command topic there is) in `bag`.
+pub fn read(bag: &Bag, from: &CommandSource) -> Result<Commands, Error> {
     let fail = |m: String| Error::flag(bag.path.display().to_string(), m);
     let bytes = std::fs::read(&bag.path).map_err(|e| fail(e.to_string()))?;
     let channels = channels(&bag.path, &bytes)?;
+    let asked = from.topic.as_deref();
     let (topic, kind) = choose_topic(bag, &channels, asked)?;
+    // an array names no joints: the controller's order is the user's to give
+    let array_joints = match (kind, &from.joints) {
+        (POSITION_ARRAY, Some(joints)) => joints.clone(),
+        (POSITION_ARRAY, None) => {
+            return Err(Error::flag("--command-joints", format!("{}: {topic} holds {POSITION_ARRAY}s, which name no joints: give its controller's joints in order", bag.path.display())));
+        }
+        _ => Vec::new(),
+    };
     let mut joints: Vec<String> = Vec::new();
     // (stamp, positions in `joints` order)
     let mut set_points: Vec<(i64, Vec<f64>)> = Vec::new();
@@ -86,6 +115,14 @@ pub fn read(bag: &Bag, asked: Option<&str>) -> Result<Commands, Error> {
             }
             field = set.field;
             (set.header.stamp.nanos(), set.joint_names, vec![(0, set.positions)])
+        } else if kind == POSITION_ARRAY {
+            let array = Float64MultiArray::decode(&message.data).map_err(decode_error)?;
+            let values = array.data.get(array.data_offset as usize..).unwrap_or(&[]).to_vec();
+            if values.len() != array_joints.len() {
+                return Err(Error::flag("--command-joints", format!("{}: {topic} sends {} positions, --command-joints names {} joints", bag.path.display(), values.len(), array_joints.len())));
+            }
+            // no stamp: when it was logged
+            (0, array_joints.clone(), vec![(0, values)])
         } else {
             let trajectory = JointTrajectory::decode(&message.data).map_err(decode_error)?;
             let points = trajectory.points.into_iter().filter(|p| p.positions.len() == trajectory.joint_names.len()).map(|p| (p.time_from_start.nanos(), p.positions)).collect::<Vec<_>>();
@@ -123,10 +160,14 @@ pub fn read(bag: &Bag, asked: Option<&str>) -> Result<Commands, Error> {
     let t0 = stamps[0];
     check_increasing(&stamps.iter().map(|s| (s - t0) as f64 * 1e-9).collect::<Vec<_>>(), &topic).map_err(fail)?;
     let positions = (0..joints.len()).map(|j| set_points.iter().map(|(_, p)| p[j]).collect()).collect();
-    let what = if kind == CONTROLLER_STATE { format!("{CONTROLLER_STATE}'s {field}") } else { format!("{TRAJECTORY}'s points") };
+    let what = match kind {
+        CONTROLLER_STATE => format!("{CONTROLLER_STATE}'s {field}"),
+        TRAJECTORY => format!("{TRAJECTORY}'s points"),
+        _ => format!("{POSITION_ARRAY}s for {}", joints.join(", ")),
+    };
     let mut notices = Vec::new();
     if asked.is_none() {
-        let others: Vec<String> = topics_of(&channels, &[TRAJECTORY]).into_iter().filter(|t| *t != topic).collect();
+        let others: Vec<String> = topics_of(&channels, &[TRAJECTORY, POSITION_ARRAY]).into_iter().filter(|t| *t != topic).collect();
         if !others.is_empty() {
             notices.push(format!("{}: the commands followed are the controller's state on {topic}, not what it was sent on {} (--command-topic to choose)", bag.path.display(), others.join(", ")));
         }
@@ -137,14 +178,17 @@ pub fn read(bag: &Bag, asked: Option<&str>) -> Result<Commands, Error> {
     if empty > 0 {
         notices.push(format!("{}: {empty} messages on {topic} hold no position per joint; left out", bag.path.display()));
     }
-    Ok(Commands { topic, what, joints, stamps, positions, held_after_end: kind == TRAJECTORY, notices })
+    // a trajectory's last point and a forward controller's last command hold; a controller's state
+    // stops where it was recorded
+    Ok(Commands { topic, what, joints, stamps, positions, held_after_end: kind != CONTROLLER_STATE, stepwise: kind == POSITION_ARRAY, notices })
 }
 
 /// The commands and the joint states of `bag` as two episodes sampled at the joint states' stamps
-/// while there are commands: commanded positions on straight lines between set points (a joint the
+/// while there are commands: commanded positions on straight lines between set points, or held
+/// (a forward controller's) (a joint the
 /// commands do not name is said in a notice; the forward replay sends it where the real joint was).
-pub fn read_forward(bag: &Bag, asked: Option<&str>) -> Result<(Episode, Episode), Error> {
-    let commands = read(bag, asked)?;
+pub fn read_forward(bag: &Bag, from: &CommandSource) -> Result<(Episode, Episode), Error> {
+    let commands = read(bag, from)?;
     let (stamps, observed) = bag.read_stamped()?;
     let fail = |m: String| Error::flag(bag.path.display().to_string(), m);
     let (first, last) = (commands.stamps[0], *commands.stamps.last().unwrap_or(&commands.stamps[0]));
@@ -178,8 +222,8 @@ pub fn read_forward(bag: &Bag, asked: Option<&str>) -> Result<(Episode, Episode)
                 segment += 1;
             }
             match commands.stamps.get(segment + 1) {
-                Some(&next) => (segment, (s - commands.stamps[segment]) as f64 / (next - commands.stamps[segment]) as f64),
-                None => (segment, 0.0),
+                Some(&next) if !commands.stepwise => (segment, (s - commands.stamps[segment]) as f64 / (next - commands.stamps[segment]) as f64),
+                _ => (segment, 0.0),
             }
         })
         .collect();
@@ -190,7 +234,8 @@ pub fn read_forward(bag: &Bag, asked: Option<&str>) -> Result<(Episode, Episode)
         .map(|(name, p)| Column { name: name.clone(), values: weights.iter().map(|&(i, w)| if w > 0.0 { p[i] + w * (p[i + 1] - p[i]) } else { p[i] }).collect() })
         .collect();
     let mut notices = commands.notices.clone();
-    notices.push(format!("{}: commands from {} on {}, on straight lines between set points at {}'s {} stamps", bag.path.display(), commands.what, commands.topic, bag.topic, kept.len()));
+    let joined = if commands.stepwise { "each held until the next" } else { "on straight lines between set points" };
+    notices.push(format!("{}: commands from {} on {}, {joined}, at {}'s {} stamps", bag.path.display(), commands.what, commands.topic, bag.topic, kept.len()));
     for c in &follower.columns {
         if !commands.joints.contains(&c.name) {
             notices.push(format!("{}: no command for {} on {}; its motor is sent where the real joint was (not compared)", bag.path.display(), c.name, commands.topic));

@@ -112,11 +112,12 @@ impl Source {
 
     /// An episode's commands and what the follower did, sampled at the same times (for the forward
     /// replay): a LeRobot episode's `action` beside its `feature`; a bag's trajectory-controller
-    /// commands (on `command_topic`, else the one command topic there is) at its joint states' stamps.
-    pub fn read_forward(&self, episode: i64, feature: &str, command_topic: Option<&str>) -> Result<(Episode, Episode), Error> {
+    /// commands (where `commands` says, else on the one command topic there is) at its joint states'
+    /// stamps.
+    pub fn read_forward(&self, episode: i64, feature: &str, commands: &commands::CommandSource) -> Result<(Episode, Episode), Error> {
         match self {
             Source::LeRobot(d) => Ok((d.read_episode(episode, "action")?, d.read_episode(episode, feature)?)),
-            Source::Bag(b) => commands::read_forward(b, command_topic),
+            Source::Bag(b) => commands::read_forward(b, commands),
             Source::Csv(path) => Err(Error::flag("--forward", format!("{}: a table holds no commands beside the positions; a LeRobot dataset (action) or a ROS 2 bag with a trajectory controller's commands does", path.display()))),
         }
     }

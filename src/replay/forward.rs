@@ -253,7 +253,7 @@ pub fn forward_episodes(
     source: &crate::motion::Source,
     episodes: &[i64],
     feature: &str,
-    command_topic: Option<&str>,
+    commands: &crate::motion::commands::CommandSource,
     jobs: usize,
     options: &(dyn Fn(i64) -> ForwardOptions + Sync),
 ) -> Result<Vec<ForwardSummary>, Error> {
@@ -263,7 +263,7 @@ pub fn forward_episodes(
         episodes
             .par_iter()
             .map(|&index| {
-                let (commands, observed) = source.read_forward(index, feature, command_topic)?;
+                let (commands, observed) = source.read_forward(index, feature, commands)?;
                 let replay = forward(replayer, &options(index), &commands, &observed)?;
                 Ok(ForwardSummary::of(index, &replay, commands.notices))
             })

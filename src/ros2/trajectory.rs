@@ -1,6 +1,7 @@
 //! The messages that carry a ROS 2 arm's commands: `trajectory_msgs/msg/JointTrajectory` (what a
-//! trajectory controller is sent) and `control_msgs/msg/JointTrajectoryControllerState` (what it
-//! followed, at its update rate). The controller state's layout changed between distributions
+//! trajectory controller is sent), `control_msgs/msg/JointTrajectoryControllerState` (what it
+//! followed, at its update rate) and `std_msgs/msg/Float64MultiArray` (a forward command
+//! controller's positions, in its configured joint order: the message names no joints). The controller state's layout changed between distributions
 //! (Foxy: `desired, actual, error`; Humble: `reference, feedback, error, output, desired, actual`
 //! and the multi-DOF points; Jazzy: no `desired`/`actual`, a `speed_scaling_factor`), so a bag's
 //! messages are read by the layout its schema gives ([`ControllerStateLayout`]); all agree on the
@@ -59,6 +60,42 @@ impl Message for JointTrajectory {
         let n = r.length(24)?;
         let points = (0..n).map(|_| JointTrajectoryPoint::read(r)).collect::<Result<_, _>>()?;
         Ok(Self { header, joint_names, points })
+    }
+}
+
+/// std_msgs/msg/MultiArrayDimension.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct MultiArrayDimension {
+    pub label: String,
+    pub size: u32,
+    pub stride: u32,
+}
+
+/// std_msgs/msg/Float64MultiArray.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Float64MultiArray {
+    pub dim: Vec<MultiArrayDimension>,
+    pub data_offset: u32,
+    pub data: Vec<f64>,
+}
+
+impl Message for Float64MultiArray {
+    const NAME: &'static str = "std_msgs/msg/Float64MultiArray";
+    fn write(&self, w: &mut CdrWriter) {
+        w.length(self.dim.len());
+        for d in &self.dim {
+            w.string(&d.label);
+            w.u32(d.size);
+            w.u32(d.stride);
+        }
+        w.u32(self.data_offset);
+        w.f64_sequence(&self.data);
+    }
+    fn read(r: &mut CdrReader) -> Result<Self, CdrError> {
+        // a dimension is at least its label's length and two counts
+        let n = r.length(12)?;
+        let dim = (0..n).map(|_| Ok(MultiArrayDimension { label: r.string()?, size: r.u32()?, stride: r.u32()? })).collect::<Result<_, CdrError>>()?;
+        Ok(Self { dim, data_offset: r.u32()?, data: r.f64_sequence()? })
     }
 }
 
@@ -196,6 +233,8 @@ mod tests {
         assert_eq!(JointTrajectory::decode(&trajectory.to_bytes()).unwrap(), trajectory);
         let state = JointTrajectoryControllerState { joint_names: vec!["a".into()], reference: point(&[0.5]), actual: point(&[0.25]), ..Default::default() };
         assert_eq!(JointTrajectoryControllerState::decode(&state.to_bytes()).unwrap(), state);
+        let array = Float64MultiArray { dim: vec![MultiArrayDimension { label: "joints".into(), size: 2, stride: 2 }], data_offset: 0, data: vec![0.5, -0.25] };
+        assert_eq!(Float64MultiArray::decode(&array.to_bytes()).unwrap(), array);
     }
 
     #[test]
