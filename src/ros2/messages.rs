@@ -27,14 +27,16 @@ pub trait Message: Sized {
     }
 }
 
-fn sequence<T: Message>(w: &mut CdrWriter, items: &[T]) {
+/// A sequence of messages: its count, then each.
+pub(super) fn sequence<T: Message>(w: &mut CdrWriter, items: &[T]) {
     w.length(items.len());
     for item in items {
         item.write(w);
     }
 }
 
-fn read_sequence<T: Message>(r: &mut CdrReader, min_size: usize) -> Result<Vec<T>, CdrError> {
+/// A sequence of messages, each at least `min_size` bytes (the count checked against what is left).
+pub(super) fn read_sequence<T: Message>(r: &mut CdrReader, min_size: usize) -> Result<Vec<T>, CdrError> {
     let n = r.length(min_size)?;
     (0..n).map(|_| T::read(r)).collect()
 }

@@ -1,14 +1,15 @@
 //! The messages that carry a ROS 2 arm's commands: `trajectory_msgs/msg/JointTrajectory` (what a
 //! trajectory controller is sent), `control_msgs/msg/JointTrajectoryControllerState` (what it
 //! followed, at its update rate) and `std_msgs/msg/Float64MultiArray` (a forward command
-//! controller's positions, in its configured joint order: the message names no joints). The controller state's layout changed between distributions
-//! (Foxy: `desired, actual, error`; Humble: `reference, feedback, error, output, desired, actual`
-//! and the multi-DOF points; Jazzy: no `desired`/`actual`, a `speed_scaling_factor`), so a bag's
+//! controller's positions, in its configured joint order: the message names no joints). The
+//! controller state's layout changed between distributions (Foxy: `desired, actual, error`; Humble:
+//! `reference, feedback, error, output, desired, actual` and the multi-DOF points; Jazzy: no
+//! `desired`/`actual`, a `speed_scaling_factor`), so a bag's
 //! messages are read by the layout its schema gives ([`ControllerStateLayout`]); all agree on the
 //! header, the joint names and a run of `JointTrajectoryPoint`s, the set point among them.
 
 use super::cdr::{CdrError, CdrReader, CdrWriter};
-use super::messages::{Header, Message, Time};
+use super::messages::{Header, Message, Time, read_sequence, sequence};
 
 /// trajectory_msgs/msg/JointTrajectoryPoint.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -48,18 +49,11 @@ impl Message for JointTrajectory {
     fn write(&self, w: &mut CdrWriter) {
         self.header.write(w);
         w.string_sequence(&self.joint_names);
-        w.length(self.points.len());
-        for p in &self.points {
-            p.write(w);
-        }
+        sequence(w, &self.points);
     }
     fn read(r: &mut CdrReader) -> Result<Self, CdrError> {
-        let header = Header::read(r)?;
-        let joint_names = r.string_sequence()?;
         // a point is at least its four sequences' counts and its duration
-        let n = r.length(24)?;
-        let points = (0..n).map(|_| JointTrajectoryPoint::read(r)).collect::<Result<_, _>>()?;
-        Ok(Self { header, joint_names, points })
+        Ok(Self { header: Header::read(r)?, joint_names: r.string_sequence()?, points: read_sequence(r, 24)? })
     }
 }
 
@@ -69,6 +63,18 @@ pub struct MultiArrayDimension {
     pub label: String,
     pub size: u32,
     pub stride: u32,
+}
+
+impl Message for MultiArrayDimension {
+    const NAME: &'static str = "std_msgs/msg/MultiArrayDimension";
+    fn write(&self, w: &mut CdrWriter) {
+        w.string(&self.label);
+        w.u32(self.size);
+        w.u32(self.stride);
+    }
+    fn read(r: &mut CdrReader) -> Result<Self, CdrError> {
+        Ok(Self { label: r.string()?, size: r.u32()?, stride: r.u32()? })
+    }
 }
 
 /// std_msgs/msg/Float64MultiArray.
@@ -82,20 +88,13 @@ pub struct Float64MultiArray {
 impl Message for Float64MultiArray {
     const NAME: &'static str = "std_msgs/msg/Float64MultiArray";
     fn write(&self, w: &mut CdrWriter) {
-        w.length(self.dim.len());
-        for d in &self.dim {
-            w.string(&d.label);
-            w.u32(d.size);
-            w.u32(d.stride);
-        }
+        sequence(w, &self.dim);
         w.u32(self.data_offset);
         w.f64_sequence(&self.data);
     }
     fn read(r: &mut CdrReader) -> Result<Self, CdrError> {
         // a dimension is at least its label's length and two counts
-        let n = r.length(12)?;
-        let dim = (0..n).map(|_| Ok(MultiArrayDimension { label: r.string()?, size: r.u32()?, stride: r.u32()? })).collect::<Result<_, CdrError>>()?;
-        Ok(Self { dim, data_offset: r.u32()?, data: r.f64_sequence()? })
+        Ok(Self { dim: read_sequence(r, 12)?, data_offset: r.u32()?, data: r.f64_sequence()? })
     }
 }
 
