@@ -195,14 +195,14 @@ impl JointMap {
         out
     }
 
-    /// The recording's columns in the model's coordinates: per coordinate its series, `None` where
-    /// the map leaves the joint out.
     /// The map's joints whose column `episode` has (a bag's commands name the joints their controller
     /// drives, not every joint).
     pub fn only_columns_of(&self, episode: &Episode) -> JointMap {
         JointMap { entries: self.entries.iter().filter(|e| episode.column(&e.column).is_some()).cloned().collect(), source: self.source.clone() }
     }
 
+    /// The recording's columns in the model's coordinates: per coordinate its series, `None` where
+    /// the map leaves the joint out.
     pub fn apply(&self, model: &Model, episode: &Episode) -> Result<Vec<Option<Vec<f64>>>, Error> {
         let mut out: Vec<Option<Vec<f64>>> = vec![None; model.dof()];
         for e in &self.entries {
