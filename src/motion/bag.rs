@@ -44,15 +44,24 @@ impl Bag {
 
     /// [`Bag::read`], and each sample's stamp (ns since the epoch, or since the bag's clock's zero).
     pub(super) fn read_stamped(&self) -> Result<(Vec<i64>, Episode), Error> {
+        self.read_stamped_from(&self.bytes()?)
+    }
+
+    /// The bag's bytes, read whole.
+    pub(super) fn bytes(&self) -> Result<Vec<u8>, Error> {
+        std::fs::read(&self.path).map_err(|e| Error::flag(self.path.display().to_string(), e.to_string()))
+    }
+
+    /// [`Bag::read_stamped`] from the bag's bytes, already read.
+    pub(super) fn read_stamped_from(&self, bytes: &[u8]) -> Result<(Vec<i64>, Episode), Error> {
         let fail = |m: String| Error::flag(self.path.display().to_string(), m);
-        let bytes = std::fs::read(&self.path).map_err(|e| fail(e.to_string()))?;
         let mut names: Vec<String> = Vec::new();
         let mut stamps: Vec<i64> = Vec::new();
         let mut positions: Vec<Vec<f64>> = Vec::new();
         let mut efforts: Vec<Vec<f64>> = Vec::new();
         let mut has_effort = true;
         let mut skipped = 0usize;
-        for message in mcap::MessageStream::new(&bytes).map_err(|e| fail(e.to_string()))? {
+        for message in mcap::MessageStream::new(bytes).map_err(|e| fail(e.to_string()))? {
             let message = message.map_err(|e| fail(e.to_string()))?;
             if message.channel.topic != self.topic {
                 continue;

@@ -46,7 +46,7 @@ pub struct Commands {
 }
 
 /// The commands topic of `bag`: `asked`, else its one controller-state topic, else its one trajectory
-/// topic; with its message type.
+/// topic, else its one array topic; with its message type.
 fn choose_topic(bag: &Bag, channels: &[std::sync::Arc<mcap::Channel<'static>>], asked: Option<&str>) -> Result<(String, &'static str), Error> {
     let states = topics_of(channels, &[CONTROLLER_STATE]);
     let trajectories = topics_of(channels, &[TRAJECTORY]);
@@ -74,9 +74,13 @@ fn choose_topic(bag: &Bag, channels: &[std::sync::Arc<mcap::Channel<'static>>], 
 
 /// Read the commands `from` asks for (or on the one command topic there is) in `bag`.
 pub fn read(bag: &Bag, from: &CommandSource) -> Result<Commands, Error> {
+    read_from(bag, &bag.bytes()?, from)
+}
+
+/// [`read`] from the bag's bytes, already read.
+fn read_from(bag: &Bag, bytes: &[u8], from: &CommandSource) -> Result<Commands, Error> {
     let fail = |m: String| Error::flag(bag.path.display().to_string(), m);
-    let bytes = std::fs::read(&bag.path).map_err(|e| fail(e.to_string()))?;
-    let channels = channels(&bag.path, &bytes)?;
+    let channels = channels(&bag.path, bytes)?;
     let asked = from.topic.as_deref();
     let (topic, kind) = choose_topic(bag, &channels, asked)?;
     // an array names no joints: the controller's order is the user's to give
@@ -87,28 +91,31 @@ pub fn read(bag: &Bag, from: &CommandSource) -> Result<Commands, Error> {
         }
         _ => Vec::new(),
     };
+    // a controller state is read by the layout its schema gives
+    let layout = match kind {
+        CONTROLLER_STATE => {
+            let channel = channels.iter().find(|c| c.topic == topic).ok_or_else(|| fail(format!("{topic}: no such channel")))?;
+            let schema = channel.schema.as_ref().ok_or_else(|| fail(format!("{topic}: no schema")))?;
+            if schema.encoding != "ros2msg" {
+                return Err(fail(format!("{topic}: its schema is {}, armscope reads ros2msg", schema.encoding)));
+            }
+            Some(ControllerStateLayout::from_definition(&String::from_utf8_lossy(&schema.data)).map_err(|e| fail(format!("{topic}: {e}")))?)
+        }
+        _ => None,
+    };
     let mut joints: Vec<String> = Vec::new();
     // (stamp, positions in `joints` order)
     let mut set_points: Vec<(i64, Vec<f64>)> = Vec::new();
     let (mut other_joints, mut empty) = (0usize, 0usize);
     let mut field = "";
-    let mut layout: Option<ControllerStateLayout> = None;
-    for message in mcap::MessageStream::new(&bytes).map_err(|e| fail(e.to_string()))? {
+    for message in mcap::MessageStream::new(bytes).map_err(|e| fail(e.to_string()))? {
         let message = message.map_err(|e| fail(e.to_string()))?;
         if message.channel.topic != topic {
             continue;
         }
         let decode_error = |e: crate::ros2::CdrError| fail(format!("{topic}: {e}"));
-        let (stamp, names, points): (i64, Vec<String>, Vec<(i64, Vec<f64>)>) = if kind == CONTROLLER_STATE {
-            if layout.is_none() {
-                let schema = message.channel.schema.as_ref().ok_or_else(|| fail(format!("{topic}: no schema")))?;
-                if schema.encoding != "ros2msg" {
-                    return Err(fail(format!("{topic}: its schema is {}, armscope reads ros2msg", schema.encoding)));
-                }
-                let text = String::from_utf8_lossy(&schema.data);
-                layout = Some(ControllerStateLayout::from_definition(&text).map_err(|e| fail(format!("{topic}: {e}")))?);
-            }
-            let set = layout.as_ref().map(|l| l.set_point(&message.data)).transpose().map_err(decode_error)?.unwrap_or_else(|| unreachable!("the layout was read above"));
+        let (stamp, names, points): (i64, Vec<String>, Vec<(i64, Vec<f64>)>) = if let Some(layout) = &layout {
+            let set = layout.set_point(&message.data).map_err(decode_error)?;
             if set.positions.is_empty() {
                 empty += 1;
                 continue;
@@ -141,9 +148,11 @@ pub fn read(bag: &Bag, from: &CommandSource) -> Result<Commands, Error> {
             other_joints += 1;
             continue;
         };
-        // a newer trajectory replaces what an older one planned from the newer's start on
-        while set_points.last().is_some_and(|(t, _)| *t >= start && kind == TRAJECTORY) {
-            set_points.pop();
+        if kind == TRAJECTORY {
+            // a newer trajectory replaces what an older one planned from the newer's start on
+            while set_points.last().is_some_and(|(t, _)| *t >= start) {
+                set_points.pop();
+            }
         }
         for (offset, positions) in points {
             let at = start + offset;
@@ -167,9 +176,10 @@ pub fn read(bag: &Bag, from: &CommandSource) -> Result<Commands, Error> {
     };
     let mut notices = Vec::new();
     if asked.is_none() {
-        let others: Vec<String> = topics_of(&channels, &[TRAJECTORY, POSITION_ARRAY]).into_iter().filter(|t| *t != topic).collect();
+        // the kinds passed over for this one (a controller's state before what it was sent)
+        let others: Vec<String> = topics_of(&channels, &[CONTROLLER_STATE, TRAJECTORY, POSITION_ARRAY]).into_iter().filter(|t| *t != topic).collect();
         if !others.is_empty() {
-            notices.push(format!("{}: the commands followed are the controller's state on {topic}, not what it was sent on {} (--command-topic to choose)", bag.path.display(), others.join(", ")));
+            notices.push(format!("{}: the commands followed are the {what} on {topic}, not those on {} (--command-topic to choose)", bag.path.display(), others.join(", ")));
         }
     }
     if other_joints > 0 {
@@ -184,12 +194,13 @@ pub fn read(bag: &Bag, from: &CommandSource) -> Result<Commands, Error> {
 }
 
 /// The commands and the joint states of `bag` as two episodes sampled at the joint states' stamps
-/// while there are commands: commanded positions on straight lines between set points, or held
-/// (a forward controller's) (a joint the
-/// commands do not name is said in a notice; the forward replay sends it where the real joint was).
+/// while there are commands: commanded positions on straight lines between set points, or each
+/// held until the next (a forward controller's). A joint the commands do not name is said in a
+/// notice; the forward replay sends it where the real joint was.
 pub fn read_forward(bag: &Bag, from: &CommandSource) -> Result<(Episode, Episode), Error> {
-    let commands = read(bag, from)?;
-    let (stamps, observed) = bag.read_stamped()?;
+    let bytes = bag.bytes()?;
+    let commands = read_from(bag, &bytes, from)?;
+    let (stamps, observed) = bag.read_stamped_from(&bytes)?;
     let fail = |m: String| Error::flag(bag.path.display().to_string(), m);
     let (first, last) = (commands.stamps[0], *commands.stamps.last().unwrap_or(&commands.stamps[0]));
     let kept: Vec<usize> = (0..stamps.len()).filter(|&k| stamps[k] >= first && (commands.held_after_end || stamps[k] <= last)).collect();
