@@ -72,16 +72,20 @@ pub fn forward(replayer: &Replayer, options: &ForwardOptions, commands: &Episode
     if command.len() != reality.len() || command.time.iter().zip(&reality.time).any(|(a, b)| (a - b).abs() > 1e-9) {
         return Err(Error::flag(commands.label.clone(), format!("its commands ({} frames) and observations ({} frames) are not sampled at the same times", command.len(), reality.len())));
     }
+    let n = model.dof();
     // a joint no command names (a bag's other controller) is sent where the real joint was
-    let uncommanded: Vec<usize> = (0..model.dof()).filter(|&j| command.recorded[j].is_none() && reality.recorded[j].is_some()).collect();
+    let uncommanded: Vec<usize> = (0..n).filter(|&j| command.recorded[j].is_none() && reality.recorded[j].is_some()).collect();
     for &j in &uncommanded {
         command.q[j] = reality.q[j].clone();
+    }
+    let mapped: Vec<usize> = (0..n).filter(|&j| command.recorded[j].is_some() && reality.recorded[j].is_some()).collect();
+    if mapped.is_empty() {
+        return Err(Error::flag(commands.label.clone(), format!("its commands name none of the recorded joints (commands: {})", commands.column_names().join(", "))));
     }
     schedule::write(&options.schedule, &command)?;
     // the run starts where the commands start: a servo's firmware holds its goal there, sagged under
     // the weight as the real follower's did (a motor with no firmware model starts on the pose)
     let (length, first_command) = schedule::span(&command);
-    let n = model.dof();
     let start: Vec<String> = first_command.iter().map(|q| format!("{q:?}")).collect();
     let config = RunConfig {
         urdf: model.source.clone(),
@@ -109,10 +113,6 @@ pub fn forward(replayer: &Replayer, options: &ForwardOptions, commands: &Episode
         return Err(Error::Diverged(format!("{}: the forward replay did not complete: {:?}", commands.label, summary.status)));
     }
     let simulated_at = capture.finish();
-    let mapped: Vec<usize> = (0..n).filter(|&j| command.recorded[j].is_some() && reality.recorded[j].is_some()).collect();
-    if mapped.is_empty() {
-        return Err(Error::flag(commands.label.clone(), format!("its commands name none of the recorded joints (commands: {})", commands.column_names().join(", "))));
-    }
     let (mut commanded, mut observed, mut simulated, mut joints) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for &j in &mapped {
         let c: Vec<f64> = command.recorded[j].clone().unwrap_or_default();
@@ -257,19 +257,11 @@ pub fn forward_episodes(
     jobs: usize,
     options: &(dyn Fn(i64) -> ForwardOptions + Sync),
 ) -> Result<Vec<ForwardSummary>, Error> {
-    use rayon::prelude::*;
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(jobs.max(1)).build().map_err(|e| Error::flag("--jobs", e.to_string()))?;
-    let results: Vec<Result<ForwardSummary, Error>> = pool.install(|| {
-        episodes
-            .par_iter()
-            .map(|&index| {
-                let (commands, observed) = source.read_forward(index, feature, commands)?;
-                let replay = forward(replayer, &options(index), &commands, &observed)?;
-                Ok(ForwardSummary::of(index, &replay, commands.notices))
-            })
-            .collect()
-    });
-    let mut summaries = results.into_iter().collect::<Result<Vec<_>, Error>>()?;
+    let mut summaries = super::over_episodes(episodes, jobs, |index| {
+        let (commands, observed) = source.read_forward(index, feature, commands)?;
+        let replay = forward(replayer, &options(index), &commands, &observed)?;
+        Ok(ForwardSummary::of(index, &replay, commands.notices))
+    })?;
     summaries.sort_by(|a, b| b.widest_gap.total_cmp(&a.widest_gap));
     Ok(summaries)
 }

@@ -91,20 +91,21 @@ pub fn replay_episodes(
     jobs: usize,
     each: &(dyn Fn(i64, &EpisodeReplay) -> Result<(), Error> + Sync),
 ) -> Result<Vec<report::EpisodeSummary>, Error> {
-    use rayon::prelude::*;
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(jobs.max(1)).build().map_err(|e| Error::flag("--jobs", e.to_string()))?;
-    let results: Vec<Result<report::EpisodeSummary, Error>> = pool.install(|| {
-        episodes
-            .par_iter()
-            .map(|&index| {
-                let episode = source.read(index, feature)?;
-                let replay = replayer.replay(&episode)?;
-                each(index, &replay)?;
-                Ok(report::EpisodeSummary::of(&replay, episode.index))
-            })
-            .collect()
-    });
-    let mut summaries = results.into_iter().collect::<Result<Vec<_>, Error>>()?;
+    let mut summaries = over_episodes(episodes, jobs, |index| {
+        let episode = source.read(index, feature)?;
+        let replay = replayer.replay(&episode)?;
+        each(index, &replay)?;
+        Ok(report::EpisodeSummary::of(&replay, episode.index))
+    })?;
     summaries.sort_by(|a, b| b.peak_load.total_cmp(&a.peak_load));
     Ok(summaries)
+}
+
+/// `each` over `episodes` on `jobs` threads: the results in episode order, or the first episode's
+/// error.
+fn over_episodes<T: Send>(episodes: &[i64], jobs: usize, each: impl Fn(i64) -> Result<T, Error> + Sync) -> Result<Vec<T>, Error> {
+    use rayon::prelude::*;
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(jobs.max(1)).build().map_err(|e| Error::flag("--jobs", e.to_string()))?;
+    let results: Vec<Result<T, Error>> = pool.install(|| episodes.par_iter().map(|&index| each(index)).collect());
+    results.into_iter().collect()
 }
