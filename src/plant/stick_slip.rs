@@ -112,11 +112,16 @@ pub struct StickSlipSolver {
     /// Each joint's parent joint when A has a branched tree's sparsity (LᵀDL), else dense LDLᵀ.
     tree_parents: Option<Vec<Option<usize>>>,
     violated: Vec<usize>,
+    /// Per joint: whether this solve has already moved it across its kink.
+    crossed: Vec<bool>,
     /// Whether `factor` holds A + diag factored, as this solve loaded it: while every joint is on a
     /// segment the system is A + diag whatever the segments, and only its right-hand side changes.
     factored_whole: bool,
     /// Solves that needed the fallback (coordinate descent) because pivoting did not finish.
     pub fallbacks: u64,
+    /// Linear systems solved by the pivoting, over every solve (the fast paths' first solve not
+    /// counted).
+    pub pivot_iterations: u64,
 }
 
 /// Why a solve failed: A is not positive definite (a state that is no longer finite).
@@ -125,7 +130,7 @@ pub struct NotPositiveDefinite;
 
 impl StickSlipSolver {
     pub fn new(n: usize, tree_parents: Option<Vec<Option<usize>>>) -> Self {
-        Self { n, factor: DMatrix::zeros(n, n), rhs: vec![0.0; n], piece: vec![0; n], points: vec![([0.0; 3], 0); n], tree_parents, violated: Vec::with_capacity(n), factored_whole: false, fallbacks: 0 }
+        Self { n, factor: DMatrix::zeros(n, n), rhs: vec![0.0; n], piece: vec![0; n], points: vec![([0.0; 3], 0); n], tree_parents, violated: Vec::with_capacity(n), crossed: vec![false; n], factored_whole: false, fallbacks: 0, pivot_iterations: 0 }
     }
 
     /// Whether joint i ended the last solve of `laws` on a limit (lower: −1, upper: +1, else 0). A
@@ -164,12 +169,14 @@ impl StickSlipSolver {
         if self.solve_sliding(a, diagonal, b, laws, x, g)? {
             return Ok(());
         }
+        self.crossed.fill(false);
         let mut fewest = usize::MAX;
         let mut stalled = 0;
         // Murty's rule terminates; the bound only guards against rounding cycles, after which the
         // coordinate-descent fallback finds the pieces
         let max_iterations = 20 * n + 50;
         for _ in 0..max_iterations {
+            self.pivot_iterations += 1;
             self.solve_on_pieces(a, diagonal, b, laws, x)?;
             self.residual(a, diagonal, b, laws, x, g);
             self.find_violations(laws, x, g);
@@ -191,10 +198,10 @@ impl StickSlipSolver {
                 let (i, up) = decode(self.violated[idx]);
                 let piece = self.piece[i];
                 // a block move takes a sliding joint whose x left its segment straight to the piece
-                // x is on (a joint chattering at a kink reverses: across it, not onto it first);
+                // x is on, or onto its kink when it would come to rest there ([`Self::across`]);
                 // one piece at a time otherwise, and always in Murty's single moves
                 self.piece[i] = if block && piece % 2 == 0 {
-                    laws[i].piece_of(x[i])
+                    self.across(i, &laws[i], x[i])
                 } else if up {
                     piece + 1
                 } else {
@@ -253,6 +260,41 @@ impl StickSlipSolver {
             g[i] = law.segment_slope(&points, m, k);
         }
         Ok(true)
+    }
+
+    /// Where a block move takes joint i, sliding on a segment that `x` (its solution there) has left:
+    /// the piece x is on — but onto the kink instead of across it when the joint would come to rest
+    /// there. Across the kink its slope drops by the whole band (above − below), which moves x_i back
+    /// by the band times the factored system's (F⁻¹)_ii (how x_i answers its own right-hand side with
+    /// every other piece held); when that carries it past the kink again, or when this solve has
+    /// moved it across once already, neither side holds it and it sticks. (A joint reversing under a
+    /// large torque goes across in one move; one slowing to rest would otherwise swing from side to
+    /// side until Murty's single moves took it onto the kink.)
+    fn across(&mut self, i: usize, law: &JointLaw, x: f64) -> usize {
+        let target = law.piece_of(x);
+        let piece = self.piece[i];
+        let (points, m) = self.points[i];
+        let Some(k) = points[..m].iter().position(|&p| p == 0.0 && law.has_kink()) else { return target };
+        let kink = 2 * k + 1;
+        if target == kink || (piece < kink) == (target < kink) {
+            return target;
+        }
+        if self.crossed[i] {
+            return kink;
+        }
+        // (F⁻¹)_ii: the factored system solved for the unit vector e_i (`rhs` is free until the
+        // next solve loads it)
+        let mut unit = std::mem::take(&mut self.rhs);
+        unit.fill(0.0);
+        unit[i] = 1.0;
+        self.substitute(&mut unit);
+        let back = (law.above - law.below) * unit[i];
+        self.rhs = unit;
+        if x.abs() <= back {
+            return kink;
+        }
+        self.crossed[i] = true;
+        target
     }
 
     /// The linear system for the current pieces: x_i fixed on a breakpoint, g_i = the slope on a
@@ -541,6 +583,31 @@ mod tests {
             solver.solve(&[2.0], &[0.0], &[b], &[law], &mut x, &mut g).unwrap();
             assert!((x[0] - expected).abs() < 1e-15, "b = {b}: x = {}", x[0]);
         }
+    }
+
+    #[test]
+    fn a_sliding_joint_brought_to_rest_goes_onto_its_kink_in_one_move() {
+        // joint 0 slid forward in the last step; now the rest of the impulse on it is within its
+        // band, so it sticks (x₀ = 0), while joint 1, coupled to it, slides on. Sliding forward
+        // puts x₀ below 0 and sliding back above it: neither side holds it, and the block move
+        // goes onto the kink at once — two linear solves (the guess, then the kink), where a move
+        // across it would swing from side to side until Murty's single moves took it there. (The
+        // coupling makes (A⁻¹)₀₀ = 2.8 where 1/A₀₀ = 1: a move judged on A's diagonal alone would
+        // cross.)
+        let a = [1.0, 0.8, 0.8, 1.0];
+        let law = JointLaw { below: -0.3, above: 0.3, ..JointLaw::FREE };
+        let laws = [law, law];
+        let mut solver = StickSlipSolver::new(2, None);
+        let (mut x, mut g) = ([0.0; 2], [0.0; 2]);
+        solver.solve(&a, &[0.0; 2], &[2.0, 2.0], &laws, &mut x, &mut g).unwrap();
+        assert!(x[0] > 0.0 && x[1] > 0.0, "both slide forward first: {x:?}");
+        let before = solver.pivot_iterations;
+        let b = [1.3, 2.0];
+        solver.solve(&a, &[0.0; 2], &b, &laws, &mut x, &mut g).unwrap();
+        assert_eq!(x[0], 0.0, "joint 0 sticks: {x:?}");
+        // x₁ = (b₁ − 0.3)/A₁₁ and joint 0's residual within its band
+        assert!((x[1] - 1.7).abs() < 1e-15 && (b[0] - 0.8 * x[1]).abs() <= 0.3, "{x:?}");
+        assert_eq!(solver.pivot_iterations - before, 2, "the guess, then the kink");
     }
 
     #[test]
