@@ -10,10 +10,16 @@ use nalgebra::DMatrix;
 /// instead of once per row of each triangular solve — which is what a small system's time is.
 pub fn ldlt_in_place(a: &mut DMatrix<f64>) -> bool {
     let n = a.nrows();
-    let a = a.as_mut_slice();
+    ldlt_in_place_slice(a.as_mut_slice(), n)
+}
+
+/// [`ldlt_in_place`] on an n×n matrix stored by columns in a slice (a workspace sized for the
+/// largest system it will hold).
+pub fn ldlt_in_place_slice(a: &mut [f64], n: usize) -> bool {
     // an arm's size known at compile time: the loops unroll with no bounds checks (the 6-joint
     // arm's plant step 7 % faster than with the general loops alone)
     match n {
+        1 => factor::<1>(a),
         2 => factor::<2>(a),
         3 => factor::<3>(a),
         4 => factor::<4>(a),
@@ -26,9 +32,13 @@ pub fn ldlt_in_place(a: &mut DMatrix<f64>) -> bool {
 
 /// Solve L·D·Lᵀ x = b in place, with the factor of [`ldlt_in_place`].
 pub fn ldlt_solve_in_place(factor: &DMatrix<f64>, b: &mut [f64]) {
-    let n = factor.nrows();
-    let l = factor.as_slice();
+    ldlt_solve_slice(factor.as_slice(), b, factor.nrows());
+}
+
+/// [`ldlt_solve_in_place`] with the factor of [`ldlt_in_place_slice`].
+pub fn ldlt_solve_slice(l: &[f64], b: &mut [f64], n: usize) {
     match n {
+        1 => substitute::<1>(l, b),
         2 => substitute::<2>(l, b),
         3 => substitute::<3>(l, b),
         4 => substitute::<4>(l, b),

@@ -26,7 +26,7 @@ pub use data::Data;
 pub use gravity_stiffness::gravity_stiffness;
 pub use energy::{kinetic_energy, kinetic_energy_from_velocities, potential_energy_from_kinematics};
 pub use jacobian::frame_jacobian;
-pub use ldlt::{ldlt_in_place, ldlt_solve_in_place};
+pub use ldlt::{ldlt_in_place, ldlt_in_place_slice, ldlt_solve_in_place, ldlt_solve_slice};
 pub use ltdl::{ltdl_in_place, ltdl_solve_in_place};
 pub use kinematics::{body_poses, forward_kinematics, frame_pose, frame_pose_in};
 pub use solvable::check_solvable;

@@ -122,7 +122,7 @@ impl DiscretePlant {
             let v_before = v[i];
             v[i] = self.v_next[i];
             q[i] += h * v[i];
-            let side = match self.solver.limit_side(&self.laws, i) {
+            let side = match self.solver.limit_side(i) {
                 // held by a self-locking gear, not by the limit
                 1 if self.locked[i].0 => 0,
                 -1 if self.locked[i].1 => 0,

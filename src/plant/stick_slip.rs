@@ -19,10 +19,13 @@
 //! piece of φ_i — a segment (g_i known: its slope) or a breakpoint (x_i known: 0 or a limit) — the
 //! linear system for that choice is solved, and a joint whose x leaves its segment, or whose g
 //! leaves its breakpoint's subdifferential, moves one piece towards where it belongs. The
-//! previous step's pieces start the search, so a stuck joint costs one solve. What ends the search
-//! is exact: every condition holds to the rounding of the solve (no regularization, no creep).
+//! previous step's pieces start the search, so a stuck joint costs one solve. A + diag is factored
+//! once a solve whatever the pieces: the joints on breakpoints are held at their values through the
+//! Schur complement of its inverse (a substitution each), so a search of several steps costs
+//! substitutions, not factorizations. What ends the search is exact: every condition holds to the
+//! rounding of the solve (no regularization, no creep), a joint on a breakpoint exactly on it.
 
-use crate::dynamics::{ldlt_in_place, ldlt_solve_in_place, ltdl_in_place, ltdl_solve_in_place};
+use crate::dynamics::{ldlt_in_place, ldlt_in_place_slice, ldlt_solve_in_place, ldlt_solve_slice, ltdl_in_place, ltdl_solve_in_place};
 use nalgebra::DMatrix;
 
 /// One joint's φ_i.
@@ -81,13 +84,60 @@ impl JointLaw {
         let last = if self.upper.is_finite() { 2 * m - 1 } else { 2 * m };
         (first, last)
     }
+}
+
+/// One joint's φ_i as the solve under way sees it, worked out once from its law: the breakpoints,
+/// the slope on each segment, which breakpoint is the kink and which are limits.
+#[derive(Clone, Copy, Debug)]
+struct Shape {
+    points: [f64; 3],
+    /// How many breakpoints.
+    m: usize,
+    /// The slope on segment k (between breakpoints k − 1 and k), k = 0..=m.
+    slopes: [f64; 4],
+    /// The pieces it can be on (a finite bound closes the segment beyond it).
+    first: usize,
+    last: usize,
+    /// The kink's breakpoint, if φ_i has one (strictly between the limits).
+    kink: Option<usize>,
+    /// Whether the first breakpoint is the lower limit, the last the upper.
+    lower_limit: bool,
+    upper_limit: bool,
+}
+
+impl Shape {
+    const NONE: Shape = Shape { points: [0.0; 3], m: 0, slopes: [0.0; 4], first: 0, last: 0, kink: None, lower_limit: false, upper_limit: false };
+
+    fn of(law: &JointLaw) -> Self {
+        let (points, m) = law.breakpoints();
+        let (first, last) = law.piece_range(m);
+        let mut slopes = [0.0; 4];
+        for (k, slope) in slopes.iter_mut().enumerate().take(m + 1) {
+            *slope = law.segment_slope(&points, m, k);
+        }
+        let kink = if law.has_kink() { points[..m].iter().position(|&p| p == 0.0) } else { None };
+        let lower_limit = law.lower.is_finite();
+        let upper_limit = law.upper.is_finite() && m > 0 && points[m - 1] == law.upper;
+        Shape { points, m, slopes, first, last, kink, lower_limit, upper_limit }
+    }
+
+    /// The ends of segment k.
+    fn ends(&self, k: usize) -> (f64, f64) {
+        (if k >= 1 { self.points[k - 1] } else { f64::NEG_INFINITY }, if k < self.m { self.points[k] } else { f64::INFINITY })
+    }
+
+    /// ∂φ_i at breakpoint k: [the slope left of it, the slope right of it], a limit's far side
+    /// unbounded.
+    fn subdifferential(&self, k: usize) -> (f64, f64) {
+        let left = if k == 0 && self.lower_limit { f64::NEG_INFINITY } else { self.slopes[k] };
+        let right = if k + 1 == self.m && self.upper_limit { f64::INFINITY } else { self.slopes[k + 1] };
+        (left, right)
+    }
 
     /// The piece x lies on (a breakpoint when x equals it).
     fn piece_of(&self, x: f64) -> usize {
-        let (points, m) = self.breakpoints();
-        let (first, last) = self.piece_range(m);
         let mut piece = 0;
-        for (k, &p) in points[..m].iter().enumerate() {
+        for (k, &p) in self.points[..self.m].iter().enumerate() {
             if x == p {
                 piece = 2 * k + 1;
                 break;
@@ -96,7 +146,7 @@ impl JointLaw {
                 piece = 2 * k + 2;
             }
         }
-        piece.clamp(first, last)
+        piece.clamp(self.first, self.last)
     }
 }
 
@@ -105,47 +155,90 @@ pub struct StickSlipSolver {
     n: usize,
     factor: DMatrix<f64>,
     rhs: Vec<f64>,
-    /// Per joint, the piece of φ_i it is on (see [`JointLaw`]); kept between solves as the start.
+    /// Per joint, the piece of φ_i it is on (see [`JointLaw`]); kept between solves as the start
+    /// (`UNKNOWN` before the first: at rest, where x = 0 lies).
     piece: Vec<usize>,
-    /// Per joint, the breakpoints of the current solve's law and how many (worked out once per solve).
-    points: Vec<([f64; 3], usize)>,
+    /// Per joint, its φ_i in the solve under way.
+    shapes: Vec<Shape>,
     /// Each joint's parent joint when A has a branched tree's sparsity (LᵀDL), else dense LDLᵀ.
     tree_parents: Option<Vec<Option<usize>>>,
     violated: Vec<usize>,
     /// Per joint: whether this solve has already moved it across its kink.
     crossed: Vec<bool>,
-    /// Whether `factor` holds A + diag factored, as this solve loaded it: while every joint is on a
-    /// segment the system is A + diag whatever the segments, and only its right-hand side changes.
+    /// Whether `factor` holds F = A + diag factored, as this solve loaded it.
     factored_whole: bool,
+    /// The joints on breakpoints in the linear system under way, and F⁻¹'s columns for them
+    /// (column j at j·n; `have_column` says which this solve has worked out: F does not change
+    /// within a solve).
+    fixed: Vec<usize>,
+    inverse_columns: Vec<f64>,
+    have_column: Vec<bool>,
+    /// The most fixed joints solved through the Schur complement ([`schur_limit`]).
+    schur_max: usize,
+    /// The Schur complement F⁻¹ restricted to the fixed joints, and its right-hand side.
+    schur: Vec<f64>,
+    schur_rhs: Vec<f64>,
     /// Solves that needed the fallback (coordinate descent) because pivoting did not finish.
     pub fallbacks: u64,
     /// Linear systems solved by the pivoting, over every solve (the fast paths' first solve not
     /// counted).
     pub pivot_iterations: u64,
+    /// Factorizations, over every solve.
+    pub factorizations: u64,
 }
+
+/// A joint's piece before its first solve.
+const UNKNOWN: usize = usize::MAX;
 
 /// Why a solve failed: A is not positive definite (a state that is no longer finite).
 #[derive(Debug, PartialEq)]
 pub struct NotPositiveDefinite;
 
+/// The most joints on breakpoints whose values are imposed through the one factorization of F
+/// (Schur complements on F⁻¹'s columns) rather than by factoring the reduced system: each costs a
+/// substitution where the reduced system costs a factorization — for the 6-joint arm a
+/// factorization is five substitutions. (n/6 for the larger trees, whose factorization grows
+/// faster than a substitution.)
+fn schur_limit(n: usize) -> usize {
+    (n / 6).max(4)
+}
+
 impl StickSlipSolver {
     pub fn new(n: usize, tree_parents: Option<Vec<Option<usize>>>) -> Self {
-        Self { n, factor: DMatrix::zeros(n, n), rhs: vec![0.0; n], piece: vec![0; n], points: vec![([0.0; 3], 0); n], tree_parents, violated: Vec::with_capacity(n), crossed: vec![false; n], factored_whole: false, fallbacks: 0, pivot_iterations: 0 }
+        let limit = schur_limit(n);
+        Self {
+            n,
+            factor: DMatrix::zeros(n, n),
+            rhs: vec![0.0; n],
+            piece: vec![UNKNOWN; n],
+            shapes: vec![Shape::NONE; n],
+            tree_parents,
+            violated: Vec::with_capacity(n),
+            crossed: vec![false; n],
+            factored_whole: false,
+            fixed: Vec::with_capacity(n),
+            inverse_columns: vec![0.0; n * n],
+            have_column: vec![false; n],
+            schur_max: limit,
+            schur: vec![0.0; limit * limit],
+            schur_rhs: vec![0.0; limit],
+            fallbacks: 0,
+            pivot_iterations: 0,
+            factorizations: 0,
+        }
     }
 
-    /// Whether joint i ended the last solve of `laws` on a limit (lower: −1, upper: +1, else 0). A
-    /// limit is the first or last breakpoint (a kink at 0 lies strictly between the limits).
-    pub fn limit_side(&self, laws: &[JointLaw], i: usize) -> i8 {
-        let law = &laws[i];
-        let (points, m) = self.points[i];
-        let piece = self.piece[i];
+    /// Whether joint i ended the last solve on a limit (lower: −1, upper: +1, else 0). A limit is
+    /// the first or last breakpoint (a kink at 0 lies strictly between the limits).
+    pub fn limit_side(&self, i: usize) -> i8 {
+        let (shape, piece) = (&self.shapes[i], self.piece[i]);
         if piece % 2 == 0 {
             return 0;
         }
         let k = piece / 2;
-        if law.lower.is_finite() && k == 0 {
+        if shape.lower_limit && k == 0 {
             -1
-        } else if law.upper.is_finite() && k == m - 1 && points[k] == law.upper {
+        } else if shape.upper_limit && k + 1 == shape.m {
             1
         } else {
             0
@@ -158,17 +251,19 @@ impl StickSlipSolver {
     pub fn solve(&mut self, a: &[f64], diagonal: &[f64], b: &[f64], laws: &[JointLaw], x: &mut [f64], g: &mut [f64]) -> Result<(), NotPositiveDefinite> {
         let n = self.n;
         self.factored_whole = false;
+        self.have_column.fill(false);
         if self.solve_free(a, diagonal, b, laws, x, g)? {
             return Ok(());
         }
-        for ((p, points), law) in self.piece.iter_mut().zip(&mut self.points).zip(laws) {
-            *points = law.breakpoints();
-            let (first, last) = law.piece_range(points.1);
-            *p = (*p).clamp(first, last);
+        for ((p, shape), law) in self.piece.iter_mut().zip(&mut self.shapes).zip(laws) {
+            *shape = Shape::of(law);
+            *p = if *p == UNKNOWN { shape.piece_of(0.0) } else { (*p).clamp(shape.first, shape.last) };
         }
-        if self.solve_sliding(a, diagonal, b, laws, x, g)? {
+        // the last solve's pieces, tried as they are: x holds their solution after this
+        if self.solve_sliding(a, diagonal, b, x, g)? {
             return Ok(());
         }
+        let mut solved = true;
         self.crossed.fill(false);
         let mut fewest = usize::MAX;
         let mut stalled = 0;
@@ -177,12 +272,15 @@ impl StickSlipSolver {
         let max_iterations = 20 * n + 50;
         for _ in 0..max_iterations {
             self.pivot_iterations += 1;
-            self.solve_on_pieces(a, diagonal, b, laws, x)?;
-            self.residual(a, diagonal, b, laws, x, g);
-            self.find_violations(laws, x, g);
+            if !solved {
+                self.solve_on_pieces(a, diagonal, b, x)?;
+            }
+            solved = false;
+            self.residual(a, diagonal, b, x, g);
+            self.find_violations(x, g);
             let count = self.violated.len();
             if count == 0 {
-                self.snap_to_pieces(laws, x);
+                self.snap_to_pieces(x);
                 return Ok(());
             }
             let block = if count < fewest {
@@ -201,7 +299,7 @@ impl StickSlipSolver {
                 // x is on, or onto its kink when it would come to rest there ([`Self::across`]);
                 // one piece at a time otherwise, and always in Murty's single moves
                 self.piece[i] = if block && piece % 2 == 0 {
-                    self.across(i, &laws[i], x[i])
+                    self.across(i, &laws[i], x[i])?
                 } else if up {
                     piece + 1
                 } else {
@@ -222,9 +320,7 @@ impl StickSlipSolver {
         if laws.iter().any(|l| l.below != 0.0 || l.above != 0.0) {
             return Ok(false);
         }
-        self.load_matrix(a, diagonal);
-        self.factor()?;
-        self.factored_whole = true;
+        self.factor_whole(a, diagonal)?;
         x.copy_from_slice(b);
         self.substitute(x);
         // strictly within: on a bound the pivoting decides whether the joint rests on it
@@ -239,25 +335,23 @@ impl StickSlipSolver {
         Ok(true)
     }
 
-    /// Every joint on a segment and staying strictly inside it (sliding on as it slid, or within
-    /// its range): the first solve from those pieces is the solution, found by the same arithmetic
-    /// as the pivoting's first solve, so bit for bit the same — without its bookkeeping (the
-    /// residual's rows, the search for violations), most of a step with gearbox friction whose
-    /// joints slide. Returns false when some joint sits on a breakpoint or leaves its segment
-    /// (x is then that first solve, the factorization kept for the pivoting).
-    fn solve_sliding(&mut self, a: &[f64], diagonal: &[f64], b: &[f64], laws: &[JointLaw], x: &mut [f64], g: &mut [f64]) -> Result<bool, NotPositiveDefinite> {
-        if self.piece.iter().any(|p| p % 2 == 1) {
+    /// The last solve's pieces, solved for: when every joint is on a segment and stays strictly
+    /// inside it (sliding on as it slid, or within its range) that is the solution, without the
+    /// pivoting's bookkeeping (the residual's rows, the search for violations) — most of a step with
+    /// gearbox friction whose joints slide. Returns false when some joint sits on a breakpoint or
+    /// leaves its segment; x is then the solution on those pieces, the pivoting's first.
+    fn solve_sliding(&mut self, a: &[f64], diagonal: &[f64], b: &[f64], x: &mut [f64], g: &mut [f64]) -> Result<bool, NotPositiveDefinite> {
+        self.solve_on_pieces(a, diagonal, b, x)?;
+        if !self.fixed.is_empty() {
             return Ok(false);
         }
-        self.solve_on_pieces(a, diagonal, b, laws, x)?;
-        for (i, law) in laws.iter().enumerate() {
-            let ((points, m), k) = (self.points[i], self.piece[i] / 2);
-            let below = if k >= 1 { points[k - 1] } else { f64::NEG_INFINITY };
-            let above = if k < m { points[k] } else { f64::INFINITY };
+        for (i, shape) in self.shapes.iter().enumerate() {
+            let k = self.piece[i] / 2;
+            let (below, above) = shape.ends(k);
             if !(below < x[i] && x[i] < above) {
                 return Ok(false);
             }
-            g[i] = law.segment_slope(&points, m, k);
+            g[i] = shape.slopes[k];
         }
         Ok(true)
     }
@@ -265,85 +359,167 @@ impl StickSlipSolver {
     /// Where a block move takes joint i, sliding on a segment that `x` (its solution there) has left:
     /// the piece x is on — but onto the kink instead of across it when the joint would come to rest
     /// there. Across the kink its slope drops by the whole band (above − below), which moves x_i back
-    /// by the band times the factored system's (F⁻¹)_ii (how x_i answers its own right-hand side with
-    /// every other piece held); when that carries it past the kink again, or when this solve has
-    /// moved it across once already, neither side holds it and it sticks. (A joint reversing under a
-    /// large torque goes across in one move; one slowing to rest would otherwise swing from side to
-    /// side until Murty's single moves took it onto the kink.)
-    fn across(&mut self, i: usize, law: &JointLaw, x: f64) -> usize {
-        let target = law.piece_of(x);
-        let piece = self.piece[i];
-        let (points, m) = self.points[i];
-        let Some(k) = points[..m].iter().position(|&p| p == 0.0 && law.has_kink()) else { return target };
-        let kink = 2 * k + 1;
+    /// by the band times (F⁻¹)_ii, how x_i answers its own right-hand side (with the joints on
+    /// breakpoints held, the Schur complement's correction); when that carries it past the kink
+    /// again, or when this solve has moved it across once already, neither side holds it and it
+    /// sticks. (A joint reversing under a large torque goes across in one move; one slowing to rest
+    /// would otherwise swing from side to side until Murty's single moves took it onto the kink.)
+    fn across(&mut self, i: usize, law: &JointLaw, x: f64) -> Result<usize, NotPositiveDefinite> {
+        let shape = self.shapes[i];
+        let target = shape.piece_of(x);
+        let Some(k) = shape.kink else { return Ok(target) };
+        let (piece, kink) = (self.piece[i], 2 * k + 1);
         if target == kink || (piece < kink) == (target < kink) {
-            return target;
+            return Ok(target);
         }
         if self.crossed[i] {
-            return kink;
+            return Ok(kink);
         }
-        // (F⁻¹)_ii: the factored system solved for the unit vector e_i (`rhs` is free until the
-        // next solve loads it)
-        let mut unit = std::mem::take(&mut self.rhs);
-        unit.fill(0.0);
-        unit[i] = 1.0;
-        self.substitute(&mut unit);
-        let back = (law.above - law.below) * unit[i];
-        self.rhs = unit;
+        let back = (law.above - law.below) * self.response(i)?;
         if x.abs() <= back {
-            return kink;
+            return Ok(kink);
         }
         self.crossed[i] = true;
-        target
+        Ok(target)
+    }
+
+    /// How x_i answers a unit change of its own right-hand side in the linear system under way
+    /// (joint i on a segment): (F⁻¹)_ii less what holding the fixed joints takes back.
+    fn response(&mut self, i: usize) -> Result<f64, NotPositiveDefinite> {
+        if self.factored_whole && self.fixed.len() <= self.schur_max {
+            self.column(i)?;
+            let n = self.n;
+            let mut response = self.inverse_columns[i * n + i];
+            if !self.fixed.is_empty() {
+                // e_iᵀ F⁻¹ E (Eᵀ F⁻¹ E)⁻¹ Eᵀ F⁻¹ e_i, S already factored by the last solve
+                let count = self.fixed.len();
+                for (k, &j) in self.fixed.iter().enumerate() {
+                    self.schur_rhs[k] = self.inverse_columns[j * n + i];
+                }
+                let mut coupling = std::mem::take(&mut self.schur_rhs);
+                ldlt_solve_slice(&self.schur[..count * count], &mut coupling[..count], count);
+                for (k, &j) in self.fixed.iter().enumerate() {
+                    response -= self.inverse_columns[j * n + i] * coupling[k];
+                }
+                self.schur_rhs = coupling;
+            }
+            Ok(response)
+        } else {
+            // the reduced system is what is factored: solve it for e_i
+            let mut unit = std::mem::take(&mut self.rhs);
+            unit.fill(0.0);
+            unit[i] = 1.0;
+            self.substitute(&mut unit);
+            let response = unit[i];
+            self.rhs = unit;
+            Ok(response)
+        }
     }
 
     /// The linear system for the current pieces: x_i fixed on a breakpoint, g_i = the slope on a
-    /// segment.
-    fn solve_on_pieces(&mut self, a: &[f64], diagonal: &[f64], b: &[f64], laws: &[JointLaw], x: &mut [f64]) -> Result<(), NotPositiveDefinite> {
+    /// segment. Solved with F = A + diag factored once a solve, whatever the pieces: with a few
+    /// joints fixed (E their unit columns, c their values), x = y + W·μ with y = F⁻¹r, W = F⁻¹E
+    /// (a substitution per fixed joint, once a solve) and S·μ = c − Eᵀy, S = EᵀF⁻¹E the Schur
+    /// complement; with many, the reduced system (the fixed rows and columns taken out) is
+    /// factored instead.
+    fn solve_on_pieces(&mut self, a: &[f64], diagonal: &[f64], b: &[f64], x: &mut [f64]) -> Result<(), NotPositiveDefinite> {
         let n = self.n;
-        let on_segments = self.piece.iter().all(|p| p % 2 == 0);
-        if !(on_segments && self.factored_whole) {
-            self.load_matrix(a, diagonal);
-        }
-        self.rhs.copy_from_slice(b);
-        for (j, law) in laws.iter().enumerate() {
-            let piece = self.piece[j];
-            let (points, m) = self.points[j];
+        self.fixed.clear();
+        for (j, (&piece, shape)) in self.piece.iter().zip(&self.shapes).enumerate() {
             if piece % 2 == 0 {
-                let slope = law.segment_slope(&points, m, piece / 2);
-                if slope != 0.0 {
-                    self.rhs[j] -= slope;
-                }
+                let slope = shape.slopes[piece / 2];
+                x[j] = if slope != 0.0 { b[j] - slope } else { b[j] };
+            } else {
+                x[j] = b[j];
+                self.fixed.push(j);
             }
         }
-        for j in 0..n {
-            let piece = self.piece[j];
-            if piece % 2 == 0 {
-                continue;
+        let count = self.fixed.len();
+        if count > self.schur_max || count == n {
+            return self.solve_reduced(a, diagonal, b, x);
+        }
+        if !self.factored_whole {
+            self.factor_whole(a, diagonal)?;
+        }
+        self.substitute(x);
+        if count == 0 {
+            return Ok(());
+        }
+        for k in 0..count {
+            self.column(self.fixed[k])?;
+        }
+        // S = Eᵀ F⁻¹ E (symmetric positive definite: a principal block of F⁻¹), S·μ = c − y
+        for (l, &jl) in self.fixed.iter().enumerate() {
+            for (k, &jk) in self.fixed.iter().enumerate() {
+                self.schur[l * count + k] = self.inverse_columns[jl * n + jk];
             }
-            let fixed = self.points[j].0[piece / 2];
-            for i in 0..n {
-                self.rhs[i] -= self.factor[(i, j)] * fixed;
+            let shape = &self.shapes[jl];
+            self.schur_rhs[l] = shape.points[self.piece[jl] / 2] - x[jl];
+        }
+        if !ldlt_in_place_slice(&mut self.schur[..count * count], count) {
+            return Err(NotPositiveDefinite);
+        }
+        ldlt_solve_slice(&self.schur[..count * count], &mut self.schur_rhs[..count], count);
+        for (l, &jl) in self.fixed.iter().enumerate() {
+            let (mu, column) = (self.schur_rhs[l], &self.inverse_columns[jl * n..(jl + 1) * n]);
+            for (xi, wi) in x.iter_mut().zip(column) {
+                *xi += wi * mu;
+            }
+        }
+        // on its breakpoint exactly, not to the rounding of the correction
+        for &j in &self.fixed {
+            x[j] = self.shapes[j].points[self.piece[j] / 2];
+        }
+        Ok(())
+    }
+
+    /// The linear system with the fixed joints' rows and columns taken out of A + diag (their
+    /// values moved to the right-hand side), factored as it is.
+    fn solve_reduced(&mut self, a: &[f64], diagonal: &[f64], b: &[f64], x: &mut [f64]) -> Result<(), NotPositiveDefinite> {
+        self.load_matrix(a, diagonal);
+        self.factored_whole = false;
+        for (j, (&piece, shape)) in self.piece.iter().zip(&self.shapes).enumerate() {
+            x[j] = if piece % 2 == 0 { b[j] - shape.slopes[piece / 2] } else { b[j] };
+        }
+        for &j in &self.fixed {
+            let fixed = self.shapes[j].points[self.piece[j] / 2];
+            for (i, xi) in x.iter_mut().enumerate() {
+                *xi -= self.factor[(i, j)] * fixed;
                 self.factor[(i, j)] = 0.0;
                 self.factor[(j, i)] = 0.0;
             }
             self.factor[(j, j)] = 1.0;
-            self.rhs[j] = fixed;
+            x[j] = fixed;
         }
-        x.copy_from_slice(&self.rhs);
-        if on_segments {
-            // the same matrix for any segments (a joint sliding either way, or the other): factored
-            // once a solve, only the right-hand side substituted again (a chattering joint
-            // reverses every step: two solves of a step, one factorization)
-            if !self.factored_whole {
-                self.factor()?;
-                self.factored_whole = true;
-            }
-        } else {
-            self.factor()?;
-            self.factored_whole = false;
-        }
+        self.factor()?;
         self.substitute(x);
+        Ok(())
+    }
+
+    /// F⁻¹'s column j, worked out once a solve.
+    fn column(&mut self, j: usize) -> Result<(), NotPositiveDefinite> {
+        if self.have_column[j] {
+            return Ok(());
+        }
+        if !self.factored_whole {
+            return Err(NotPositiveDefinite);
+        }
+        let n = self.n;
+        let mut column = std::mem::take(&mut self.inverse_columns);
+        let unit = &mut column[j * n..(j + 1) * n];
+        unit.fill(0.0);
+        unit[j] = 1.0;
+        self.substitute(unit);
+        self.inverse_columns = column;
+        self.have_column[j] = true;
+        Ok(())
+    }
+
+    /// F = A + diag, loaded and factored.
+    fn factor_whole(&mut self, a: &[f64], diagonal: &[f64]) -> Result<(), NotPositiveDefinite> {
+        self.load_matrix(a, diagonal);
+        self.factor()?;
+        self.factored_whole = true;
         Ok(())
     }
 
@@ -357,6 +533,7 @@ impl StickSlipSolver {
 
     /// Factor the workspace's matrix (along the tree, or dense LDLᵀ).
     fn factor(&mut self) -> Result<(), NotPositiveDefinite> {
+        self.factorizations += 1;
         let factored = match &self.tree_parents {
             Some(parents) => ltdl_in_place(&mut self.factor, parents),
             None => ldlt_in_place(&mut self.factor),
@@ -374,27 +551,25 @@ impl StickSlipSolver {
 
     /// Each joint whose x leaves its segment or whose g leaves its breakpoint's subdifferential,
     /// encoded with the direction it must move (see `decode`), in increasing joint order.
-    fn find_violations(&mut self, laws: &[JointLaw], x: &[f64], g: &[f64]) {
+    fn find_violations(&mut self, x: &[f64], g: &[f64]) {
         self.violated.clear();
         let scale = x.iter().fold(1.0_f64, |s, v| s.max(v.abs()));
-        for (i, law) in laws.iter().enumerate() {
-            let (points, m) = self.points[i];
+        for (i, shape) in self.shapes.iter().enumerate() {
             let piece = self.piece[i];
             let k = piece / 2;
             if piece % 2 == 0 {
                 // on segment k, between breakpoints k−1 and k: a kink is left within rounding of
                 // the solve (both pieces give the same x there), a limit exactly as it is reached
-                let tolerance = |p: f64| if p == 0.0 && law.has_kink() { 1e-13 * scale } else { 0.0 };
-                if k < m && x[i] > points[k] + tolerance(points[k]) {
+                let (below, above) = shape.ends(k);
+                let tolerance = |end: usize| if shape.kink == Some(end) { 1e-13 * scale } else { 0.0 };
+                if k < shape.m && x[i] > above + tolerance(k) {
                     self.violated.push(encode(i, true));
-                } else if k >= 1 && x[i] < points[k - 1] - tolerance(points[k - 1]) {
+                } else if k >= 1 && x[i] < below - tolerance(k - 1) {
                     self.violated.push(encode(i, false));
                 }
             } else {
-                // on breakpoint k: g within [slope left of it, slope right of it]; a limit's side
-                // is unbounded
-                let left = if k == 0 && law.lower.is_finite() { f64::NEG_INFINITY } else { law.segment_slope(&points, m, k) };
-                let right = if k == m - 1 && law.upper.is_finite() && points[k] == law.upper { f64::INFINITY } else { law.segment_slope(&points, m, k + 1) };
+                // on breakpoint k: g within [slope left of it, slope right of it]
+                let (left, right) = shape.subdifferential(k);
                 if g[i] > right {
                     self.violated.push(encode(i, true));
                 } else if g[i] < left {
@@ -407,12 +582,12 @@ impl StickSlipSolver {
     /// g = b − (A + diag)·x: on a segment the slope the solve imposed there, on a breakpoint the
     /// row worked out (A by columns, symmetric: row i read as column i) — only the rows the checks
     /// need, as a frictionless step away from its limits needs none.
-    fn residual(&self, a: &[f64], diagonal: &[f64], b: &[f64], laws: &[JointLaw], x: &[f64], g: &mut [f64]) {
+    fn residual(&self, a: &[f64], diagonal: &[f64], b: &[f64], x: &[f64], g: &mut [f64]) {
         let n = x.len();
         for i in 0..n {
-            let (piece, (points, m)) = (self.piece[i], self.points[i]);
+            let piece = self.piece[i];
             if piece % 2 == 0 {
-                g[i] = laws[i].segment_slope(&points, m, piece / 2);
+                g[i] = self.shapes[i].slopes[piece / 2];
                 continue;
             }
             let mut ax = diagonal[i] * x[i];
@@ -424,12 +599,12 @@ impl StickSlipSolver {
     }
 
     /// A joint on a segment that ends at a kink may sit a rounding error past it: put it on the kink.
-    fn snap_to_pieces(&self, laws: &[JointLaw], x: &mut [f64]) {
-        for (i, law) in laws.iter().enumerate() {
-            let (piece, (points, m)) = (self.piece[i], self.points[i]);
-            if piece % 2 == 0 && law.has_kink() {
+    fn snap_to_pieces(&self, x: &mut [f64]) {
+        for (i, shape) in self.shapes.iter().enumerate() {
+            let piece = self.piece[i];
+            if let (0, Some(kink)) = (piece % 2, shape.kink) {
                 let k = piece / 2;
-                if (k < m && points[k] == 0.0 && x[i] > 0.0) || (k >= 1 && points[k - 1] == 0.0 && x[i] < 0.0) {
+                if (k == kink && x[i] > 0.0) || (k == kink + 1 && x[i] < 0.0) {
                     x[i] = 0.0;
                 }
             }
@@ -467,7 +642,7 @@ impl StickSlipSolver {
                     (r - law.above) / aii
                 };
                 let xi = xi.clamp(law.lower, law.upper);
-                let piece = law.piece_of(xi);
+                let piece = self.shapes[i].piece_of(xi);
                 if piece != self.piece[i] {
                     self.piece[i] = piece;
                     changed = true;
@@ -481,9 +656,9 @@ impl StickSlipSolver {
         }
         // polish: the exact solution on the pieces found (within rounding of the descent, they are
         // the solution's)
-        self.solve_on_pieces(a, diagonal, b, laws, x)?;
-        self.residual(a, diagonal, b, laws, x, g);
-        self.snap_to_pieces(laws, x);
+        self.solve_on_pieces(a, diagonal, b, x)?;
+        self.residual(a, diagonal, b, x, g);
+        self.snap_to_pieces(x);
         Ok(())
     }
 }
@@ -558,11 +733,11 @@ mod tests {
                 shortcut += 1;
                 let mut reference = StickSlipSolver::new(n, None);
                 reference.piece.iter_mut().zip(&laws).for_each(|(p, l)| *p = if l.lower.is_finite() { 2 } else { 0 });
-                reference.points.iter_mut().zip(&laws).for_each(|(p, l)| *p = l.breakpoints());
+                reference.shapes.iter_mut().zip(&laws).for_each(|(s, l)| *s = Shape::of(l));
                 let mut y = vec![0.0; n];
-                reference.solve_on_pieces(&a, &diagonal, &b, &laws, &mut y).unwrap();
+                reference.solve_on_pieces(&a, &diagonal, &b, &mut y).unwrap();
                 assert!(x.iter().zip(&y).all(|(p, q)| p.to_bits() == q.to_bits()), "case {case}: {x:?} vs {y:?}");
-                assert!((0..n).all(|i| solver.limit_side(&laws, i) == 0) && g.iter().all(|&gi| gi == 0.0));
+                assert!((0..n).all(|i| solver.limit_side(i) == 0) && g.iter().all(|&gi| gi == 0.0));
             } else {
                 pivoted += 1;
                 for i in 0..n {
@@ -608,6 +783,78 @@ mod tests {
         // x₁ = (b₁ − 0.3)/A₁₁ and joint 0's residual within its band
         assert!((x[1] - 1.7).abs() < 1e-15 && (b[0] - 0.8 * x[1]).abs() <= 0.3, "{x:?}");
         assert_eq!(solver.pivot_iterations - before, 2, "the guess, then the kink");
+    }
+
+    /// Random problems (friction and limits on every joint, 1–12 joints, warm starts), solved with
+    /// the joints on breakpoints held through the Schur complement on the one factorization, and
+    /// with the reduced system factored every time: the same pieces, x and g to rounding.
+    #[test]
+    fn the_schur_complement_and_the_reduced_system_agree() {
+        let mut seed = 0x51_7C_C1_B7_27_22_0A_95_u64;
+        let mut held = 0;
+        for trial in 0..400 {
+            let n = 1 + trial % 12;
+            let a = random_spd(n, &mut seed);
+            let mut schur = StickSlipSolver::new(n, None);
+            let mut reduced = StickSlipSolver::new(n, None);
+            reduced.schur_max = 0;
+            for _round in 0..3 {
+                let mut r = || {
+                    seed ^= seed << 13;
+                    seed ^= seed >> 7;
+                    seed ^= seed << 17;
+                    (seed % 20001) as f64 / 10000.0 - 1.0
+                };
+                let b: Vec<f64> = (0..n).map(|_| 2.0 * r()).collect();
+                let laws: Vec<JointLaw> = (0..n).map(|_| JointLaw { lower: -0.3 - 0.5 * (r() + 1.0), upper: 0.3 + 0.5 * (r() + 1.0), below: -0.6 * (r() + 1.0), above: 0.6 * (r() + 1.0) }).collect();
+                let diagonal = vec![0.01; n];
+                let (mut x1, mut g1, mut x2, mut g2) = (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+                schur.solve(&a, &diagonal, &b, &laws, &mut x1, &mut g1).unwrap();
+                reduced.solve(&a, &diagonal, &b, &laws, &mut x2, &mut g2).unwrap();
+                assert_eq!(schur.piece, reduced.piece, "trial {trial}: the same pieces");
+                let scale = x2.iter().chain(&b).fold(1.0_f64, |s, v| s.max(v.abs()));
+                for i in 0..n {
+                    assert!((x1[i] - x2[i]).abs() <= 1e-12 * scale && (g1[i] - g2[i]).abs() <= 1e-12 * scale, "trial {trial} joint {i}: x {} vs {}, g {} vs {}", x1[i], x2[i], g1[i], g2[i]);
+                }
+                held += (1..=schur.schur_max.min(n - 1)).contains(&schur.piece.iter().filter(|p| *p % 2 == 1).count()) as usize;
+            }
+        }
+        assert!(held > 300, "the Schur complement exercised: {held}");
+    }
+
+    /// The linear system on any pieces with at most `schur_max` joints fixed is solved on the one
+    /// factorization of A + diag, each fixed joint's value exact.
+    #[test]
+    fn pieces_with_a_few_fixed_joints_cost_no_factorization() {
+        let mut seed = 0x2B_99_2D_DF_A2_32_49_D6_u64;
+        let n = 7;
+        let a = random_spd(n, &mut seed);
+        let diagonal = vec![0.02; n];
+        let b: Vec<f64> = random_spd(n, &mut seed)[..n].to_vec();
+        let law = JointLaw { lower: -0.7, upper: 0.9, below: -0.2, above: 0.3 };
+        let mut solver = StickSlipSolver::new(n, None);
+        solver.shapes.fill(Shape::of(&law));
+        solver.factor_whole(&a, &diagonal).unwrap();
+        let factorizations = solver.factorizations;
+        // pieces: 1 lower limit, 2 below the kink, 3 the kink, 4 above it, 5 upper limit
+        for (pattern, pieces) in [[2, 4, 2, 4, 2, 4, 2], [3, 4, 2, 4, 2, 4, 2], [1, 4, 3, 4, 2, 5, 2], [3, 3, 3, 3, 2, 4, 2]].iter().enumerate() {
+            solver.piece.copy_from_slice(pieces);
+            let mut x = vec![0.0; n];
+            solver.solve_on_pieces(&a, &diagonal, &b, &mut x).unwrap();
+            let mut reduced = StickSlipSolver::new(n, None);
+            reduced.shapes.fill(Shape::of(&law));
+            reduced.piece.copy_from_slice(pieces);
+            reduced.schur_max = 0;
+            let mut y = vec![0.0; n];
+            reduced.solve_on_pieces(&a, &diagonal, &b, &mut y).unwrap();
+            for i in 0..n {
+                assert!((x[i] - y[i]).abs() < 1e-12, "pattern {pattern} joint {i}: {} vs {}", x[i], y[i]);
+                if pieces[i] % 2 == 1 {
+                    assert_eq!(x[i], [-0.7, 0.0, 0.9][pieces[i] / 2], "pattern {pattern} joint {i} on its breakpoint exactly");
+                }
+            }
+        }
+        assert_eq!(solver.factorizations, factorizations, "no factorization after the first");
     }
 
     #[test]
