@@ -160,6 +160,15 @@ pub struct StickSlipSolver {
     piece: Vec<usize>,
     /// Per joint, its φ_i in the solve under way.
     shapes: Vec<Shape>,
+    /// Per joint, the sign of x in the last solve that searched the pieces (0: at rest, or none
+    /// yet); unchanged by a guess that held.
+    side: Vec<i8>,
+    /// The sides [`Self::solve_held`] tries.
+    trial: Vec<i8>,
+    /// Whether the last solve was [`Self::solve_held`]'s, which leaves `piece` as it was; then
+    /// `held_limit` says which resting joints rest on a limit.
+    pieces_stale: bool,
+    held_limit: Vec<i8>,
     /// Each joint's parent joint when A has a branched tree's sparsity (LᵀDL), else dense LDLᵀ.
     tree_parents: Option<Vec<Option<usize>>>,
     violated: Vec<usize>,
@@ -212,6 +221,10 @@ impl StickSlipSolver {
             rhs: vec![0.0; n],
             piece: vec![UNKNOWN; n],
             shapes: vec![Shape::NONE; n],
+            side: vec![0; n],
+            trial: vec![0; n],
+            pieces_stale: false,
+            held_limit: vec![0; n],
             tree_parents,
             violated: Vec::with_capacity(n),
             crossed: vec![false; n],
@@ -231,6 +244,9 @@ impl StickSlipSolver {
     /// Whether joint i ended the last solve on a limit (lower: −1, upper: +1, else 0). A limit is
     /// the first or last breakpoint (a kink at 0 lies strictly between the limits).
     pub fn limit_side(&self, i: usize) -> i8 {
+        if self.pieces_stale {
+            return self.held_limit[i];
+        }
         let (shape, piece) = (&self.shapes[i], self.piece[i]);
         if piece % 2 == 0 {
             return 0;
@@ -253,12 +269,25 @@ impl StickSlipSolver {
         self.factored_whole = false;
         self.have_column.fill(false);
         if self.solve_free(a, diagonal, b, laws, x, g)? {
+            self.pieces_stale = false;
             return Ok(());
         }
-        for ((p, shape), law) in self.piece.iter_mut().zip(&mut self.shapes).zip(laws) {
-            *shape = Shape::of(law);
-            *p = if *p == UNKNOWN { shape.piece_of(0.0) } else { (*p).clamp(shape.first, shape.last) };
+        if self.solve_held(a, diagonal, b, laws, x, g)? {
+            self.pieces_stale = true;
+            return Ok(());
         }
+        for (((p, shape), law), &side) in self.piece.iter_mut().zip(&mut self.shapes).zip(laws).zip(&self.side) {
+            *shape = Shape::of(law);
+            *p = if *p == UNKNOWN {
+                shape.piece_of(0.0)
+            } else if self.pieces_stale {
+                // the segment on the side it moved to
+                shape.piece_of(side as f64 * f64::MIN_POSITIVE)
+            } else {
+                (*p).clamp(shape.first, shape.last)
+            };
+        }
+        self.pieces_stale = false;
         // the last solve's pieces, tried as they are: x holds their solution after this
         if self.solve_sliding(a, diagonal, b, x, g)? {
             return Ok(());
@@ -281,6 +310,7 @@ impl StickSlipSolver {
             let count = self.violated.len();
             if count == 0 {
                 self.snap_to_pieces(x);
+                self.record_sides(x);
                 return Ok(());
             }
             let block = if count < fewest {
@@ -308,7 +338,16 @@ impl StickSlipSolver {
             }
         }
         self.fallbacks += 1;
-        self.coordinate_descent(a, diagonal, b, laws, x, g)
+        self.coordinate_descent(a, diagonal, b, laws, x, g)?;
+        self.record_sides(x);
+        Ok(())
+    }
+
+    /// Which way each joint moves: the next solve's first guess ([`Self::solve_held`]).
+    fn record_sides(&mut self, x: &[f64]) {
+        for (side, &xi) in self.side.iter_mut().zip(x) {
+            *side = if xi > 0.0 { 1 } else if xi < 0.0 { -1 } else { 0 };
+        }
     }
 
     /// Without friction (every law's slopes 0), the unconstrained solution when it lies within every
@@ -333,6 +372,86 @@ impl StickSlipSolver {
         }
         g.fill(0.0);
         Ok(true)
+    }
+
+    /// The last solve's outcome guessed to hold: each joint that moved slides on the way it moved
+    /// (slope `above` one way, `below` the other), each that was at rest stays at rest (x_i = 0,
+    /// held through the Schur complement). That is the solution when every moving x_i keeps its
+    /// sign strictly within its bounds and every resting joint's g_i lies in ∂φ_i(0). When it is not,
+    /// the guess is mended a few times as the pieces' search would move it — a moving joint whose x
+    /// changed sign reverses (and rests, if it changes sign again), a resting one pushed out of its
+    /// band starts moving that way — each try a substitution. Most plant steps of an arm, moving,
+    /// holding, starting, stopping or chattering, end here, without the pieces' bookkeeping; a limit
+    /// reached, or a guess still wrong after the tries, is left to the search. Returns false (x
+    /// overwritten) then.
+    fn solve_held(&mut self, a: &[f64], diagonal: &[f64], b: &[f64], laws: &[JointLaw], x: &mut [f64], g: &mut [f64]) -> Result<bool, NotPositiveDefinite> {
+        const TRIES: usize = 3;
+        let n = self.n;
+        self.trial.copy_from_slice(&self.side);
+        self.crossed.fill(false);
+        for _ in 0..TRIES {
+            self.fixed.clear();
+            for (i, ((xi, (law, &side)), (bi, gi))) in x.iter_mut().zip(laws.iter().zip(&self.trial)).zip(b.iter().zip(g.iter_mut())).enumerate() {
+                if side == 0 {
+                    if !(law.lower <= 0.0 && 0.0 <= law.upper) {
+                        return Ok(false);
+                    }
+                    self.fixed.push(i);
+                    *xi = *bi;
+                } else {
+                    *gi = if side > 0 { law.above } else { law.below };
+                    *xi = if *gi != 0.0 { bi - *gi } else { *bi };
+                }
+            }
+            if self.fixed.len() > self.schur_max || self.fixed.len() == n {
+                return Ok(false);
+            }
+            if !self.factored_whole {
+                self.factor_whole(a, diagonal)?;
+            }
+            self.substitute(x);
+            if !self.fixed.is_empty() {
+                for k in 0..self.fixed.len() {
+                    self.column(self.fixed[k])?;
+                    self.schur_rhs[k] = -x[self.fixed[k]];
+                }
+                self.hold_fixed(x)?;
+                for &i in &self.fixed {
+                    x[i] = 0.0;
+                }
+            }
+            let mut settled = true;
+            for (i, ((&xi, law), side)) in x.iter().zip(laws).zip(self.trial.iter_mut()).enumerate() {
+                if *side == 0 {
+                    // ∂φ_i(0): unbounded towards a limit at 0, else the band [below, above]
+                    let mut row = 0.0;
+                    for (aij, xj) in a[i * n..(i + 1) * n].iter().zip(x.iter()) {
+                        row += aij * xj;
+                    }
+                    g[i] = b[i] - row;
+                    if law.lower != 0.0 && g[i] < law.below {
+                        (*side, settled) = (-1, false);
+                    } else if law.upper != 0.0 && g[i] > law.above {
+                        (*side, settled) = (1, false);
+                    }
+                } else if (*side > 0 && xi >= law.upper) || (*side < 0 && xi <= law.lower) {
+                    // a limit reached
+                    return Ok(false);
+                } else if (*side > 0 && xi <= 0.0) || (*side < 0 && xi >= 0.0) {
+                    *side = if self.crossed[i] { 0 } else { -*side };
+                    self.crossed[i] = true;
+                    settled = false;
+                }
+            }
+            if settled {
+                self.side.copy_from_slice(&self.trial);
+                for ((limit, law), &side) in self.held_limit.iter_mut().zip(laws).zip(&self.side) {
+                    *limit = if side != 0 { 0 } else if law.lower == 0.0 { -1 } else if law.upper == 0.0 { 1 } else { 0 };
+                }
+                return Ok(true);
+            }
+        }
+        Ok(false)
     }
 
     /// The last solve's pieces, solved for: when every joint is on a segment and stays strictly
@@ -448,13 +567,26 @@ impl StickSlipSolver {
         for k in 0..count {
             self.column(self.fixed[k])?;
         }
-        // S = Eᵀ F⁻¹ E (symmetric positive definite: a principal block of F⁻¹), S·μ = c − y
+        for (l, &jl) in self.fixed.iter().enumerate() {
+            self.schur_rhs[l] = self.shapes[jl].points[self.piece[jl] / 2] - x[jl];
+        }
+        self.hold_fixed(x)?;
+        // on its breakpoint exactly, not to the rounding of the correction
+        for &j in &self.fixed {
+            x[j] = self.shapes[j].points[self.piece[j] / 2];
+        }
+        Ok(())
+    }
+
+    /// x += W·μ with S·μ = `schur_rhs` (S = EᵀF⁻¹E, symmetric positive definite: a principal block
+    /// of F⁻¹; W = F⁻¹E, the fixed joints' columns already worked out): what holds the fixed joints
+    /// where `schur_rhs` moves them.
+    fn hold_fixed(&mut self, x: &mut [f64]) -> Result<(), NotPositiveDefinite> {
+        let (n, count) = (self.n, self.fixed.len());
         for (l, &jl) in self.fixed.iter().enumerate() {
             for (k, &jk) in self.fixed.iter().enumerate() {
                 self.schur[l * count + k] = self.inverse_columns[jl * n + jk];
             }
-            let shape = &self.shapes[jl];
-            self.schur_rhs[l] = shape.points[self.piece[jl] / 2] - x[jl];
         }
         if !ldlt_in_place_slice(&mut self.schur[..count * count], count) {
             return Err(NotPositiveDefinite);
@@ -465,10 +597,6 @@ impl StickSlipSolver {
             for (xi, wi) in x.iter_mut().zip(column) {
                 *xi += wi * mu;
             }
-        }
-        // on its breakpoint exactly, not to the rounding of the correction
-        for &j in &self.fixed {
-            x[j] = self.shapes[j].points[self.piece[j] / 2];
         }
         Ok(())
     }
@@ -763,31 +891,59 @@ mod tests {
     #[test]
     fn a_sliding_joint_brought_to_rest_goes_onto_its_kink_in_one_move() {
         // joint 0 slid forward in the last step; now the rest of the impulse on it is within its
-        // band, so it sticks (x₀ = 0), while joint 1, coupled to it, slides on. Sliding forward
-        // puts x₀ below 0 and sliding back above it: neither side holds it, and the block move
-        // goes onto the kink at once — two linear solves (the guess, then the kink), where a move
-        // across it would swing from side to side until Murty's single moves took it there. (The
-        // coupling makes (A⁻¹)₀₀ = 2.8 where 1/A₀₀ = 1: a move judged on A's diagonal alone would
-        // cross.)
-        let a = [1.0, 0.8, 0.8, 1.0];
+        // band, so it sticks (x₀ = 0), while joint 1, coupled to it, slides on — and joint 2, on its
+        // own, runs into its upper limit, which sends the solve to the pieces' search. Sliding
+        // forward puts x₀ below 0 and sliding back above it: neither side holds it, and the block
+        // move goes onto the kink at once — two linear solves (the guess, then the kink and the
+        // limit), where a move across it would swing from side to side until Murty's single moves
+        // took it there. (The coupling makes (A⁻¹)₀₀ = 2.8 where 1/A₀₀ = 1: a move judged on A's
+        // diagonal alone would cross.)
+        let a = [1.0, 0.8, 0.0, 0.8, 1.0, 0.0, 0.0, 0.0, 1.0];
+        let law = JointLaw { below: -0.3, above: 0.3, ..JointLaw::FREE };
+        let limited = JointLaw { upper: 2.5, ..law };
+        let laws = [law, law, limited];
+        let mut solver = StickSlipSolver::new(3, None);
+        let (mut x, mut g) = ([0.0; 3], [0.0; 3]);
+        solver.solve(&a, &[0.0; 3], &[2.0, 2.0, 1.0], &laws, &mut x, &mut g).unwrap();
+        assert!(x.iter().all(|&xi| xi > 0.0), "all slide forward first: {x:?}");
+        let before = solver.pivot_iterations;
+        let b = [1.3, 2.0, 3.0];
+        solver.solve(&a, &[0.0; 3], &b, &laws, &mut x, &mut g).unwrap();
+        assert_eq!((x[0], x[2]), (0.0, 2.5), "joint 0 sticks, joint 2 stops at its limit: {x:?}");
+        // x₁ = (b₁ − 0.3)/A₁₁ and joint 0's residual within its band
+        assert!((x[1] - 1.7).abs() < 1e-15 && (b[0] - 0.8 * x[1]).abs() <= 0.3, "{x:?}");
+        assert_eq!(solver.limit_side(2), 1);
+        assert_eq!(solver.pivot_iterations - before, 2, "the guess, then the kink");
+    }
+
+    /// A joint reversing, coming to rest or starting to move, next to one that slides on: the last
+    /// solve's outcome, mended, is the solution — no search of the pieces — and each meets every
+    /// condition.
+    #[test]
+    fn reversing_stopping_and_starting_are_mended_without_the_search() {
+        let a = [1.0, 0.6, 0.6, 1.0];
         let law = JointLaw { below: -0.3, above: 0.3, ..JointLaw::FREE };
         let laws = [law, law];
         let mut solver = StickSlipSolver::new(2, None);
         let (mut x, mut g) = ([0.0; 2], [0.0; 2]);
-        solver.solve(&a, &[0.0; 2], &[2.0, 2.0], &laws, &mut x, &mut g).unwrap();
-        assert!(x[0] > 0.0 && x[1] > 0.0, "both slide forward first: {x:?}");
+        solver.solve(&a, &[0.0; 2], &[2.0, 3.0], &laws, &mut x, &mut g).unwrap();
         let before = solver.pivot_iterations;
-        let b = [1.3, 2.0];
-        solver.solve(&a, &[0.0; 2], &b, &laws, &mut x, &mut g).unwrap();
-        assert_eq!(x[0], 0.0, "joint 0 sticks: {x:?}");
-        // x₁ = (b₁ − 0.3)/A₁₁ and joint 0's residual within its band
-        assert!((x[1] - 1.7).abs() < 1e-15 && (b[0] - 0.8 * x[1]).abs() <= 0.3, "{x:?}");
-        assert_eq!(solver.pivot_iterations - before, 2, "the guess, then the kink");
+        // joint 0: reverses, reverses back, comes to rest, stays, starts again; joint 1 slides on
+        for (step, b0) in [-2.0, 2.5, 1.6, 1.7, 4.0, -3.0].into_iter().enumerate() {
+            let b = [b0, 3.0];
+            solver.solve(&a, &[0.0; 2], &b, &laws, &mut x, &mut g).unwrap();
+            for i in 0..2 {
+                let g: f64 = b[i] - (0..2).map(|j| a[j * 2 + i] * x[j]).sum::<f64>();
+                assert!(optimality_violation(&laws[i], x[i], g) < 1e-12, "step {step} joint {i}: x = {}, g = {g}", x[i]);
+            }
+            assert_eq!(x[0] == 0.0, (2..4).contains(&step), "step {step}: joint 0 at rest exactly when its band holds it: {x:?}");
+        }
+        assert_eq!(solver.pivot_iterations, before, "no search of the pieces");
     }
 
     /// Random problems (friction and limits on every joint, 1–12 joints, warm starts), solved with
     /// the joints on breakpoints held through the Schur complement on the one factorization, and
-    /// with the reduced system factored every time: the same pieces, x and g to rounding.
+    /// with the reduced system factored every time: the same limits reached, x and g to rounding.
     #[test]
     fn the_schur_complement_and_the_reduced_system_agree() {
         let mut seed = 0x51_7C_C1_B7_27_22_0A_95_u64;
@@ -811,12 +967,12 @@ mod tests {
                 let (mut x1, mut g1, mut x2, mut g2) = (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
                 schur.solve(&a, &diagonal, &b, &laws, &mut x1, &mut g1).unwrap();
                 reduced.solve(&a, &diagonal, &b, &laws, &mut x2, &mut g2).unwrap();
-                assert_eq!(schur.piece, reduced.piece, "trial {trial}: the same pieces");
+                assert!((0..n).all(|i| schur.limit_side(i) == reduced.limit_side(i)), "trial {trial}: the same limits reached");
                 let scale = x2.iter().chain(&b).fold(1.0_f64, |s, v| s.max(v.abs()));
                 for i in 0..n {
                     assert!((x1[i] - x2[i]).abs() <= 1e-12 * scale && (g1[i] - g2[i]).abs() <= 1e-12 * scale, "trial {trial} joint {i}: x {} vs {}, g {} vs {}", x1[i], x2[i], g1[i], g2[i]);
                 }
-                held += (1..=schur.schur_max.min(n - 1)).contains(&schur.piece.iter().filter(|p| *p % 2 == 1).count()) as usize;
+                held += (1..=schur.schur_max.min(n - 1)).contains(&x1.iter().filter(|&&xi| xi == 0.0).count()) as usize;
             }
         }
         assert!(held > 300, "the Schur complement exercised: {held}");
@@ -855,6 +1011,34 @@ mod tests {
             }
         }
         assert_eq!(solver.factorizations, factorizations, "no factorization after the first");
+    }
+
+    /// A problem that changes little from one solve to the next (a plant stepping on): the last
+    /// solve's outcome, sliding joints sliding on and resting ones resting, is the solution most of
+    /// the time and is taken without searching the pieces — and every solution meets every condition.
+    #[test]
+    fn a_slowly_changing_problem_is_solved_by_the_last_outcome_and_meets_every_condition() {
+        let mut seed = 0x6A09_E667_F3BC_C908_u64;
+        let n = 6;
+        let a = random_spd(n, &mut seed);
+        let start: Vec<f64> = random_spd(n, &mut seed)[..n].iter().map(|v| 3.0 * v).collect();
+        let drift: Vec<f64> = random_spd(n, &mut seed)[n..2 * n].to_vec();
+        // bands wide enough that some joints rest, narrow enough that others slide
+        let laws: Vec<JointLaw> = (0..n).map(|i| JointLaw { lower: -50.0, upper: 40.0, below: -0.4 - 0.3 * i as f64, above: 0.5 + 0.2 * i as f64 }).collect();
+        let mut solver = StickSlipSolver::new(n, None);
+        let (mut x, mut g) = (vec![0.0; n], vec![0.0; n]);
+        let (solves, mut resting) = (2000, 0);
+        for k in 0..solves {
+            let b: Vec<f64> = start.iter().zip(&drift).map(|(s, d)| s + 1e-3 * k as f64 * d).collect();
+            solver.solve(&a, &[0.0; 6], &b, &laws, &mut x, &mut g).unwrap();
+            for i in 0..n {
+                let g: f64 = b[i] - (0..n).map(|j| a[j * n + i] * x[j]).sum::<f64>();
+                assert!(optimality_violation(&laws[i], x[i], g) < 1e-12, "solve {k} joint {i}: x = {}, g = {g}", x[i]);
+            }
+            resting += x.iter().filter(|&&xi| xi == 0.0).count();
+        }
+        assert!(resting > solves && resting < (n - 1) * solves, "some joints rest, some slide: {resting} joint-solves at rest");
+        assert!(solver.pivot_iterations < solves as u64 / 10, "the pieces searched in {} of {solves} solves", solver.pivot_iterations);
     }
 
     #[test]
