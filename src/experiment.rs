@@ -142,17 +142,17 @@ impl Experiment {
         Ok(Self { config, model: Arc::new(model), gains, plant, trajectory, steps, start, motors, steppers, servos, collisions })
     }
 
+    /// The PD controller, on the motors' limits with `--motors`; the joints an open-loop stepper or
+    /// a servo's firmware drives are left to them.
     pub fn controller(&self) -> PdGravityController {
         let n = self.model.dof();
-        PdGravityController {
-            kp: self.gains.kp.clone(),
-            kd: self.gains.kd.clone(),
-            effort: self.model.effort_limits(),
-            actuated: (0..n).map(|i| self.model.is_actuated(i)).collect(),
-            feed_forward: !self.config.no_ff,
-            motors: self.motors.clone(),
-            detent_origin: self.start.clone(),
-        }
+        let controller = PdGravityController::new(self.gains.kp.clone(), self.gains.kd.clone(), self.model.effort_limits(), (0..n).map(|i| self.model.is_actuated(i)).collect(), !self.config.no_ff);
+        let controller = match &self.motors {
+            Some(motors) => controller.with_motors(motors.clone(), self.start.clone()),
+            None => controller,
+        };
+        let stepped = self.stepped_joints();
+        controller.leaving(self.firmware_joints().iter().zip(&stepped).map(|(&a, &b)| a || b).collect())
     }
 
     pub fn make_plant(&self) -> Box<dyn Plant> {

@@ -110,10 +110,10 @@ pub fn simulate_beside(experiment: &Experiment, recorders: &mut [&mut dyn Record
         controller.compute(&q, &v, &cmd, &cmd_dot, &data.gravity, ControlOutput { u: &mut u, saturated: &mut saturated, limit: &mut torque_limit });
         if let Some(s) = steppers.as_mut() {
             // no PD on a stepper joint: the driver steps to the command, the rotor follows as it can
-            s.set_command(&cmd, &cmd_dot, dt);
-            s.torques(&q, &v, &mut u);
+            s.command(&cmd, &cmd_dot, dt, &q, &v, &mut u);
             s.load_angles(&q, &mut load_angle);
             s.lost_steps(&mut lost_steps);
+            s.limits(&u, &v, &mut torque_limit);
             for j in (0..n).filter(|&j| s.stepped[j]) {
                 // past the peak of the torque–angle curve: the motor is giving all it can
                 saturated[j] = load_angle[j].abs() > 90.0;
@@ -193,7 +193,7 @@ pub fn simulate_beside(experiment: &Experiment, recorders: &mut [&mut dyn Record
             break;
         }
         if heat.any() {
-            // the motors carry this step's torque (a stepper's as it stood at the control step)
+            // the motors carry this step's torque (a stepper's over the period's first plant step)
             heat.step(&u);
         }
         if let Some(a) = audit.as_mut() {
@@ -211,8 +211,7 @@ pub fn simulate_beside(experiment: &Experiment, recorders: &mut [&mut dyn Record
             // step's start
             let mut drive = |h: f64, q: &[f64], v: &[f64], u: &mut [f64]| {
                 if let Some(s) = steppers.as_mut() {
-                    s.advance(h);
-                    s.torques(q, v, u);
+                    s.plant_step(h, q, v, u);
                 }
                 if let Some(s) = servos.as_mut() {
                     s.plant_step(h, q, v, u);

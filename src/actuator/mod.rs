@@ -7,6 +7,7 @@
 pub mod bus_servo;
 pub mod carried;
 pub mod catalogue;
+mod envelope;
 mod firmware_drive;
 mod lossy_gear;
 mod open_loop;
@@ -18,6 +19,7 @@ pub mod thermal;
 pub use bus_servo::BusServo;
 pub use carried::{Mount, PlacedPart};
 pub use catalogue::{Catalogue, load_motor_file};
+pub use envelope::{Detent, DriveEnvelope, TorqueSpeed};
 pub use firmware_drive::FirmwareDrives;
 pub use lossy_gear::LossyGear;
 pub use open_loop::{LostSteps, OpenLoopSteppers};
@@ -36,6 +38,11 @@ pub trait Motor: Debug + Send + Sync {
     /// knows better (a DC motor brakes with at least its stall torque).
     fn braking_torque_at(&self, speed: f64) -> f64 {
         self.torque_at(speed)
+    }
+    /// Its torque–speed curve as plain numbers, for the control step (the default: only the motor
+    /// can say, through the two methods above).
+    fn torque_speed(&self) -> TorqueSpeed {
+        TorqueSpeed::Motor
     }
     /// Rotor inertia, kg·m².
     fn rotor_inertia(&self) -> f64;
@@ -199,17 +206,7 @@ impl DriveTrain {
     /// speed `speed` — what a controller can command: (lowest ≤ 0, highest ≥ 0). The gearbox's
     /// rating caps what reaches the joint: rated/η driving, rated·η_b braking.
     pub fn torque_range(&self, speed: f64) -> (f64, f64) {
-        let cap = |torque: f64| {
-            let rated = if !Self::braking(torque, speed) {
-                self.rated_torque / self.gear.efficiency
-            } else if self.gear.self_locking() {
-                self.rated_torque
-            } else {
-                self.rated_torque * self.gear.backdrive_efficiency
-            };
-            self.motor_torque(torque, speed).min(rated)
-        };
-        (-cap(-1.0), cap(1.0))
+        DriveEnvelope::of(self).torque_range(speed, &*self.motor)
     }
 
     /// This drive train followed by a further reduction (a belt or gearbox after a gearmotor): the
@@ -265,12 +262,6 @@ impl DriveTrain {
     /// firmware model gives one) and the reductions' inputs, kg·m².
     pub fn shaft_inertia(&self) -> f64 {
         self.servo.as_ref().map_or_else(|| self.motor.rotor_inertia(), |s| s.armature) + self.input_inertia
-    }
-
-    /// A stepper's detent torque at the joint, N·T_d(N·offset), with the joint `offset` (rad) from
-    /// where the rotor sat in a detent position; 0 for other motors.
-    pub fn detent_torque(&self, offset: f64) -> f64 {
-        self.motor.as_stepper().map_or(0.0, |s| self.gear_ratio * s.detent_torque_at(self.gear_ratio * offset))
     }
 
     /// The rotor's (and the reductions' input) inertia seen at the joint, J·N².

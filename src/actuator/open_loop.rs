@@ -9,6 +9,9 @@
 //! lost, and, open loop, the arm keeps that offset. The torque is evaluated at the plant rate. The
 //! rotor's electrical damping adds to it, the total never more than the motor gives at its speed.
 //!
+//! The torque a plant step applies is worked out at its start, the generator's pulses for that step
+//! emitted; the samples record it as it stands at the control step.
+//!
 //! The driver's step generator, as AccelStepper and the arm's firmware do, follows the command with
 //! a bounded acceleration (a stepper cannot start at full speed): its velocity moves toward
 //! cmd_dot + K·(cmd − position), K = 50/s, by at most `acceleration`·dt per control period (motor file
@@ -16,7 +19,7 @@
 //! weight it carries at the start pose, against the joint's inertia there). Once caught up on a smooth
 //! command it follows it exactly.
 
-use super::{DriveTrain, MotorSet, Stepper};
+use super::{DriveEnvelope, DriveTrain, MotorSet, Stepper};
 use std::f64::consts::PI;
 
 /// One joint's open-loop stepper.
@@ -27,6 +30,8 @@ struct SteppedJoint {
     efficiency: f64,
     rated_torque: f64,
     stepper: Stepper,
+    /// Its drive train's torque at speed, caps and detent, worked out once.
+    envelope: DriveEnvelope,
     /// Electrical periods per motor radian (N_r).
     teeth: f64,
     /// One microstep, motor radians.
@@ -53,17 +58,17 @@ impl SteppedJoint {
     }
 
     fn torque(&self, q: f64, v: f64) -> f64 {
-        let available = super::Motor::torque_at(&self.stepper, self.gear_ratio * v);
-        let pull = self.gear_ratio * available * (self.teeth * self.lag(q)).sin();
+        let (available, _) = self.envelope.motor_torque(v, &self.stepper);
+        let pull = available * (self.teeth * self.lag(q)).sin();
         // the rotor's oscillation about the field damped (at the joint through the gears, N²): on the
         // slip speed, the field turning at the step generator's speed (the drive holds the current,
         // so there is no drag on the speed itself: that is the pull-out curve's part)
         let damping = self.stepper.damping * self.gear_ratio * self.gear_ratio * (self.generator_velocity - v);
         // the drive limits the phase current: field and damping together give at most what the
         // motor gives at this speed (capped so that the gearbox's output stays within its rating)
-        let most = (self.gear_ratio * available).min(self.rated_torque / self.efficiency);
+        let most = available.min(self.envelope.driving_cap());
         // the magnets' detent torque does not go through the current limit
-        (pull + damping).clamp(-most, most) + self.gear_ratio * self.stepper.detent_torque_at(self.gear_ratio * (q - self.start))
+        (pull + damping).clamp(-most, most) + self.envelope.detent_torque(q - self.start)
     }
 }
 
@@ -90,7 +95,8 @@ impl OpenLoopSteppers {
     pub fn new(motors: &MotorSet, start: &[f64], inertia: &[f64], load: &[f64]) -> Option<Self> {
         let mut joints = Vec::new();
         for (j, drive) in motors.joints.iter().enumerate() {
-            let Some(DriveTrain { motor, gear_ratio, gear, rated_torque, .. }) = drive else { continue };
+            let Some(train) = drive else { continue };
+            let DriveTrain { motor, gear_ratio, gear, rated_torque, .. } = train;
             let Some(stepper) = motor.as_stepper() else { continue };
             let micro = motors.microsteps.get(j).copied().flatten().unwrap_or(1) as f64;
             let mut joint = SteppedJoint {
@@ -101,6 +107,7 @@ impl OpenLoopSteppers {
                 teeth: 90.0 / stepper.step_angle_deg,
                 microstep: stepper.step_angle_deg.to_radians() / micro,
                 stepper: stepper.clone(),
+                envelope: DriveEnvelope::of(train),
                 start: start[j],
                 generator_position: 0.0,
                 generator_velocity: 0.0,
@@ -127,9 +134,11 @@ impl OpenLoopSteppers {
         Some(Self { joints, stepped })
     }
 
-    /// The driver's step generator for this control period: its velocity moves toward the command
-    /// with bounded acceleration and holds for the period; [`Self::advance`] then emits the pulses.
-    pub fn set_command(&mut self, cmd: &[f64], cmd_dot: &[f64], dt: f64) {
+    /// A control step: the driver's step generator for the period — its velocity moves toward the
+    /// command with bounded acceleration and holds for the period — and each stepper joint's torque
+    /// at (q, q̇) as it stands, the pulses so far (into `u`, other joints untouched: what the
+    /// samples record).
+    pub fn command(&mut self, cmd: &[f64], cmd_dot: &[f64], dt: f64, q: &[f64], v: &[f64], u: &mut [f64]) {
         const CATCH_UP: f64 = 50.0;
         for s in &mut self.joints {
             let error = cmd[s.joint] - s.start - s.generator_position;
@@ -137,13 +146,20 @@ impl OpenLoopSteppers {
             let bound = s.max_acceleration * dt;
             s.generator_velocity += (wanted - s.generator_velocity).clamp(-bound, bound);
         }
+        self.torques(q, v, u);
+    }
+
+    /// A plant step of `h` s from (q, q̇): its pulses, then each stepper joint's torque into `u`.
+    pub fn plant_step(&mut self, h: f64, q: &[f64], v: &[f64], u: &mut [f64]) {
+        self.advance(h);
+        self.torques(q, v, u);
     }
 
     /// The step pulses over the next `h` seconds of the period (one plant step): the motor's command
     /// is the generator's position at the middle of that step in whole microsteps. A real driver
     /// steps continuously (27 microsteps per millisecond at 4 rev/s and 32 microsteps): a command
     /// moved only at the control rate would kick the rotor by a whole period's steps at once.
-    pub fn advance(&mut self, h: f64) {
+    fn advance(&mut self, h: f64) {
         for s in &mut self.joints {
             let middle = s.generator_position + 0.5 * s.generator_velocity * h;
             s.command = (s.gear_ratio * middle / s.microstep).round() * s.microstep;
@@ -165,9 +181,18 @@ impl OpenLoopSteppers {
     }
 
     /// The torque each stepper joint gets at (q, q̇), into `u` (other joints untouched).
-    pub fn torques(&self, q: &[f64], v: &[f64], u: &mut [f64]) {
+    fn torques(&self, q: &[f64], v: &[f64], u: &mut [f64]) {
         for s in &self.joints {
             u[s.joint] = s.torque(q[s.joint], v[s.joint]);
+        }
+    }
+
+    /// Each stepper joint's limit at joint speed `v` in the direction of its torque `u` (what its
+    /// motor gives there through its gearbox's caps), into `out`.
+    pub fn limits(&self, u: &[f64], v: &[f64], out: &mut [f64]) {
+        for s in &self.joints {
+            let (lowest, highest) = s.envelope.torque_range(v[s.joint], &s.stepper);
+            out[s.joint] = if u[s.joint] >= 0.0 { highest } else { -lowest };
         }
     }
 

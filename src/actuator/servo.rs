@@ -4,7 +4,7 @@
 //! to the drive voltage: the line gives T_stall·(1 + |ω|/ω₀), held to the stall torque (Isaac Lab
 //! clips it to the effort limit) — a servo pushed past its no-load speed still brakes.
 
-use super::Motor;
+use super::{Motor, TorqueSpeed};
 
 #[derive(Clone, Debug)]
 pub struct DcServo {
@@ -18,11 +18,15 @@ pub struct DcServo {
 
 impl Motor for DcServo {
     fn torque_at(&self, speed: f64) -> f64 {
-        (self.stall_torque * (1.0 - speed.abs() / self.no_load_speed)).max(0.0)
+        self.torque_speed().at(speed, self).0
     }
 
-    fn braking_torque_at(&self, _speed: f64) -> f64 {
-        self.stall_torque
+    fn braking_torque_at(&self, speed: f64) -> f64 {
+        self.torque_speed().at(speed, self).1
+    }
+
+    fn torque_speed(&self) -> TorqueSpeed {
+        TorqueSpeed::Line { stall: self.stall_torque, no_load: self.no_load_speed }
     }
 
     fn rotor_inertia(&self) -> f64 {

@@ -2,8 +2,7 @@
 //! teeth for 1.8°: one electrical period is 4 full steps); the torque it can give while turning
 //! falls with speed (the pull-out curve), because the phase current cannot follow.
 
-use super::Motor;
-use std::f64::consts::PI;
+use super::{Detent, Motor, TorqueSpeed};
 
 /// The pull-out torque against speed.
 #[derive(Clone, Debug)]
@@ -46,7 +45,12 @@ impl Stepper {
         if self.detent_torque == 0.0 {
             return 0.0;
         }
-        -self.detent_torque * (std::f64::consts::TAU * angle / self.step_angle_deg.to_radians()).sin()
+        self.detent().at(angle)
+    }
+
+    /// Its detent torque's amplitude and period.
+    pub fn detent(&self) -> Detent {
+        Detent { amplitude: self.detent_torque, full_step: self.step_angle_deg.to_radians() }
     }
 
     /// The corner speed of a derived pull-out curve, rev/s.
@@ -60,13 +64,11 @@ impl Stepper {
 
 impl Motor for Stepper {
     fn torque_at(&self, speed: f64) -> f64 {
-        let rev_s = speed.abs() / (2.0 * PI);
         match &self.pull_out {
-            PullOut::Derived { .. } => {
-                let corner = self.corner_speed_rev_s().unwrap_or(f64::INFINITY);
-                if rev_s <= corner { self.holding_torque } else { self.holding_torque * corner / rev_s }
-            }
+            // the closed form (it never asks the motor back)
+            PullOut::Derived { .. } => self.torque_speed().at(speed, self).0,
             PullOut::Table(points) => {
+                let rev_s = speed.abs() / std::f64::consts::TAU;
                 let first = points[0];
                 if rev_s <= first.0 {
                     return first.1;
@@ -79,6 +81,13 @@ impl Motor for Stepper {
                 }
                 points[points.len() - 1].1
             }
+        }
+    }
+
+    fn torque_speed(&self) -> TorqueSpeed {
+        match self.corner_speed_rev_s() {
+            Some(corner_rev_s) => TorqueSpeed::Corner { torque: self.holding_torque, corner_rev_s },
+            None => TorqueSpeed::Motor,
         }
     }
 

@@ -93,11 +93,13 @@ fn large_trees(c: &mut Criterion) {
     }
 }
 
-/// With motors (`--motors assets/motors/tutorial.toml`): one control step of the loop's work —
-/// controller (PD on the speed-dependent limit, or the open-loop steppers' command) and one plant step
-/// — against the same without motors. Stepper mode also evaluates the stepper torque at every plant
-/// step; its run takes more plant steps per control period (chosen for the stiffest stepper), which
-/// `motors_run_*` shows whole.
+/// With motors (`--motors assets/motors/tutorial.toml`): one control step of the loop's work, as
+/// `sim::simulate` does it — kinematics, τ_g and C·q̇, the controller (PD on the speed-dependent
+/// limit; as steppers, the open-loop steppers' command, torque, load angle and limit at the control
+/// step, then their torque again at the plant step), one plant step — against the same without
+/// motors. Stepper mode's run takes more plant steps per control period (chosen for the stiffest
+/// stepper), which `motors_run_*` shows whole; here it takes one, so that the control step's share
+/// is all in it.
 fn motors(c: &mut Criterion) {
     let urdf = urdf();
     let motors = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/motors/tutorial.toml");
@@ -116,7 +118,8 @@ fn motors(c: &mut Criterion) {
         let mut steppers = experiment.open_loop_steppers();
         let (q0, v0, _) = state();
         let (cmd, cmd_dot) = (vec![0.1; 6], vec![0.2; 6]);
-        let (mut u, mut sat, mut limit) = (vec![0.0; 6], vec![false; 6], vec![0.0; 6]);
+        let (mut u, mut sat, mut limit, mut load_angle, mut lost) = (vec![0.0; 6], vec![false; 6], vec![0.0; 6], vec![0.0; 6], vec![0i64; 6]);
+        let mut events = Vec::new();
         group.bench_function(name, |b| {
             b.iter_batched_ref(
                 || (q0.clone(), v0.clone()),
@@ -126,18 +129,16 @@ fn motors(c: &mut Criterion) {
                     controller.compute(q, v, &cmd, &cmd_dot, &data.gravity, armscope::control::controller::ControlOutput { u: &mut u, saturated: &mut sat, limit: &mut limit });
                     match steppers.as_mut() {
                         Some(s) => {
-                            s.set_command(&cmd, &cmd_dot, 0.001);
-                            plant.advance_driven(
-                                model,
-                                &mut data,
-                                &mut u,
-                                &mut |h, q, v, u| {
-                                    s.advance(h);
-                                    s.torques(q, v, u)
-                                },
-                                q,
-                                v,
-                            );
+                            s.command(&cmd, &cmd_dot, 0.001, q, v, &mut u);
+                            s.load_angles(q, &mut load_angle);
+                            s.lost_steps(&mut lost);
+                            s.limits(&u, v, &mut limit);
+                            for j in 0..6 {
+                                sat[j] = load_angle[j].abs() > 90.0;
+                            }
+                            plant.advance_driven(model, &mut data, &mut u, &mut |h, q, v, u| s.plant_step(h, q, v, u), q, v);
+                            s.update(q, 0.0, &mut events);
+                            events.clear();
                         }
                         None => plant.advance(model, &mut data, &u, q, v),
                     }
