@@ -10,9 +10,9 @@ use std::f64::consts::TAU;
 /// A motor's torque–speed curve, with the motion and against it, at its shaft.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum TorqueSpeed {
-    /// `torque` up to the corner speed, then falling as corner/speed, either way: a stepper's
-    /// derived pull-out curve ([`super::Stepper`]).
-    Corner { torque: f64, corner_rev_s: f64 },
+    /// `torque` up to the corner speed (rad/s at the shaft), then falling as corner/speed, either
+    /// way: a stepper's derived pull-out curve ([`super::Stepper`]).
+    Corner { torque: f64, corner: f64 },
     /// T_stall·(1 − |ω|/ω₀), not below 0, with the motion; T_stall against it: a DC servo's line
     /// ([`super::DcServo`]).
     Line { stall: f64, no_load: f64 },
@@ -24,9 +24,8 @@ impl TorqueSpeed {
     /// (with the motion, against it) at shaft speed `speed`, rad/s; `motor` answers for [`Self::Motor`].
     pub fn at(&self, speed: f64, motor: &dyn Motor) -> (f64, f64) {
         match *self {
-            TorqueSpeed::Corner { torque, corner_rev_s } => {
-                let rev_s = speed.abs() / TAU;
-                let t = if rev_s <= corner_rev_s { torque } else { torque * corner_rev_s / rev_s };
+            TorqueSpeed::Corner { torque, corner } => {
+                let t = if speed.abs() <= corner { torque } else { torque * corner / speed.abs() };
                 (t, t)
             }
             TorqueSpeed::Line { stall, no_load } => ((stall * (1.0 - speed.abs() / no_load)).max(0.0), stall),
@@ -40,15 +39,25 @@ impl TorqueSpeed {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Detent {
     /// T_d, N·m at the shaft.
-    pub amplitude: f64,
-    /// One full step, rad.
-    pub full_step: f64,
+    amplitude: f64,
+    /// 2π over one full step, per rad.
+    per_rad: f64,
 }
 
 impl Detent {
+    /// The detent of amplitude T_d (N·m at the shaft) and full step `full_step` (rad).
+    pub fn new(amplitude: f64, full_step: f64) -> Self {
+        Detent { amplitude, per_rad: TAU / full_step }
+    }
+
+    /// Its amplitude T_d, N·m at the shaft.
+    pub fn amplitude(&self) -> f64 {
+        self.amplitude
+    }
+
     /// The torque at rotor angle `angle` (rad) from a detent position.
     pub fn at(&self, angle: f64) -> f64 {
-        -self.amplitude * (TAU * angle / self.full_step).sin()
+        -self.amplitude * (self.per_rad * angle).sin()
     }
 }
 
@@ -73,7 +82,7 @@ impl DriveEnvelope {
             curve: drive.motor.torque_speed(),
             driving_cap: drive.rated_torque / gear.efficiency,
             braking_cap: if gear.self_locking() { drive.rated_torque } else { drive.rated_torque * gear.backdrive_efficiency },
-            detent: drive.motor.as_stepper().map(|s| s.detent()).filter(|d| d.amplitude != 0.0),
+            detent: drive.motor.as_stepper().map(|s| s.detent()).filter(|d| d.amplitude() != 0.0),
         }
     }
 

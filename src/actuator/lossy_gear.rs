@@ -54,22 +54,15 @@ impl LossyGear {
         self.backdrive_efficiency <= 0.0
     }
 
-    /// The load-dependent loss when the motor's torque at the joint along the motion is `along`
-    /// (> 0: it drives the motion; < 0: the motion back-drives it).
-    fn loss(&self, along: f64) -> f64 {
-        if along > 0.0 {
-            (1.0 - self.efficiency) * along
-        } else if self.self_locking() {
-            f64::INFINITY
-        } else {
-            (1.0 / self.backdrive_efficiency - 1.0) * -along
-        }
-    }
-
     /// (F⁺, F⁻): the Coulomb friction against positive and against negative joint motion when the
     /// motor gives `motor_torque` (N·τ_m) at the joint; infinite on a side the drive locks.
     pub fn friction_bounds(&self, motor_torque: f64) -> (f64, f64) {
-        (self.breakaway_torque + self.loss(motor_torque), self.breakaway_torque + self.loss(-motor_torque))
+        self.losses().friction_bounds(motor_torque)
+    }
+
+    /// Its losses as the coefficients a loop asks at every step.
+    pub fn losses(&self) -> GearLosses {
+        GearLosses { breakaway: self.breakaway_torque, driving: 1.0 - self.efficiency, back_driven: if self.self_locking() { f64::INFINITY } else { 1.0 / self.backdrive_efficiency - 1.0 } }
     }
 
     /// The torque the joint gets while it moves in `direction` (> 0 or < 0) at `speed` with the
@@ -112,6 +105,40 @@ impl LossyGear {
             breakaway_torque: self.breakaway_torque * ratio * next.efficiency + next.breakaway_torque,
             viscous: self.viscous * ratio * ratio + next.viscous,
         }
+    }
+}
+
+/// A gear's losses at the joint as coefficients, worked out once: the breakaway F_b, the share lost
+/// driving (1 − η) and back-driven (1/η_b − 1; infinite for a self-locking gear).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GearLosses {
+    breakaway: f64,
+    driving: f64,
+    back_driven: f64,
+}
+
+impl GearLosses {
+    /// The load-dependent loss when the motor's torque at the joint along the motion is `along`
+    /// (> 0: it drives the motion; < 0: the motion back-drives it).
+    fn loss(&self, along: f64) -> f64 {
+        if along > 0.0 {
+            self.driving * along
+        } else if self.back_driven.is_infinite() {
+            f64::INFINITY
+        } else {
+            self.back_driven * -along
+        }
+    }
+
+    /// [`LossyGear::friction_bounds`].
+    pub fn friction_bounds(&self, motor_torque: f64) -> (f64, f64) {
+        if self.back_driven.is_infinite() {
+            return (self.breakaway + self.loss(motor_torque), self.breakaway + self.loss(-motor_torque));
+        }
+        // the same sums without a branch on the torque's sign, which swings step to step when a
+        // joint chatters: one of the two parts is 0
+        let (driving, back_driven) = (motor_torque.max(0.0), (-motor_torque).max(0.0));
+        (self.breakaway + (self.driving * driving + self.back_driven * back_driven), self.breakaway + (self.driving * back_driven + self.back_driven * driving))
     }
 }
 

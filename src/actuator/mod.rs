@@ -21,7 +21,7 @@ pub use carried::{Mount, PlacedPart};
 pub use catalogue::{Catalogue, load_motor_file};
 pub use envelope::{Detent, DriveEnvelope, TorqueSpeed};
 pub use firmware_drive::FirmwareDrives;
-pub use lossy_gear::LossyGear;
+pub use lossy_gear::{GearLosses, LossyGear};
 pub use open_loop::{LostSteps, OpenLoopSteppers};
 pub use reduction::{Reduction, Stage};
 pub use servo::DcServo;

@@ -50,7 +50,7 @@ impl Stepper {
 
     /// Its detent torque's amplitude and period.
     pub fn detent(&self) -> Detent {
-        Detent { amplitude: self.detent_torque, full_step: self.step_angle_deg.to_radians() }
+        Detent::new(self.detent_torque, self.step_angle_deg.to_radians())
     }
 
     /// The corner speed of a derived pull-out curve, rev/s.
@@ -86,7 +86,7 @@ impl Motor for Stepper {
 
     fn torque_speed(&self) -> TorqueSpeed {
         match self.corner_speed_rev_s() {
-            Some(corner_rev_s) => TorqueSpeed::Corner { torque: self.holding_torque, corner_rev_s },
+            Some(corner_rev_s) => TorqueSpeed::Corner { torque: self.holding_torque, corner: corner_rev_s * std::f64::consts::TAU },
             None => TorqueSpeed::Motor,
         }
     }

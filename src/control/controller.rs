@@ -102,7 +102,7 @@ impl PdGravityController {
                 u += envelope.detent_torque(q[i] - self.detent_origin[i]);
             }
             let (lowest, highest) = self.range(i, v[i]);
-            out.saturated[i] = u > highest || u < lowest;
+            out.saturated[i] = (u > highest) | (u < lowest);
             out.u[i] = u.clamp(lowest, highest);
             out.limit[i] = if u >= 0.0 { highest } else { -lowest };
         }

@@ -99,9 +99,9 @@ impl DiscretePlant {
             if self.friction.has_servos() {
                 self.friction.observe(&data.gravity, v);
             }
+            self.friction.all_bounds(u, &mut self.bounds);
             for (i, joint) in model.joints.iter().enumerate() {
                 self.damping_step[i] = h * (joint.damping + self.friction.viscous(i));
-                self.bounds[i] = self.friction.bounds(i, u[i]);
                 let (law, locked_up, locked_down) = JointFriction::law_of(self.bounds[i], h, (joint.lower - q[i]) / h, (joint.upper - q[i]) / h);
                 self.laws[i] = law;
                 self.locked[i] = (locked_up, locked_down);

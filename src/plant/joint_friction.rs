@@ -7,7 +7,7 @@
 //! the other joints' inertial coupling left out.)
 
 use super::stick_slip::JointLaw;
-use crate::actuator::LossyGear;
+use crate::actuator::{GearLosses, LossyGear};
 use crate::actuator::bus_servo::ServoFriction;
 use crate::model::Model;
 
@@ -15,12 +15,18 @@ use crate::model::Model;
 #[derive(Clone, Debug)]
 pub struct JointFriction {
     coulomb: Vec<f64>,
-    gears: Vec<Option<LossyGear>>,
+    gears: Vec<Option<GearLosses>>,
     /// Per joint, its servo's friction and the ratio from the servo to the joint.
     servos: Vec<Option<(ServoFriction, f64)>>,
     /// The servos' inputs at the step's start: each joint's gravity torque and speed.
     external: Vec<f64>,
     speed: Vec<f64>,
+    /// Per joint, the gear's and the servo's viscous friction at the joint, and whether it has any
+    /// friction at all (worked out once: the plant asks at every step).
+    viscous: Vec<f64>,
+    has: Vec<bool>,
+    /// Whether some joint has a servo's friction.
+    servo_friction: bool,
     /// Whether any joint has friction or gear losses (without, the plants keep their plain update).
     pub any: bool,
 }
@@ -29,24 +35,36 @@ impl JointFriction {
     /// The model's joint friction and the drive trains' gears (by coordinate; empty: none).
     pub fn new(model: &Model, gears: &[Option<LossyGear>]) -> Self {
         let coulomb: Vec<f64> = model.joints.iter().map(|j| j.friction).collect();
-        let gears: Vec<Option<LossyGear>> = (0..model.dof()).map(|i| gears.get(i).copied().flatten().filter(|g| !g.is_lossless())).collect();
-        let any = coulomb.iter().any(|&f| f > 0.0) || gears.iter().any(Option::is_some);
+        let lossy: Vec<Option<LossyGear>> = (0..model.dof()).map(|i| gears.get(i).copied().flatten().filter(|g| !g.is_lossless())).collect();
         let n = coulomb.len();
-        Self { coulomb, gears, servos: vec![None; n], external: vec![0.0; n], speed: vec![0.0; n], any }
+        let mut friction = Self { coulomb, gears: lossy.iter().map(|g| g.map(|g| g.losses())).collect(), servos: vec![None; n], external: vec![0.0; n], speed: vec![0.0; n], viscous: lossy.iter().map(|g| g.map_or(0.0, |g| g.viscous)).collect(), has: vec![false; n], servo_friction: false, any: false };
+        friction.update_has();
+        friction
     }
 
     /// With the servos' friction (by coordinate, with the ratio from servo to joint).
     pub fn with_servos(mut self, servos: &[Option<(ServoFriction, f64)>]) -> Self {
-        for (slot, servo) in self.servos.iter_mut().zip(servos) {
+        for ((slot, servo), viscous) in self.servos.iter_mut().zip(servos).zip(&mut self.viscous) {
             *slot = *servo;
+            if let Some((servo, n)) = servo {
+                *viscous += n * n * servo.viscous;
+            }
         }
-        self.any |= self.has_servos();
+        self.update_has();
         self
+    }
+
+    fn update_has(&mut self) {
+        for (i, has) in self.has.iter_mut().enumerate() {
+            *has = self.coulomb[i] > 0.0 || self.gears[i].is_some() || self.servos[i].is_some();
+        }
+        self.any = self.has.contains(&true);
+        self.servo_friction = self.servos.iter().any(Option::is_some);
     }
 
     /// Whether some joint has a servo's friction.
     pub fn has_servos(&self) -> bool {
-        self.servos.iter().any(Option::is_some)
+        self.servo_friction
     }
 
     /// The step's start: each joint's gravity torque and speed (what the servos' budgets depend on).
@@ -62,14 +80,17 @@ impl JointFriction {
 
     /// Whether joint i has any friction (its friction torque and stuck flag mean something).
     pub fn has(&self, i: usize) -> bool {
-        self.coulomb[i] > 0.0 || self.gears[i].is_some() || self.servos[i].is_some()
+        self.has[i]
     }
 
     /// (F⁺, F⁻) of joint i when the motor gives `u` at the joint: the friction against positive and
     /// against negative motion, infinite on a side a self-locking gear locks.
     pub fn bounds(&self, i: usize, u: f64) -> (f64, f64) {
         // a servo's budget at its output, ×N at the joint: its torque u/N, the load τ_e/N, speed N·q̇
-        let f = self.coulomb[i] + self.servos[i].map_or(0.0, |(servo, n)| n * servo.budget(u / n, self.external[i] / n, n * self.speed[i]));
+        let f = match &self.servos[i] {
+            Some((servo, n)) => self.coulomb[i] + n * servo.budget(u / n, self.external[i] / n, n * self.speed[i]),
+            None => self.coulomb[i],
+        };
         match &self.gears[i] {
             Some(gear) => {
                 let (up, down) = gear.friction_bounds(u);
@@ -79,9 +100,29 @@ impl JointFriction {
         }
     }
 
-    /// The gear's viscous coefficient at joint i, N·m·s/rad (added to the joint's damping).
+    /// Every joint's (F⁺, F⁻) ([`Self::bounds`]) when the motors give `u` at the joints, into `out`.
+    pub fn all_bounds(&self, u: &[f64], out: &mut [(f64, f64)]) {
+        if self.servo_friction {
+            for (i, (out, &u)) in out.iter_mut().zip(u).enumerate() {
+                *out = self.bounds(i, u);
+            }
+            return;
+        }
+        for ((out, &u), (&f, gear)) in out.iter_mut().zip(u).zip(self.coulomb.iter().zip(&self.gears)) {
+            *out = match gear {
+                Some(gear) => {
+                    let (up, down) = gear.friction_bounds(u);
+                    (f + up, f + down)
+                }
+                None => (f, f),
+            };
+        }
+    }
+
+    /// The gear's and the servo's viscous coefficient at joint i, N·m·s/rad (added to the joint's
+    /// damping).
     pub fn viscous(&self, i: usize) -> f64 {
-        self.gears[i].map_or(0.0, |g| g.viscous) + self.servos[i].map_or(0.0, |(servo, n)| n * n * servo.viscous)
+        self.viscous[i]
     }
 
     /// The law for joint i with the bounds `scale`·(F⁺, F⁻) and the position bounds (lower, upper):

@@ -98,8 +98,8 @@ fn large_trees(c: &mut Criterion) {
 /// limit; as steppers, the open-loop steppers' command, torque, load angle and limit at the control
 /// step, then their torque again at the plant step), one plant step — against the same without
 /// motors. Stepper mode's run takes more plant steps per control period (chosen for the stiffest
-/// stepper), which `motors_run_*` shows whole; here it takes one, so that the control step's share
-/// is all in it.
+/// stepper), which `motors_run_*` shows whole, beside the run without motors at the same plant
+/// step; here it takes one, so that the control step's share is all in it (the worst case).
 fn motors(c: &mut Criterion) {
     let urdf = urdf();
     let motors = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/motors/tutorial.toml");
@@ -151,10 +151,18 @@ fn motors(c: &mut Criterion) {
     group.finish();
     let mut group = c.benchmark_group("motors_run");
     group.sample_size(10);
+    let steppers = RunConfig { urdf: urdf.clone(), motors: Some(motors.clone()), ..RunConfig::default() };
+    // the steppers' run takes the plant step the stiffest stepper needs: the same run without
+    // motors at that step is what a plant step of it costs without them
+    let stepper_plant_step = match Experiment::prepare(steppers.clone()).unwrap().plant {
+        armscope::experiment::PlantSpec::Discrete { time_step, .. } => time_step,
+        armscope::experiment::PlantSpec::Continuous { .. } => unreachable!("the default plant is discrete"),
+    };
     for (name, config) in [
         ("default_30s_without_motors", RunConfig { urdf: urdf.clone(), ..RunConfig::default() }),
         ("default_30s_servo_mode", RunConfig { urdf: urdf.clone(), motors: Some(motors.clone()), drive: armscope::config::DriveMode::Pd, ..RunConfig::default() }),
-        ("default_30s_stepper_mode", RunConfig { urdf: urdf.clone(), motors: Some(motors.clone()), ..RunConfig::default() }),
+        ("default_30s_without_motors_at_the_steppers_plant_step", RunConfig { urdf: urdf.clone(), time_step: Some(stepper_plant_step), ..RunConfig::default() }),
+        ("default_30s_stepper_mode", steppers),
     ] {
         let experiment = Experiment::prepare(config).unwrap();
         group.bench_function(name, |b| b.iter(|| black_box(simulate(&experiment, &mut [], None).unwrap().steps)));
