@@ -278,11 +278,11 @@ impl StickSlipSolver {
         }
         for (((p, shape), law), &side) in self.piece.iter_mut().zip(&mut self.shapes).zip(laws).zip(&self.side) {
             *shape = Shape::of(law);
-            *p = if *p == UNKNOWN {
-                shape.piece_of(0.0)
-            } else if self.pieces_stale {
-                // the segment on the side it moved to
+            *p = if self.pieces_stale {
+                // the last solve ended on the sides it held: the segment on the side each moved to
                 shape.piece_of(side as f64 * f64::MIN_POSITIVE)
+            } else if *p == UNKNOWN {
+                shape.piece_of(0.0)
             } else {
                 (*p).clamp(shape.first, shape.last)
             };
@@ -403,21 +403,30 @@ impl StickSlipSolver {
                     *xi = if *gi != 0.0 { bi - *gi } else { *bi };
                 }
             }
-            if self.fixed.len() > self.schur_max || self.fixed.len() == n {
-                return Ok(false);
-            }
-            if !self.factored_whole {
-                self.factor_whole(a, diagonal)?;
-            }
-            self.substitute(x);
-            if !self.fixed.is_empty() {
-                for k in 0..self.fixed.len() {
-                    self.column(self.fixed[k])?;
-                    self.schur_rhs[k] = -x[self.fixed[k]];
+            let count = self.fixed.len();
+            if count > self.schur_max || count == n {
+                // many at rest (an arm holding still): their rows and columns taken out
+                let mut held = std::mem::take(&mut self.rhs);
+                for &j in &self.fixed {
+                    held[j] = 0.0;
                 }
-                self.hold_fixed(x)?;
-                for &i in &self.fixed {
-                    x[i] = 0.0;
+                let solved = self.solve_reduced(a, diagonal, x, &held);
+                self.rhs = held;
+                solved?;
+            } else {
+                if !self.factored_whole {
+                    self.factor_whole(a, diagonal)?;
+                }
+                self.substitute(x);
+                if count > 0 {
+                    for k in 0..count {
+                        self.column(self.fixed[k])?;
+                        self.schur_rhs[k] = -x[self.fixed[k]];
+                    }
+                    self.hold_fixed(x)?;
+                    for &i in &self.fixed {
+                        x[i] = 0.0;
+                    }
                 }
             }
             let mut settled = true;
@@ -555,7 +564,13 @@ impl StickSlipSolver {
         }
         let count = self.fixed.len();
         if count > self.schur_max || count == n {
-            return self.solve_reduced(a, diagonal, b, x);
+            let mut held = std::mem::take(&mut self.rhs);
+            for &j in &self.fixed {
+                held[j] = self.shapes[j].points[self.piece[j] / 2];
+            }
+            let solved = self.solve_reduced(a, diagonal, x, &held);
+            self.rhs = held;
+            return solved;
         }
         if !self.factored_whole {
             self.factor_whole(a, diagonal)?;
@@ -602,15 +617,17 @@ impl StickSlipSolver {
     }
 
     /// The linear system with the fixed joints' rows and columns taken out of A + diag (their
-    /// values moved to the right-hand side), factored as it is.
-    fn solve_reduced(&mut self, a: &[f64], diagonal: &[f64], b: &[f64], x: &mut [f64]) -> Result<(), NotPositiveDefinite> {
+    /// values, `held` by joint, moved to the right-hand side `x` holds), factored as it is.
+    fn solve_reduced(&mut self, a: &[f64], diagonal: &[f64], x: &mut [f64], held: &[f64]) -> Result<(), NotPositiveDefinite> {
+        if self.fixed.len() == self.n {
+            // every joint fixed: nothing to solve
+            x.copy_from_slice(held);
+            return Ok(());
+        }
         self.load_matrix(a, diagonal);
         self.factored_whole = false;
-        for (j, (&piece, shape)) in self.piece.iter().zip(&self.shapes).enumerate() {
-            x[j] = if piece % 2 == 0 { b[j] - shape.slopes[piece / 2] } else { b[j] };
-        }
         for &j in &self.fixed {
-            let fixed = self.shapes[j].points[self.piece[j] / 2];
+            let fixed = held[j];
             for (i, xi) in x.iter_mut().enumerate() {
                 *xi -= self.factor[(i, j)] * fixed;
                 self.factor[(i, j)] = 0.0;
@@ -914,6 +931,31 @@ mod tests {
         assert!((x[1] - 1.7).abs() < 1e-15 && (b[0] - 0.8 * x[1]).abs() <= 0.3, "{x:?}");
         assert_eq!(solver.limit_side(2), 1);
         assert_eq!(solver.pivot_iterations - before, 2, "the guess, then the kink");
+    }
+
+    /// An arm holding still, every joint within its band: x = 0 exactly, found without factoring
+    /// anything; one joint pushed out of its band moves alone, the others held.
+    #[test]
+    fn an_arm_held_still_by_its_friction_costs_no_factorization() {
+        let mut seed = 0x3C6E_F372_FE94_F82B_u64;
+        let n = 6;
+        let a = random_spd(n, &mut seed);
+        let laws: Vec<JointLaw> = (0..n).map(|_| JointLaw { lower: -5.0, upper: 5.0, below: -1.0, above: 1.2 }).collect();
+        let mut solver = StickSlipSolver::new(n, None);
+        let (mut x, mut g) = (vec![0.0; n], vec![0.0; n]);
+        let mut b = vec![0.5, -0.9, 0.3, 1.1, -0.2, 0.0];
+        for _ in 0..3 {
+            solver.solve(&a, &[0.0; 6], &b, &laws, &mut x, &mut g).unwrap();
+            assert!(x.iter().all(|&xi| xi == 0.0) && g == b, "held still: {x:?}");
+        }
+        assert_eq!((solver.factorizations, solver.pivot_iterations), (0, 0));
+        b[2] = 4.0;
+        solver.solve(&a, &[0.0; 6], &b, &laws, &mut x, &mut g).unwrap();
+        for i in 0..n {
+            let g: f64 = b[i] - (0..n).map(|j| a[j * n + i] * x[j]).sum::<f64>();
+            assert!(optimality_violation(&laws[i], x[i], g) < 1e-12, "joint {i}: x = {}, g = {g}", x[i]);
+        }
+        assert!(x[2] > 0.0 && solver.pivot_iterations == 0, "{x:?}");
     }
 
     /// A joint reversing, coming to rest or starting to move, next to one that slides on: the last
