@@ -1,6 +1,7 @@
 //! A control step (kinematics, τ_g and C·q̇, controller, plant) allocates nothing, for the discrete
-//! and the continuous plant. Counted with a global allocator that tallies every allocation made on
-//! the test's own thread (the test harness's threads allocate when they like).
+//! and the continuous plant, and with motors (PD on the drive trains, open-loop steppers). Counted
+//! with a global allocator that tallies every allocation made on the test's own thread (the test
+//! harness's threads allocate when they like).
 
 mod common;
 
@@ -43,15 +44,29 @@ fn allocations_in_steps(config: RunConfig) -> usize {
     let mut data = Data::new(model);
     let mut plant = experiment.make_plant();
     let controller = experiment.controller();
+    // stepper mode: the open-loop steppers as the loop drives them
+    let mut steppers = experiment.open_loop_steppers();
     let (mut q, mut v) = experiment.initial_state();
     let (mut cmd, mut cmd_dot, mut u, mut sat, mut limit) = (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![false; n], vec![0.0; n]);
+    let (mut load_angle, mut lost, mut events) = (vec![0.0; n], vec![0i64; n], Vec::with_capacity(n));
     let mut step = |k: usize, q: &mut Vec<f64>, v: &mut Vec<f64>| {
         forward_kinematics(model, &mut data, q);
         gravity_and_bias_from_kinematics(model, &mut data, v);
         experiment.trajectory.sample(k as f64 * 0.001, &mut cmd, &mut cmd_dot);
         controller.compute(q, v, &cmd, &cmd_dot, &data.gravity, ControlOutput { u: &mut u, saturated: &mut sat, limit: &mut limit });
         std::hint::black_box(frame_pose(model, &data, model.tool_frame));
-        plant.advance(model, &mut data, &u, q, v);
+        match steppers.as_mut() {
+            Some(s) => {
+                s.command(&cmd, &cmd_dot, 0.001, q, v, &mut u);
+                s.load_angles(q, &mut load_angle);
+                s.lost_steps(&mut lost);
+                s.limits(&u, v, &mut limit);
+                plant.advance_driven(model, &mut data, &mut u, &mut |h, q, v, u| s.plant_step(h, q, v, u), q, v);
+                s.update(q, k as f64 * 0.001, &mut events);
+                events.clear();
+            }
+            None => plant.advance(model, &mut data, &u, q, v),
+        }
     };
     step(0, &mut q, &mut v); // warm-up: nothing lazy left
     let before = allocations();
@@ -69,4 +84,14 @@ fn discrete_and_continuous_steps_do_not_allocate() {
     // a step that passes a joint limit takes the active-set path
     let limited = allocations_in_steps(RunConfig { urdf, test_joint: Some("2".into()), test_angle: 3.0, ..RunConfig::default() });
     assert_eq!((discrete, continuous, limited), (0, 0, 0), "allocations in 499 steps: discrete, continuous, at a limit");
+}
+
+/// With motors too: the drive trains on the PD loop (their gear friction through the exact
+/// stick–slip solve at every step) and the open-loop steppers (their torque at every plant step).
+#[test]
+fn steps_with_motors_do_not_allocate() {
+    let motors = common::repo().join("assets/motors/tutorial.toml");
+    let pd = allocations_in_steps(RunConfig { urdf: common::box_urdf(), motors: Some(motors.clone()), drive: armscope::config::DriveMode::Pd, ..RunConfig::default() });
+    let steppers = allocations_in_steps(RunConfig { urdf: common::box_urdf(), motors: Some(motors), ..RunConfig::default() });
+    assert_eq!((pd, steppers), (0, 0), "allocations in 499 steps: --drive pd, steppers");
 }
