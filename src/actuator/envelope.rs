@@ -59,6 +59,13 @@ impl Detent {
     pub fn at(&self, angle: f64) -> f64 {
         -self.amplitude * (self.per_rad * angle).sin()
     }
+
+    /// The same at the rotor's electrical angle e (N_r·angle), given as sin e and cos e: a full step
+    /// is a quarter of an electrical period, so the detent is −T_d·sin 4e.
+    pub fn at_electrical(&self, sin_e: f64, cos_e: f64) -> f64 {
+        let (sin_2e, cos_2e) = (2.0 * sin_e * cos_e, (cos_e - sin_e) * (cos_e + sin_e));
+        -self.amplitude * 2.0 * sin_2e * cos_2e
+    }
 }
 
 /// One drive train as the control step sees it.
@@ -115,5 +122,10 @@ impl DriveEnvelope {
     /// where the rotor sat in a detent position; 0 for other motors.
     pub fn detent_torque(&self, offset: f64) -> f64 {
         self.detent.map_or(0.0, |d| self.gear_ratio * d.at(self.gear_ratio * offset))
+    }
+
+    /// The same with the rotor's electrical angle given as its sine and cosine ([`Detent::at_electrical`]).
+    pub fn detent_torque_at_phase(&self, sin_electrical: f64, cos_electrical: f64) -> f64 {
+        self.detent.map_or(0.0, |d| self.gear_ratio * d.at_electrical(sin_electrical, cos_electrical))
     }
 }

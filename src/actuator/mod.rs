@@ -13,6 +13,7 @@ mod lossy_gear;
 mod open_loop;
 pub mod reduction;
 mod servo;
+mod sin_cos;
 mod stepper;
 pub mod thermal;
 
