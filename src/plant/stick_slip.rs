@@ -385,7 +385,8 @@ impl StickSlipSolver {
     /// reached, or a guess still wrong after the tries, is left to the search. Returns false (x
     /// overwritten) then.
     fn solve_held(&mut self, a: &[f64], diagonal: &[f64], b: &[f64], laws: &[JointLaw], x: &mut [f64], g: &mut [f64]) -> Result<bool, NotPositiveDefinite> {
-        const TRIES: usize = 3;
+        // on the tutorial's 30 s --drive pd run three tries leave 6.6 % of the solves to the search, five 0.04 %
+        const TRIES: usize = 5;
         let n = self.n;
         self.trial.copy_from_slice(&self.side);
         self.crossed.fill(false);
