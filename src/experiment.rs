@@ -21,6 +21,16 @@ pub enum PlantSpec {
     Continuous { rtol: f64, atol: f64 },
 }
 
+impl PlantSpec {
+    /// The discrete plant's step, s; None for the continuous plant (its steps are its own).
+    pub fn time_step(&self) -> Option<f64> {
+        match *self {
+            PlantSpec::Discrete { time_step, .. } => Some(time_step),
+            PlantSpec::Continuous { .. } => None,
+        }
+    }
+}
+
 pub struct Experiment {
     pub config: RunConfig,
     pub model: Arc<Model>,

@@ -4,6 +4,7 @@ use crate::dynamics::{Data, body_poses, forward_kinematics, frame_pose, frame_po
 use crate::model::Model;
 use crate::error::Error;
 use crate::experiment::Experiment;
+use crate::actuator::StepperOutput;
 use crate::control::controller::ControlOutput;
 use crate::recorder::{Recorder, RunInfo};
 use crate::sample::Sample;
@@ -77,10 +78,7 @@ pub fn simulate_beside(experiment: &Experiment, recorders: &mut [&mut dyn Record
     let (mut load_angle, mut lost_steps, mut lost_events) = (vec![0.0; n], vec![0i64; n], Vec::new());
     // firmware mode: the servos driven by their own position loops, their duty, current and supply
     let mut servos = experiment.firmware_drives();
-    let plant_step = match experiment.plant {
-        crate::experiment::PlantSpec::Discrete { time_step, .. } => time_step,
-        crate::experiment::PlantSpec::Continuous { .. } => dt,
-    };
+    let plant_step = experiment.plant.time_step().unwrap_or(dt);
     let (mut duty, mut current, mut supply) = if servos.is_some() { (vec![0.0; n], vec![0.0; n], vec![0.0; n]) } else { (Vec::new(), Vec::new(), Vec::new()) };
     let (mut chatter, mut previous_u, mut previous_saturated) = (vec![false; n], vec![0.0; n], vec![false; n]);
     let mut at_limit = vec![false; n];
@@ -110,14 +108,7 @@ pub fn simulate_beside(experiment: &Experiment, recorders: &mut [&mut dyn Record
         controller.compute(&q, &v, &cmd, &cmd_dot, &data.gravity, ControlOutput { u: &mut u, saturated: &mut saturated, limit: &mut torque_limit });
         if let Some(s) = steppers.as_mut() {
             // no PD on a stepper joint: the driver steps to the command, the rotor follows as it can
-            s.command(&cmd, &cmd_dot, dt, &q, &v, &mut u);
-            s.load_angles(&q, &mut load_angle);
-            s.lost_steps(&mut lost_steps);
-            s.limits(&u, &v, &mut torque_limit);
-            for j in (0..n).filter(|&j| s.stepped[j]) {
-                // past the peak of the torque–angle curve: the motor is giving all it can
-                saturated[j] = load_angle[j].abs() > 90.0;
-            }
+            s.control_step(&cmd, &cmd_dot, dt, &q, &v, StepperOutput { u: &mut u, limit: &mut torque_limit, saturated: &mut saturated, load_angle: &mut load_angle, lost_steps: &mut lost_steps });
         }
         if let Some(s) = servos.as_mut() {
             // no PD on a servo joint: its firmware's position loop sets the duty toward the command
@@ -193,7 +184,7 @@ pub fn simulate_beside(experiment: &Experiment, recorders: &mut [&mut dyn Record
             break;
         }
         if heat.any() {
-            // the motors carry this step's torque (a stepper's over the period's first plant step)
+            // the motors carry this step's torque (a stepper's as it stood at the control step)
             heat.step(&u);
         }
         if let Some(a) = audit.as_mut() {

@@ -6,6 +6,7 @@
 mod common;
 
 use armscope::config::RunConfig;
+use armscope::actuator::StepperOutput;
 use armscope::control::controller::ControlOutput;
 use armscope::dynamics::{Data, forward_kinematics, frame_pose, gravity_and_bias_from_kinematics};
 use armscope::experiment::Experiment;
@@ -57,10 +58,7 @@ fn allocations_in_steps(config: RunConfig) -> usize {
         std::hint::black_box(frame_pose(model, &data, model.tool_frame));
         match steppers.as_mut() {
             Some(s) => {
-                s.command(&cmd, &cmd_dot, 0.001, q, v, &mut u);
-                s.load_angles(q, &mut load_angle);
-                s.lost_steps(&mut lost);
-                s.limits(&u, v, &mut limit);
+                s.control_step(&cmd, &cmd_dot, 0.001, q, v, StepperOutput { u: &mut u, limit: &mut limit, saturated: &mut sat, load_angle: &mut load_angle, lost_steps: &mut lost });
                 plant.advance_driven(model, &mut data, &mut u, &mut |h, q, v, u| s.plant_step(h, q, v, u), q, v);
                 s.update(q, k as f64 * 0.001, &mut events);
                 events.clear();

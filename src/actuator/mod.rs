@@ -23,7 +23,7 @@ pub use catalogue::{Catalogue, load_motor_file};
 pub use envelope::{Detent, DriveEnvelope, TorqueSpeed};
 pub use firmware_drive::FirmwareDrives;
 pub use lossy_gear::{GearLosses, LossyGear};
-pub use open_loop::{LostSteps, OpenLoopSteppers};
+pub use open_loop::{LostSteps, OpenLoopSteppers, StepperOutput};
 pub use reduction::{Reduction, Stage};
 pub use servo::DcServo;
 pub use stepper::{PullOut, Stepper};

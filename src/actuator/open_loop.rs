@@ -115,6 +115,21 @@ pub struct OpenLoopSteppers {
     pub stepped: Vec<bool>,
 }
 
+/// What the open-loop steppers give and report at a control step, by coordinate (the joints they do
+/// not drive left untouched).
+pub struct StepperOutput<'a> {
+    /// Each stepper joint's torque as it stands at the control step (what the samples record).
+    pub u: &'a mut [f64],
+    /// Its limit at its speed in the direction of that torque.
+    pub limit: &'a mut [f64],
+    /// Past the peak of the torque–angle curve (|load angle| > 90°): the motor gives all it can.
+    pub saturated: &'a mut [bool],
+    /// The load angle, electrical degrees ([`OpenLoopSteppers::load_angles`]).
+    pub load_angle: &'a mut [f64],
+    /// Full steps lost so far.
+    pub lost_steps: &'a mut [i64],
+}
+
 /// A lost-step event: at time `t`, joint `joint` lost `steps` full steps (signed).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LostSteps {
@@ -178,11 +193,22 @@ impl OpenLoopSteppers {
         Some(Self { joints, stepped })
     }
 
-    /// A control step: the driver's step generator for the period — its velocity moves toward the
-    /// command with bounded acceleration and holds for the period — and each stepper joint's torque
-    /// at (q, q̇) as it stands, the pulses so far (into `u`, other joints untouched: what the
-    /// samples record).
-    pub fn command(&mut self, cmd: &[f64], cmd_dot: &[f64], dt: f64, q: &[f64], v: &[f64], u: &mut [f64]) {
+    /// A control step at (q, q̇), before its plant steps ([`Self::plant_step`]): the command to the
+    /// drivers, and what the steppers give and report then.
+    pub fn control_step(&mut self, cmd: &[f64], cmd_dot: &[f64], dt: f64, q: &[f64], v: &[f64], out: StepperOutput) {
+        self.command(cmd, cmd_dot, dt, q, v, out.u);
+        self.load_angles(q, out.load_angle);
+        self.lost_steps(out.lost_steps);
+        self.limits(out.u, v, out.limit);
+        for s in &self.joints {
+            out.saturated[s.joint] = out.load_angle[s.joint].abs() > 90.0;
+        }
+    }
+
+    /// The driver's step generator for the period — its velocity moves toward the command with
+    /// bounded acceleration and holds for the period — and each stepper joint's torque at (q, q̇) as
+    /// it stands, the pulses so far, into `u`.
+    fn command(&mut self, cmd: &[f64], cmd_dot: &[f64], dt: f64, q: &[f64], v: &[f64], u: &mut [f64]) {
         const CATCH_UP: f64 = 50.0;
         for s in &mut self.joints {
             let error = cmd[s.joint] - s.start - s.generator_position;
@@ -235,7 +261,7 @@ impl OpenLoopSteppers {
 
     /// Each stepper joint's limit at joint speed `v` in the direction of its torque `u` (what its
     /// motor gives there through its gearbox's caps), into `out`.
-    pub fn limits(&self, u: &[f64], v: &[f64], out: &mut [f64]) {
+    fn limits(&self, u: &[f64], v: &[f64], out: &mut [f64]) {
         for s in &self.joints {
             let (lowest, highest) = s.envelope.torque_range(v[s.joint], &s.stepper);
             out[s.joint] = if u[s.joint] >= 0.0 { highest } else { -lowest };
@@ -243,11 +269,11 @@ impl OpenLoopSteppers {
     }
 
     /// Each stepper joint's load angle, electrical degrees (±90° is the peak torque, ±180° the slip
-    /// point), of the lag left after whole lost periods; 0 elsewhere.
-    pub fn load_angles(&self, q: &[f64], out: &mut [f64]) {
+    /// point), of the lag left after whole lost periods.
+    fn load_angles(&self, q: &[f64], out: &mut [f64]) {
         for s in &self.joints {
             let electrical = s.teeth * s.lag(q[s.joint]);
-            out[s.joint] = (electrical - 2.0 * PI * (electrical / (2.0 * PI)).round()).to_degrees();
+            out[s.joint] = (electrical - 2.0 * PI * round(electrical / (2.0 * PI))).to_degrees();
         }
     }
 
@@ -264,8 +290,8 @@ impl OpenLoopSteppers {
         }
     }
 
-    /// Full steps lost so far per coordinate (0 for joints not driven here).
-    pub fn lost_steps(&self, out: &mut [i64]) {
+    /// Full steps lost so far, by coordinate (the joints not driven here left untouched).
+    fn lost_steps(&self, out: &mut [i64]) {
         for s in &self.joints {
             out[s.joint] = s.lost_steps;
         }

@@ -154,6 +154,8 @@ impl Shape {
 pub struct StickSlipSolver {
     n: usize,
     factor: DMatrix<f64>,
+    /// Scratch by joint: the values the fixed joints are held at ([`Self::solve_holding`]), or a
+    /// unit column.
     rhs: Vec<f64>,
     /// Per joint, the piece of φ_i it is on (see [`JointLaw`]); kept between solves as the start
     /// (`UNKNOWN` before the first: at rest, where x = 0 lies).
@@ -404,32 +406,10 @@ impl StickSlipSolver {
                     *xi = if *gi != 0.0 { bi - *gi } else { *bi };
                 }
             }
-            let count = self.fixed.len();
-            if count > self.schur_max || count == n {
-                // many at rest (an arm holding still): their rows and columns taken out
-                let mut held = std::mem::take(&mut self.rhs);
-                for &j in &self.fixed {
-                    held[j] = 0.0;
-                }
-                let solved = self.solve_reduced(a, diagonal, x, &held);
-                self.rhs = held;
-                solved?;
-            } else {
-                if !self.factored_whole {
-                    self.factor_whole(a, diagonal)?;
-                }
-                self.substitute(x);
-                if count > 0 {
-                    for k in 0..count {
-                        self.column(self.fixed[k])?;
-                        self.schur_rhs[k] = -x[self.fixed[k]];
-                    }
-                    self.hold_fixed(x)?;
-                    for &i in &self.fixed {
-                        x[i] = 0.0;
-                    }
-                }
+            for &j in &self.fixed {
+                self.rhs[j] = 0.0;
             }
+            self.solve_holding(a, diagonal, x)?;
             let mut settled = true;
             for (i, ((&xi, law), side)) in x.iter().zip(laws).zip(self.trial.iter_mut()).enumerate() {
                 if *side == 0 {
@@ -546,13 +526,8 @@ impl StickSlipSolver {
     }
 
     /// The linear system for the current pieces: x_i fixed on a breakpoint, g_i = the slope on a
-    /// segment. Solved with F = A + diag factored once a solve, whatever the pieces: with a few
-    /// joints fixed (E their unit columns, c their values), x = y + W·μ with y = F⁻¹r, W = F⁻¹E
-    /// (a substitution per fixed joint, once a solve) and S·μ = c − Eᵀy, S = EᵀF⁻¹E the Schur
-    /// complement; with many, the reduced system (the fixed rows and columns taken out) is
-    /// factored instead.
+    /// segment ([`Self::solve_holding`]: F = A + diag factored once a solve, whatever the pieces).
     fn solve_on_pieces(&mut self, a: &[f64], diagonal: &[f64], b: &[f64], x: &mut [f64]) -> Result<(), NotPositiveDefinite> {
-        let n = self.n;
         self.fixed.clear();
         for (j, (&piece, shape)) in self.piece.iter().zip(&self.shapes).enumerate() {
             if piece % 2 == 0 {
@@ -563,12 +538,20 @@ impl StickSlipSolver {
                 self.fixed.push(j);
             }
         }
+        for &j in &self.fixed {
+            self.rhs[j] = self.shapes[j].points[self.piece[j] / 2];
+        }
+        self.solve_holding(a, diagonal, x)
+    }
+
+    /// F·x = r with the joints in `fixed` held at their values in `rhs` (x holds r on entry): with
+    /// a few, x = y + W·μ with y = F⁻¹r, W = F⁻¹E (a substitution per fixed joint, once a solve) and
+    /// S·μ = c − Eᵀy, S = EᵀF⁻¹E the Schur complement; with many, the reduced system (the fixed rows
+    /// and columns taken out) factored instead.
+    fn solve_holding(&mut self, a: &[f64], diagonal: &[f64], x: &mut [f64]) -> Result<(), NotPositiveDefinite> {
         let count = self.fixed.len();
-        if count > self.schur_max || count == n {
-            let mut held = std::mem::take(&mut self.rhs);
-            for &j in &self.fixed {
-                held[j] = self.shapes[j].points[self.piece[j] / 2];
-            }
+        if count > self.schur_max || count == self.n {
+            let held = std::mem::take(&mut self.rhs);
             let solved = self.solve_reduced(a, diagonal, x, &held);
             self.rhs = held;
             return solved;
@@ -584,12 +567,12 @@ impl StickSlipSolver {
             self.column(self.fixed[k])?;
         }
         for (l, &jl) in self.fixed.iter().enumerate() {
-            self.schur_rhs[l] = self.shapes[jl].points[self.piece[jl] / 2] - x[jl];
+            self.schur_rhs[l] = self.rhs[jl] - x[jl];
         }
         self.hold_fixed(x)?;
-        // on its breakpoint exactly, not to the rounding of the correction
+        // on its value exactly, not to the rounding of the correction
         for &j in &self.fixed {
-            x[j] = self.shapes[j].points[self.piece[j] / 2];
+            x[j] = self.rhs[j];
         }
         Ok(())
     }

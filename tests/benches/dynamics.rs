@@ -2,6 +2,7 @@
 //! (../shared/reference/README.md, 2-core machine): Pinocchio ABA 1.28 µs, RNEA 0.63 µs,
 //! CRBA 0.31 µs; MuJoCo 2.5 µs per step; the tutorial's 30 s default run 1.6 s.
 
+use armscope::actuator::StepperOutput;
 use armscope::config::RunConfig;
 use armscope::dynamics::{Data, aba, crba, forward_kinematics, gravity_and_bias_from_kinematics, rnea};
 use armscope::experiment::Experiment;
@@ -129,13 +130,7 @@ fn motors(c: &mut Criterion) {
                     controller.compute(q, v, &cmd, &cmd_dot, &data.gravity, armscope::control::controller::ControlOutput { u: &mut u, saturated: &mut sat, limit: &mut limit });
                     match steppers.as_mut() {
                         Some(s) => {
-                            s.command(&cmd, &cmd_dot, 0.001, q, v, &mut u);
-                            s.load_angles(q, &mut load_angle);
-                            s.lost_steps(&mut lost);
-                            s.limits(&u, v, &mut limit);
-                            for j in 0..6 {
-                                sat[j] = load_angle[j].abs() > 90.0;
-                            }
+                            s.control_step(&cmd, &cmd_dot, 0.001, q, v, StepperOutput { u: &mut u, limit: &mut limit, saturated: &mut sat, load_angle: &mut load_angle, lost_steps: &mut lost });
                             plant.advance_driven(model, &mut data, &mut u, &mut |h, q, v, u| s.plant_step(h, q, v, u), q, v);
                             s.update(q, 0.0, &mut events);
                             events.clear();
@@ -154,10 +149,7 @@ fn motors(c: &mut Criterion) {
     let steppers = RunConfig { urdf: urdf.clone(), motors: Some(motors.clone()), ..RunConfig::default() };
     // the steppers' run takes the plant step the stiffest stepper needs: the same run without
     // motors at that step is what a plant step of it costs without them
-    let stepper_plant_step = match Experiment::prepare(steppers.clone()).unwrap().plant {
-        armscope::experiment::PlantSpec::Discrete { time_step, .. } => time_step,
-        armscope::experiment::PlantSpec::Continuous { .. } => unreachable!("the default plant is discrete"),
-    };
+    let stepper_plant_step = Experiment::prepare(steppers.clone()).unwrap().plant.time_step().expect("the default plant is discrete");
     for (name, config) in [
         ("default_30s_without_motors", RunConfig { urdf: urdf.clone(), ..RunConfig::default() }),
         ("default_30s_servo_mode", RunConfig { urdf: urdf.clone(), motors: Some(motors.clone()), drive: armscope::config::DriveMode::Pd, ..RunConfig::default() }),

@@ -5,7 +5,7 @@
 //! few percent. `cargo bench --bench motor_cost [ROUNDS]` (default 30).
 
 use armscope::config::{DriveMode, RunConfig};
-use armscope::experiment::{Experiment, PlantSpec};
+use armscope::experiment::Experiment;
 use armscope::sim::simulate;
 use std::hint::black_box;
 use std::path::Path;
@@ -21,10 +21,7 @@ fn main() {
     let steppers = RunConfig { motors: Some(motors), ..bare.clone() };
     // the steppers' run takes the plant step its stiffest stepper needs: the run without motors at
     // that step is what its plant steps cost without them
-    let stepper_plant_step = match Experiment::prepare(steppers.clone()).expect("the tutorial's steppers").plant {
-        PlantSpec::Discrete { time_step, .. } => time_step,
-        PlantSpec::Continuous { .. } => unreachable!("the default plant is discrete"),
-    };
+    let stepper_plant_step = Experiment::prepare(steppers.clone()).expect("the tutorial's steppers").plant.time_step().expect("the default plant is discrete");
     let bare_at_stepper_step = RunConfig { time_step: Some(stepper_plant_step), ..bare.clone() };
     let pairs = [
         ("--drive pd", "the run without motors", bare, pd),
