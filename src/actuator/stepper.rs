@@ -38,17 +38,9 @@ impl Stepper {
         360.0 / self.step_angle_deg
     }
 
-    /// The detent torque at rotor angle `angle` (rad) from a detent position: the magnets pull the
-    /// rotor to the nearest one, −T_d·sin(2π·angle/step): one period per full step, the first
-    /// harmonic of a hybrid stepper's cogging (its unpowered rest positions are the full steps).
-    pub fn detent_torque_at(&self, angle: f64) -> f64 {
-        if self.detent_torque == 0.0 {
-            return 0.0;
-        }
-        self.detent().at(angle)
-    }
-
-    /// Its detent torque's amplitude and period.
+    /// Its detent torque's amplitude and period: the magnets pull the rotor to the nearest detent
+    /// position, −T_d·sin(2π·angle/step), one period per full step, the first harmonic of a hybrid
+    /// stepper's cogging (its unpowered rest positions are the full steps).
     pub fn detent(&self) -> Detent {
         Detent::new(self.detent_torque, self.step_angle_deg.to_radians())
     }
@@ -121,12 +113,12 @@ mod tests {
     #[test]
     fn detent_has_one_period_per_full_step_and_pulls_to_the_nearest_full_step() {
         let stepper = Stepper { name: "s".into(), holding_torque: 0.4, rotor_inertia: 5.4e-6, step_angle_deg: 1.8, pull_out: PullOut::Table(vec![(0.0, 0.4)]), damping: 0.0, detent_torque: 0.022 };
-        let step = 1.8f64.to_radians();
+        let (detent, step) = (stepper.detent(), 1.8f64.to_radians());
         for k in [-3.0, 0.0, 1.0, 7.0] {
-            assert!(stepper.detent_torque_at(k * step).abs() < 1e-15, "zero on full step {k}");
-            assert!((stepper.detent_torque_at(k * step + 0.25 * step) + 0.022).abs() < 1e-15, "a quarter step past: pulled back with T_d");
-            assert!((stepper.detent_torque_at(k * step - 0.25 * step) - 0.022).abs() < 1e-15);
+            assert!(detent.at(k * step).abs() < 1e-15, "zero on full step {k}");
+            assert!((detent.at(k * step + 0.25 * step) + 0.022).abs() < 1e-15, "a quarter step past: pulled back with T_d");
+            assert!((detent.at(k * step - 0.25 * step) - 0.022).abs() < 1e-15);
         }
-        assert!((stepper.detent_torque_at(0.1 * step) - stepper.detent_torque_at(1.1 * step)).abs() < 1e-15);
+        assert!((detent.at(0.1 * step) - detent.at(1.1 * step)).abs() < 1e-15);
     }
 }

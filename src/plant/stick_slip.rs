@@ -551,10 +551,7 @@ impl StickSlipSolver {
     fn solve_holding(&mut self, a: &[f64], diagonal: &[f64], x: &mut [f64]) -> Result<(), NotPositiveDefinite> {
         let count = self.fixed.len();
         if count > self.schur_max || count == self.n {
-            let held = std::mem::take(&mut self.rhs);
-            let solved = self.solve_reduced(a, diagonal, x, &held);
-            self.rhs = held;
-            return solved;
+            return self.solve_reduced(a, diagonal, x);
         }
         if !self.factored_whole {
             self.factor_whole(a, diagonal)?;
@@ -601,17 +598,17 @@ impl StickSlipSolver {
     }
 
     /// The linear system with the fixed joints' rows and columns taken out of A + diag (their
-    /// values, `held` by joint, moved to the right-hand side `x` holds), factored as it is.
-    fn solve_reduced(&mut self, a: &[f64], diagonal: &[f64], x: &mut [f64], held: &[f64]) -> Result<(), NotPositiveDefinite> {
+    /// values, in `rhs` by joint, moved to the right-hand side `x` holds), factored as it is.
+    fn solve_reduced(&mut self, a: &[f64], diagonal: &[f64], x: &mut [f64]) -> Result<(), NotPositiveDefinite> {
         if self.fixed.len() == self.n {
             // every joint fixed: nothing to solve
-            x.copy_from_slice(held);
+            x.copy_from_slice(&self.rhs);
             return Ok(());
         }
         self.load_matrix(a, diagonal);
         self.factored_whole = false;
         for &j in &self.fixed {
-            let fixed = held[j];
+            let fixed = self.rhs[j];
             for (i, xi) in x.iter_mut().enumerate() {
                 *xi -= self.factor[(i, j)] * fixed;
                 self.factor[(i, j)] = 0.0;
