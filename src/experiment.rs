@@ -533,7 +533,7 @@ fn install_drive_trains(model: &mut Model, set: &MotorSet) -> Result<(), Error> 
 /// firmware's goal the start pose; the discrete plant only (the servos' friction budgets are its).
 /// None without such servos.
 fn servo_setup(config: &RunConfig, model: &mut Model, motors: &MotorSet, start: &mut [f64], plant: &mut PlantSpec) -> Result<Option<FirmwareDrives>, Error> {
-    let Some(drives) = FirmwareDrives::new(motors, start) else { return Ok(None) };
+    let Some(drives) = FirmwareDrives::new(motors, start, config.dt) else { return Ok(None) };
     if matches!(plant, PlantSpec::Continuous { .. }) {
         return Err(Error::flag("--time-step", format!("0 (the continuous plant): the joints driven by their servos' firmware ({}) need the discrete plant, which takes their friction budgets; --drive pd runs them on the continuous plant as torque sources", names(model, &drives.driven))));
     }

@@ -57,7 +57,7 @@ fn row_of<'a>(rows: &'a [String], name: &str) -> &'a str {
     let squash = |s: &str| s.chars().filter(|c| c.is_ascii_alphanumeric()).collect::<String>().to_lowercase();
     let spelled = match name {
         "NEMA17-RobotShop-1182" => "NEMA17 per RobotShop datasheet-1182",
-        "STS3215-C018" => "Feetech ST-3215-C018",
+        "STS3215-C018" | "STS3215-C018-BAM12V" => "Feetech ST-3215-C018",
         "EC-i40-488607" => "maxon EC-i 40 100 W (488607)",
         "EC45flat-50W-24V" => "maxon EC 45 flat 50 W (6516xx)",
         "HD17-20" => "Robrotics HD17",

@@ -128,7 +128,18 @@ impl Catalogue {
                 entries.insert(name, t);
             }
         }
+        for (name, t) in &entries {
+            if let Some(of) = t.get("variant_of").and_then(Value::as_str).filter(|of| !entries.contains_key(*of)) {
+                return Err(fail(path, format!("motor '{name}': field 'variant_of' names '{of}', which is not in the catalogue")));
+            }
+        }
         Ok(Self { entries, reductions, source: path.to_path_buf() })
+    }
+
+    /// The entry motor `name` is a variant of (the same motor, other identified parameters): sizing
+    /// tries a variant only when asked for it by name.
+    pub fn variant_of(&self, name: &str) -> Option<&str> {
+        self.entries.get(name)?.get("variant_of").and_then(Value::as_str)
     }
 
     /// The built-in catalogue with a user's file on top (its entries added, or replacing the
@@ -188,6 +199,18 @@ impl Catalogue {
         self.entries.get(name).map(|t| drive_train_from(&self.source, name, t))
     }
 
+    /// The identified parameters of the servo named `name` (its `[NAME.firmware]` table), or None
+    /// when the catalogue has no such motor or it has no firmware model.
+    pub fn servo_params(&self, name: &str) -> Option<Result<super::bus_servo::ServoParams, Error>> {
+        let Value::Table(firmware) = self.entries.get(name)?.get("firmware")? else { return None };
+        Some(firmware_params(&self.source, name, firmware))
+    }
+
+    /// The motors with a firmware model, for messages.
+    pub fn servo_names(&self) -> String {
+        self.entries.iter().filter(|(_, t)| t.get("firmware").is_some_and(Value::is_table)).map(|(n, _)| n.as_str()).collect::<Vec<_>>().join(", ")
+    }
+
     /// The motor's mass in kg, if the catalogue gives it.
     pub fn mass(&self, name: &str) -> Option<f64> {
         self.entries.get(name)?.get("mass").and_then(|v| v.as_float().or(v.as_integer().map(|i| i as f64)))
@@ -239,7 +262,10 @@ fn drive_train_from(source: &Path, name: &str, t: &toml::Table) -> Result<DriveT
         // straight torque–speed line from the stall torque to the no-load speed; a servo's firmware
         // model where identified
         "servo" | "dc" => {
-            fields.known(&[&common[..], &["stall_torque", "no_load_speed", "mass", "voltage", "inductance", "continuous_torque", "firmware"]].concat())?;
+            fields.known(&[&common[..], &["stall_torque", "no_load_speed", "mass", "voltage", "inductance", "continuous_torque", "firmware", "variant_of"]].concat())?;
+            if t.get("variant_of").is_some_and(|v| !v.is_str()) {
+                return Err(fields.err("variant_of", "must be the name of the catalogue entry this one is a variant of"));
+            }
             let line = match (t.contains_key("stall_torque") || !t.contains_key("firmware"), kind.as_str()) {
                 (true, _) | (_, "dc") => Some(DcServo { name: name.to_string(), stall_torque: fields.positive("stall_torque")?, no_load_speed: fields.positive("no_load_speed")?, rotor_inertia: fields.non_negative("rotor_inertia")? }),
                 _ => None,
@@ -341,6 +367,21 @@ fn protection_registers(fields: &Fields, motor: &str, drive: &mut DriveTrain) ->
 fn firmware_from(source: &Path, name: &str, table: &toml::Table, voltage: Option<f64>, line: Option<&DcServo>) -> Result<super::BusServo, Error> {
     let what = format!("motor '{name}'");
     let fields = Fields { file: source, what: &what, table };
+    let params = firmware_params(source, name, table)?;
+    let kp = fields.optional_positive("kp")?.unwrap_or(params.family.default_kp);
+    let supply = match (fields.optional_positive("supply_voltage")?, voltage) {
+        (Some(v), _) | (None, Some(v)) => v,
+        (None, None) => params.family.nominal_supply,
+    };
+    let mut servo = super::BusServo::from_params(name, &params, kp, supply);
+    servo.envelope = line.map(|l| (l.stall_torque, l.no_load_speed));
+    Ok(servo)
+}
+
+/// A servo entry's `firmware` table as the identified parameters (BAM's keys).
+fn firmware_params(source: &Path, name: &str, table: &toml::Table) -> Result<super::bus_servo::ServoParams, Error> {
+    let what = format!("motor '{name}'");
+    let fields = Fields { file: source, what: &what, table };
     let family = fields.string("family").map_err(|_| fields.err("firmware.family", "is missing: the servo's firmware (xl330, xl320, mx64, mx106, sts3215)"))?;
     let mut json = serde_json::Map::new();
     for (key, value) in table {
@@ -366,14 +407,7 @@ fn firmware_from(source: &Path, name: &str, table: &toml::Table, voltage: Option
     if !table.get("source").and_then(Value::as_str).is_some_and(|s| !s.trim().is_empty()) {
         return Err(fields.err("firmware.source", "is missing: where the identified parameters were read"));
     }
-    let kp = fields.optional_positive("kp")?.unwrap_or(params.family.default_kp);
-    let supply = match (fields.optional_positive("supply_voltage")?, voltage) {
-        (Some(v), _) | (None, Some(v)) => v,
-        (None, None) => params.family.nominal_supply,
-    };
-    let mut servo = super::BusServo::from_params(name, &params, kp, supply);
-    servo.envelope = line.map(|l| (l.stall_torque, l.no_load_speed));
-    Ok(servo)
+    Ok(params)
 }
 
 /// A catalogue reduction; errors name `source`, the entry and the field.

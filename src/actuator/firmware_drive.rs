@@ -1,7 +1,9 @@
 //! Firmware mode: joints driven by their serial-bus servo's own position loop, as a LeRobot or
 //! Dynamixel arm runs (no PD of armscope's: the command is the servo's goal position).
 //!
-//! The command is the goal position, held over the control period. The firmware ticks at every
+//! The command is the goal position, held over the control period; a servo with a command delay
+//! acts on the goal sent that long before (a delay line of the goals sent, filled when the drives
+//! are made: nothing is allocated while the arm runs). The firmware ticks at every
 //! plant step (a servo's loop runs at kilohertz rates, faster than a host sends goals): its duty
 //! from the goal and the position, in the servo's units ([`super::bus_servo::firmware`]), and the
 //! motor's torque at the joint's speed through its back-EMF, both at the plant step's start. Behind a further reduction of
@@ -22,6 +24,12 @@ struct ServoJoint {
     state: FirmwareState,
     /// The goal at the servo (N × the command).
     goal: f64,
+    /// The goals sent, newest at `newest`, as many as the command delay spans plus two.
+    sent: Vec<f64>,
+    newest: usize,
+    /// The command delay in control periods: whole ones, and the fraction beyond.
+    delay_periods: usize,
+    delay_fraction: f64,
     /// The motor at the last plant step's start.
     out: ServoOutput,
 }
@@ -50,8 +58,9 @@ pub struct FirmwareDrives {
 
 impl FirmwareDrives {
     /// The joints of `motors` whose servo has a firmware model; None when there are none. `start`
-    /// is where each firmware's internal target starts (a Feetech's walks from there).
-    pub fn new(motors: &MotorSet, start: &[f64]) -> Option<Self> {
+    /// is where each firmware's internal target starts (a Feetech's walks from there), and the goal
+    /// every servo has had before the first command; commands come every `control_dt` s.
+    pub fn new(motors: &MotorSet, start: &[f64], control_dt: f64) -> Option<Self> {
         let joints: Vec<ServoJoint> = motors
             .joints
             .iter()
@@ -59,7 +68,10 @@ impl FirmwareDrives {
             .filter_map(|(j, d)| {
                 let d = d.as_ref()?;
                 let servo = d.servo.clone()?;
-                Some(ServoJoint { joint: j, servo, gear_ratio: d.gear_ratio, state: FirmwareState::at(d.gear_ratio * start[j]), goal: d.gear_ratio * start[j], out: ServoOutput::default() })
+                let goal = d.gear_ratio * start[j];
+                let periods = servo.command_delay / control_dt;
+                let delay_periods = periods.floor() as usize;
+                Some(ServoJoint { joint: j, servo, gear_ratio: d.gear_ratio, state: FirmwareState::at(goal), goal, sent: vec![goal; delay_periods + 2], newest: 0, delay_periods, delay_fraction: periods - delay_periods as f64, out: ServoOutput::default() })
             })
             .collect();
         if joints.is_empty() {
@@ -77,7 +89,12 @@ impl FirmwareDrives {
     /// (other joints untouched).
     pub fn command(&mut self, cmd: &[f64], q: &[f64], v: &[f64], h: f64, u: &mut [f64]) {
         for s in &mut self.joints {
-            s.goal = s.gear_ratio * cmd[s.joint];
+            s.newest = (s.newest + 1) % s.sent.len();
+            s.sent[s.newest] = s.gear_ratio * cmd[s.joint];
+            let len = s.sent.len();
+            let at = |periods: usize| s.sent[(s.newest + len - periods) % len];
+            let (later, earlier) = (at(s.delay_periods), at(s.delay_periods + 1));
+            s.goal = later + s.delay_fraction * (earlier - later);
         }
         self.tick(h, q, v, u);
         self.ticked = true;

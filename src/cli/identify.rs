@@ -2,7 +2,8 @@
 
 use super::*;
 use crate::actuator::bus_servo::{FrictionModel, firmware};
-use crate::identify::{FitOptions, Space, fit};
+use crate::identify::{FitOptions, Progress, Space, fit};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use crate::testbench::{BenchLog, ReplayOptions, Step, Supply, mae};
 
 #[derive(Args, Debug)]
@@ -28,8 +29,9 @@ pub struct IdentifyArgs {
     /// Exact steps per log row (--step exact).
     #[arg(long, default_value_t = 5)]
     pub substeps: usize,
-    /// nominal: the header's vin; measured: the logs' input_volts row by row.
-    #[arg(long, value_enum, default_value_t = Supply::Nominal)]
+    /// auto: the header's vin, or the log's input_volts row by row where the two disagree by more than
+    /// 10 %; nominal: the header's vin; measured: the logs' input_volts row by row.
+    #[arg(long, value_enum, default_value_t = Supply::Auto)]
     pub supply: Supply,
     /// Also fit a resistance on the bridge's supply side (a loss growing with the duty squared; BAM
     /// assumes an ideal supply).
@@ -38,19 +40,29 @@ pub struct IdentifyArgs {
     /// Also fit the largest voltage the servo puts across its motor (BAM assumes duty × supply).
     #[arg(long)]
     pub fit_motor_voltage_limit: bool,
-    /// Also start the refinement from these parameters (BAM's JSON).
+    /// Leave the command delay out (0, as BAM's model has it): by default it is fitted, the time
+    /// from a goal's sending to the firmware acting on it (the bus, the register read, the loop's
+    /// period).
+    #[arg(long)]
+    pub no_command_delay: bool,
+    /// Start the first search from these parameters (BAM's JSON; by default the search space's
+    /// centre).
     #[arg(long, value_name = "P.json")]
     pub start: Option<PathBuf>,
     /// The grid a raw log is resampled to, s.
     #[arg(long, value_name = "SECONDS", default_value_t = crate::testbench::log::DEFAULT_DT)]
     pub dt: f64,
-    /// Particles of the global search.
-    #[arg(long, default_value_t = FitOptions::default().particles)]
-    pub particles: usize,
-    /// Iterations of the global search.
-    #[arg(long, default_value_t = FitOptions::default().swarm_iterations)]
-    pub iterations: u64,
-    /// Independent global searches; the best wins.
+    /// Candidates a generation of the search (CMA-ES's λ; 0: its default for the number of
+    /// parameters, rounded up to a multiple of the cores).
+    #[arg(long, default_value_t = FitOptions::default().population)]
+    pub population: usize,
+    /// Generations at most of each search on the windowed replay (the first stage).
+    #[arg(long, default_value_t = FitOptions::default().generations)]
+    pub generations: usize,
+    /// Generations at most of the refinement on the free-running replay (the second stage).
+    #[arg(long, default_value_t = FitOptions::default().refine_generations)]
+    pub refine_generations: usize,
+    /// Independent searches of the first stage, from different starts; the best is refined.
     #[arg(long, default_value_t = FitOptions::default().searches)]
     pub searches: usize,
     /// The random seed of the global search (the same seed, logs and flags give the same fit).
@@ -77,6 +89,8 @@ struct IdentifySummary {
     step: Step,
     supply: Supply,
     evaluations: usize,
+    replays: usize,
+    replays_stopped: usize,
     seconds: f64,
     train: Vec<LogMae>,
     train_mean_mae_rad: f64,
@@ -100,15 +114,19 @@ pub fn identify(args: &IdentifyArgs) -> Result<i32, Error> {
     if args.substeps == 0 {
         return Err(Error::flag("--substeps", "must be at least 1"));
     }
-    if args.particles < 2 {
-        return Err(Error::flag("--particles", "must be at least 2"));
+    if args.population == 1 {
+        return Err(Error::flag("--population", "must be at least 2 (or 0 for CMA-ES's default)"));
+    }
+    if args.generations == 0 {
+        return Err(Error::flag("--generations", "must be at least 1"));
     }
     if !(args.dt.is_finite() && args.dt > 0.0) {
         return Err(Error::flag("--dt", format!("must be a positive number of seconds (got {})", args.dt)));
     }
     let replay = ReplayOptions { step: args.step, substeps: args.substeps, supply: args.supply, reset_rows: None, ..Default::default() };
-    let train = read_logs(&args.logs, args.dt)?;
-    let validate = read_logs(&args.validate, args.dt)?;
+    let all: Vec<PathBuf> = args.logs.iter().chain(&args.validate).cloned().collect();
+    let mut train = read_logs_for(&all, args.dt, args.supply)?;
+    let validate = train.split_off(args.logs.len());
     for log in train.iter().chain(&validate) {
         if firmware::family(&log.actuator).map(|f| f.name) != Some(family.name) {
             return Err(Error::flag("LOG", format!("{}: field 'motor' is '{}', but --actuator is {}", log.path.display(), log.actuator, family.name)));
@@ -128,10 +146,24 @@ pub fn identify(args: &IdentifyArgs) -> Result<i32, Error> {
         }
         None => None,
     };
-    let space = Space::new(family, args.friction_model, args.fit_supply_resistance, args.fit_motor_voltage_limit);
-    let options = FitOptions { searches: args.searches, particles: args.particles, swarm_iterations: args.iterations, seed: args.seed, start, ..Default::default() };
+    let space = Space::new(family, args.friction_model, args.fit_supply_resistance, args.fit_motor_voltage_limit, !args.no_command_delay);
+    let options = FitOptions { searches: args.searches, population: args.population, generations: args.generations, refine_generations: args.refine_generations, seed: args.seed, start };
     let started = std::time::Instant::now();
-    let found = fit(&space, &train, replay, &options).map_err(|m| Error::flag("identify", m))?;
+    let bar = ProgressBar::new(0);
+    if args.quiet {
+        bar.set_draw_target(ProgressDrawTarget::hidden());
+    } else {
+        bar.set_style(ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:30} {pos}/{len} generations  {msg}").unwrap_or_else(|_| ProgressStyle::default_bar()));
+        bar.enable_steady_tick(std::time::Duration::from_millis(200));
+    }
+    let progress = |p: Progress| {
+        bar.set_length(p.generations as u64);
+        bar.set_position(p.generation as u64);
+        let search = if p.searches > 1 { format!(" search {}/{}", p.search + 1, p.searches) } else { String::new() };
+        bar.set_message(format!("{}{search}: best {:.2} mrad", p.stage, 1e3 * p.best));
+    };
+    let found = fit(&space, &train, replay, &options, &progress).map_err(|m| Error::flag("identify", m))?;
+    bar.finish_and_clear();
     let seconds = started.elapsed().as_secs_f64();
     let train_maes = maes(&train, &found.params, &replay);
     let validate_maes = maes(&validate, &found.params, &replay);
@@ -140,7 +172,16 @@ pub fn identify(args: &IdentifyArgs) -> Result<i32, Error> {
     crate::runner::create_parent(&args.out)?;
     std::fs::write(&args.out, serde_json::to_string_pretty(&file_json).unwrap_or_default() + "\n").map_err(|e| Error::output(&args.out, e))?;
     if !args.quiet {
-        println!("{} {} fitted to {} log(s) in {seconds:.1} s ({} replays of every log; the searches ended at {} mrad):", family.name, args.friction_model.name(), train.len(), found.evaluations, found.search_losses.iter().map(|l| format!("{:.2}", 1e3 * l)).collect::<Vec<_>>().join(", "));
+        println!(
+            "{} {} fitted to {} log(s) in {seconds:.1} s ({} candidates: {} log replays run through, {} stopped once they could not do better; the windowed searches ended at {} mrad):",
+            family.name,
+            args.friction_model.name(),
+            train.len(),
+            found.evaluations,
+            found.replays,
+            found.replays_stopped,
+            found.search_losses.iter().map(|l| format!("{:.2}", 1e3 * l)).collect::<Vec<_>>().join(", ")
+        );
         let width = train.iter().chain(&validate).map(|l| l.name().chars().count()).max().unwrap_or(4);
         for (log, m) in train.iter().zip(&train_maes) {
             println!("  train     {:<width$} MAE {:>7.2} mrad", log.name(), 1e3 * m.mae_rad);
@@ -164,6 +205,8 @@ pub fn identify(args: &IdentifyArgs) -> Result<i32, Error> {
             step: args.step,
             supply: args.supply,
             evaluations: found.evaluations,
+            replays: found.replays,
+            replays_stopped: found.replays_stopped,
             seconds,
             train_mean_mae_rad: mean(&train_maes),
             validate_mean_mae_rad: (!validate_maes.is_empty()).then(|| mean(&validate_maes)),

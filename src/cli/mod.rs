@@ -26,7 +26,7 @@ pub use replay::{ReplayArgs, replay, trace_path};
 pub use crate::flags::{GainArgs, MotorArgs, RunArgs, WaveArgs};
 pub use run::{default_run_name, run};
 pub use size::{SizeArgs, parse_ratios, size};
-pub use testbench::{TestbenchArgs, read_logs, read_params, testbench};
+pub use testbench::{TestbenchArgs, read_logs, read_logs_for, read_params, servo_of, testbench};
 pub use trajectory::{TrajectoryArgs, trajectory};
 
 use crate::config::{IntegratorKind, RunConfig};

@@ -311,7 +311,8 @@ pub fn size(args: &SizeArgs) -> Result<i32, Error> {
             names.clone()
         }
         None => {
-            let (with, without): (Vec<String>, Vec<String>) = catalogue.entries.keys().cloned().partition(|name| catalogue.mass(name).is_some());
+            // a variant (the same motor, other identified parameters) is tried when named
+            let (with, without): (Vec<String>, Vec<String>) = catalogue.entries.keys().filter(|name| catalogue.variant_of(name).is_none()).cloned().partition(|name| catalogue.mass(name).is_some());
             if !without.is_empty() {
                 // one line for all, as for the reductions below (it was a line a motor: 17 with the built-in catalogue)
                 eprintln!("armscope: notice: motors left out, no mass published in {} (sizing ranks by mass): {}", catalogue_path.display(), without.join(", "));

@@ -1,8 +1,9 @@
 //! Identifying a servo from bench logs (`armscope identify`): which parameters and where to look
-//! ([`space`]), and the fit ([`fit`]).
+//! ([`space`]), and the fit ([`fit`]) with CMA-ES ([`cmaes`]).
 
+pub mod cmaes;
 pub mod fit;
 pub mod space;
 
-pub use fit::{Fit, FitOptions, fit};
+pub use fit::{Fit, FitOptions, Progress, fit};
 pub use space::Space;

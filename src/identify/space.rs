@@ -33,6 +33,11 @@ impl Dimension {
     }
 }
 
+/// The command delays identification searches, s: a bus servo's transfer, register read and
+/// control period add up to milliseconds to tens of them (K-Scale's STS3215 logs fit 20–30 ms);
+/// 100 ms is past any of them.
+pub const COMMAND_DELAY_RANGE: f64 = 0.1;
+
 /// The search space of one servo family and friction model.
 #[derive(Clone, Debug)]
 pub struct Space {
@@ -43,8 +48,10 @@ pub struct Space {
 
 impl Space {
     /// BAM's parameters for `family` with friction `model`, plus the supply's resistance when
-    /// `supply_resistance` (armscope's: 0 … 2 Ω).
-    pub fn new(family: Family, model: FrictionModel, supply_resistance: bool, motor_voltage_limit: bool) -> Self {
+    /// `supply_resistance` (armscope's: 0 … 2 Ω), the motor's voltage limit when
+    /// `motor_voltage_limit`, and the command delay (0 … [`COMMAND_DELAY_RANGE`] s) when
+    /// `command_delay`.
+    pub fn new(family: Family, model: FrictionModel, supply_resistance: bool, motor_voltage_limit: bool, command_delay: bool) -> Self {
         let mut d = Vec::new();
         let (max_load, feetech) = (if family.name == "xl320" { 1.0 } else { 0.5 }, family.goal_speed_limiter);
         match family.name {
@@ -77,6 +84,9 @@ impl Space {
         if motor_voltage_limit {
             d.push(Dimension::new(crate::actuator::bus_servo::params::MOTOR_VOLTAGE_LIMIT_KEY, 0.3 * family.nominal_supply, 2.0 * family.nominal_supply));
         }
+        if command_delay {
+            d.push(Dimension::new(crate::actuator::bus_servo::params::COMMAND_DELAY_KEY, 0.0, COMMAND_DELAY_RANGE));
+        }
         Self { family, model, dimensions: d }
     }
 
@@ -101,6 +111,7 @@ impl Space {
             max_velocity: self.family.default_max_velocity,
             supply_resistance: 0.0,
             motor_voltage_limit: f64::INFINITY,
+            command_delay: 0.0,
         };
         for (d, &u) in self.dimensions.iter().zip(u) {
             set(&mut p, d.key, d.value(u));
@@ -124,6 +135,7 @@ fn set(p: &mut ServoParams, key: &str, x: f64) {
         "max_velocity" => p.max_velocity = x,
         "supply_resistance" => p.supply_resistance = x,
         "motor_voltage_limit" => p.motor_voltage_limit = x,
+        "command_delay" => p.command_delay = x,
         _ => {
             p.friction.set(key, x);
         }
@@ -140,6 +152,7 @@ fn get(p: &ServoParams, key: &str) -> f64 {
         "max_velocity" => p.max_velocity,
         "supply_resistance" => p.supply_resistance,
         "motor_voltage_limit" => p.motor_voltage_limit,
+        "command_delay" => p.command_delay,
         _ => p.friction.get(key).unwrap_or(0.0),
     }
 }
@@ -152,14 +165,14 @@ mod tests {
     #[test]
     fn points_and_params_round_trip() {
         for (family, model) in [(XL330, FrictionModel::M6), (STS3215, FrictionModel::M1), (XL330, FrictionModel::M4)] {
-            let space = Space::new(family, model, true, true);
+            let space = Space::new(family, model, true, true, true);
             let u: Vec<f64> = (0..space.len()).map(|i| (i as f64 * 0.37).fract()).collect();
             let back = space.point(&space.params(&u));
             for (a, b) in u.iter().zip(&back) {
                 assert!((a - b).abs() < 1e-12, "{a} vs {b}");
             }
         }
-        let space = Space::new(XL330, FrictionModel::M6, false, false);
+        let space = Space::new(XL330, FrictionModel::M6, false, false, false);
         assert_eq!(space.len(), 3 + 1 + 11);
         let armature = space.dimensions.iter().find(|d| d.key == "armature").unwrap();
         assert!(armature.logarithmic);

@@ -8,6 +8,11 @@
 //! onto that grid as `bam.process` does: t_k = k·Δt for t_k below the last raw timestamp, each field
 //! interpolated linearly between the raw entries around t_k (extrapolated from the first two before
 //! the first), `torque_enable` interpolated as 0/1 and thresholded at ½.
+//!
+//! Read as a second lab's logs are (K-Scale Labs' STS3215 set): an isolated sample at −π (the
+//! encoder's read failure: one or two rows within a few counts of −π between rows far from it) is
+//! dropped before resampling and counted ([`BenchLog::glitches`]); the header's `vin` is kept as
+//! written, and [`BenchLog::measured_supply`] says what the servo's own voltage reading gave.
 
 use std::path::{Path, PathBuf};
 
@@ -49,8 +54,18 @@ pub struct BenchLog {
     pub dt: f64,
     /// Whether it was resampled here from a raw log.
     pub resampled: bool,
+    /// Isolated samples at −π (encoder read glitches) dropped from the log.
+    pub glitches: usize,
     pub entries: Vec<Entry>,
 }
+
+/// A position within this of −π is the encoder's read failure value (a few counts of a 4096-count
+/// encoder: 2π/4096 = 1.5 mrad a count; K-Scale's glitches read −3.1401, one count above −π).
+const GLITCH_TOLERANCE: f64 = 0.01;
+/// A glitch is isolated: the rows on either side are this far from it, rad.
+const GLITCH_JUMP: f64 = 0.5;
+/// A glitch is at most this many rows in a row.
+const GLITCH_MAX_ROWS: usize = 2;
 
 /// A raw entry, before resampling.
 #[derive(Clone, Copy, Debug)]
@@ -140,6 +155,10 @@ impl BenchLog {
                 volts: field("input_volts")?,
             });
         }
+        let glitches = drop_glitches(&mut raw);
+        if raw.len() < 2 {
+            return Err(format!("{file}: field 'entries' has {} entries once its samples at −π (encoder read glitches) are dropped; a log needs at least 2", raw.len()));
+        }
         if let Some(k) = raw.windows(2).position(|w| !(w[1].timestamp > w[0].timestamp)) {
             return Err(format!("{file}: entries[{}].timestamp {} does not increase (after {} at entries[{k}])", k + 1, raw[k + 1].timestamp, raw[k].timestamp));
         }
@@ -175,7 +194,23 @@ impl BenchLog {
                 (step, resample(&raw, step), true)
             }
         };
-        Ok(Self { path: path.to_path_buf(), mass, arm_mass, length, kp, vin, actuator, trajectory, dt, resampled, entries })
+        Ok(Self { path: path.to_path_buf(), mass, arm_mass, length, kp, vin, actuator, trajectory, dt, resampled, glitches, entries })
+    }
+
+    /// The median of the supply the servo measured, V (None: the log has no `input_volts`).
+    pub fn measured_supply(&self) -> Option<f64> {
+        let mut volts: Vec<f64> = self.entries.iter().filter_map(|e| e.volts).collect();
+        if volts.is_empty() {
+            return None;
+        }
+        volts.sort_by(f64::total_cmp);
+        Some(volts[volts.len() / 2])
+    }
+
+    /// Whether the header's `vin` disagrees with the measured supply by more than
+    /// [`SUPPLY_DISAGREEMENT`] (None: nothing measured).
+    pub fn supply_disagrees(&self) -> Option<bool> {
+        self.measured_supply().map(|v| (v - self.vin).abs() > SUPPLY_DISAGREEMENT * self.vin)
     }
 
     /// The log's name: its file name without `.json` (and `.processed` / `.raw`).
@@ -189,6 +224,36 @@ impl BenchLog {
     pub fn duration(&self) -> f64 {
         self.entries.len() as f64 * self.dt
     }
+}
+
+/// A header's `vin` more than this fraction away from the measured supply's median disagrees with
+/// it. BAM's XL330 logs (vin 7.4 V) read 5.8–9.2 V row by row, medians within 3 % of 7.4; K-Scale's
+/// STS3215 logs say 15 V and read 11.7–12.2 V (20 % below).
+pub const SUPPLY_DISAGREEMENT: f64 = 0.1;
+
+/// Drop runs of at most [`GLITCH_MAX_ROWS`] rows at −π whose neighbours (on each side the log has
+/// one) are at least [`GLITCH_JUMP`] away; the count dropped.
+fn drop_glitches(raw: &mut Vec<RawEntry>) -> usize {
+    let at_minus_pi = |r: &RawEntry| (r.position + std::f64::consts::PI).abs() <= GLITCH_TOLERANCE;
+    let mut keep = vec![true; raw.len()];
+    let mut i = 0;
+    while i < raw.len() {
+        if !at_minus_pi(&raw[i]) {
+            i += 1;
+            continue;
+        }
+        let end = (i..raw.len()).find(|&j| !at_minus_pi(&raw[j])).unwrap_or(raw.len());
+        let far = |j: usize| (raw[j].position - raw[i].position).abs() >= GLITCH_JUMP;
+        let isolated = end - i <= GLITCH_MAX_ROWS && (i > 0 || end < raw.len()) && (i == 0 || far(i - 1)) && (end == raw.len() || far(end));
+        if isolated {
+            keep[i..end].iter_mut().for_each(|k| *k = false);
+        }
+        i = end;
+    }
+    let before = raw.len();
+    let mut flags = keep.into_iter();
+    raw.retain(|_| flags.next().unwrap_or(true));
+    before - raw.len()
 }
 
 fn entry(time: f64, goal: f64, enabled: bool, position: f64, speed: f64, duty: Option<f64>, volts: Option<f64>) -> Entry {
@@ -245,6 +310,25 @@ mod tests {
         // torque_enable thresholded at ½: at 0.015, 6/7 of the way to 0
         assert!(!log.entries[3].enabled);
         assert_eq!(log.name(), "x");
+    }
+
+    #[test]
+    fn isolated_samples_at_minus_pi_are_dropped_and_counted() {
+        // K-Scale's glitch: one row reads −3.1401 between rows at 1.22 rad; a run of two as well;
+        // a real swing through −π (neighbours close to it) is kept
+        let row = |t: f64, q: f64| format!(r#"{{"timestamp": {t}, "position": {q}, "speed": 0, "goal_position": 0.0, "torque_enable": true, "input_volts": 12.0}}"#);
+        let rows = [row(0.0, 1.22), row(0.01, 1.223), row(0.02, -3.1401), row(0.03, 1.223), row(0.04, -3.1401), row(0.05, -3.1405), row(0.06, 1.2), row(0.07, -3.0), row(0.08, -3.14), row(0.09, -3.1)];
+        let text = raw_log(&rows.join(",")).replace("xl330", "sts3215v12");
+        let log = BenchLog::parse(&text, Path::new("k.json"), Some(0.01)).unwrap();
+        assert_eq!(log.glitches, 3);
+        assert_eq!(log.actuator, "sts3215v12");
+        // the row at 0.02 is interpolated between its neighbours, not pulled towards −π
+        assert!((log.entries[2].position - 1.223).abs() < 1e-12, "{:?}", log.entries[2]);
+        assert!(log.entries.iter().all(|e| e.position > -3.2));
+        assert!((log.entries[8].position - (-3.14)).abs() < 1e-12);
+        // the supply: 12 V measured against the header's 7.4 (the raw_log header) disagrees
+        assert_eq!(log.measured_supply(), Some(12.0));
+        assert_eq!(log.supply_disagrees(), Some(true));
     }
 
     #[test]

@@ -4,6 +4,7 @@
 
 pub mod log;
 pub mod pendulum;
+pub mod reading;
 pub mod recording;
 pub mod replay;
 pub mod report;
@@ -11,5 +12,5 @@ pub mod synthetic;
 
 pub use log::BenchLog;
 pub use pendulum::Pendulum;
-pub use replay::{ReplayOptions, Rollout, Step, Supply, mae, rollout};
+pub use replay::{ReplayOptions, Rollout, Step, Supply, mae, mae_within, rollout};
 pub use report::{LogResult, Summary};

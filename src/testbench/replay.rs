@@ -1,6 +1,7 @@
 //! Replaying a bench log: the log's goals and torque enables sent to a simulated servo on the
 //! log's pendulum, from the log's first measured state, never re-synchronised (BAM's
-//! `rollout_log` with the control simulated).
+//! `rollout_log` with the control simulated). The firmware acts on each goal its
+//! `command_delay` after the log sent it (0 in BAM's files).
 //!
 //! Two steps, chosen by [`Step`]:
 //! - **BAM's** explicit step of Δt = the log's dt, which BAM's identified files were fitted with
@@ -32,11 +33,25 @@ pub enum Step {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum Supply {
-    /// The header's nominal `vin` (BAM's assumption).
+    /// The header's `vin`, unless the log's measured supply disagrees with it (by more than 10 %):
+    /// then the measured one, row by row.
     #[default]
+    Auto,
+    /// The header's nominal `vin` (BAM's assumption).
     Nominal,
     /// The log's measured `input_volts` at each row (the nominal where a row has none).
     Measured,
+}
+
+impl Supply {
+    /// Whether `log` is replayed on its measured supply.
+    pub fn measured_for(self, log: &BenchLog) -> bool {
+        match self {
+            Supply::Auto => log.supply_disagrees() == Some(true),
+            Supply::Nominal => false,
+            Supply::Measured => true,
+        }
+    }
 }
 
 /// How to replay.
@@ -55,7 +70,7 @@ pub struct ReplayOptions {
 
 impl Default for ReplayOptions {
     fn default() -> Self {
-        Self { step: Step::Bam, substeps: 5, supply: Supply::Nominal, reset_rows: None, gravity: super::pendulum::GRAVITY }
+        Self { step: Step::Bam, substeps: 5, supply: Supply::Auto, reset_rows: None, gravity: super::pendulum::GRAVITY }
     }
 }
 
@@ -95,41 +110,44 @@ struct Bench {
     pendulum: Pendulum,
     q_offset: f64,
     inertia: f64,
+    measured_supply: bool,
 }
 
 impl Bench {
-    fn new(log: &BenchLog, params: &ServoParams, gravity: f64) -> Self {
+    fn new(log: &BenchLog, params: &ServoParams, options: &ReplayOptions) -> Self {
         let servo = BusServo::from_params(&log.actuator, params, log.kp, log.vin);
-        let pendulum = Pendulum::from_log(log, gravity);
-        Self { inertia: pendulum.inertia() + params.armature, servo, pendulum, q_offset: params.q_offset }
+        let pendulum = Pendulum::from_log(log, options.gravity);
+        Self { inertia: pendulum.inertia() + params.armature, servo, pendulum, q_offset: params.q_offset, measured_supply: options.supply.measured_for(log) }
     }
 
-    fn supply(&self, log: &BenchLog, row: usize, options: &ReplayOptions) -> f64 {
-        match options.supply {
-            Supply::Nominal => log.vin,
-            Supply::Measured => log.entries[row].volts.unwrap_or(log.vin),
-        }
+    fn supply(&self, log: &BenchLog, row: usize) -> f64 {
+        if self.measured_supply { log.entries[row].volts.unwrap_or(log.vin) } else { log.vin }
     }
 }
 
-/// Replay `log` with the servo of `params`; `record` gets each row's state before its step.
-fn replay(log: &BenchLog, params: &ServoParams, options: &ReplayOptions, mut record: impl FnMut(usize, f64, f64, &crate::actuator::bus_servo::ServoOutput)) {
-    let bench = Bench::new(log, params, options.gravity);
+/// Replay `log` with the servo of `params`; `record` gets each row's state before its step, and
+/// stops the replay by returning false.
+fn replay(log: &BenchLog, params: &ServoParams, options: &ReplayOptions, mut record: impl FnMut(usize, f64, f64, &crate::actuator::bus_servo::ServoOutput) -> bool) {
+    let bench = Bench::new(log, params, options);
     let dt = log.dt;
     let first = &log.entries[0];
     let (mut q, mut v) = (first.position, first.speed);
     // a Feetech's internal target starts at 0 when a log is loaded (BAM's feetech/actuator.py)
     let mut firmware = FirmwareState::default();
     let friction = &bench.servo.friction;
+    let delay_rows = params.command_delay / dt;
     for (row, entry) in log.entries.iter().enumerate() {
         if options.reset_rows.is_some_and(|n| row > 0 && row % n == 0) {
             (q, v) = (entry.position, entry.speed);
         }
-        let supply = bench.supply(log, row, options);
+        let supply = bench.supply(log, row);
+        let (goal, enabled) = delayed_command(log, row, delay_rows);
         match options.step {
             Step::Bam => {
-                let out = bench.servo.tick(&mut firmware, entry.goal, q, v, dt, supply, entry.enabled);
-                record(row, q, v, &out);
+                let out = bench.servo.tick(&mut firmware, goal, q, v, dt, supply, enabled);
+                if !record(row, q, v, &out) {
+                    return;
+                }
                 let external = bench.pendulum.gravity_torque(q + bench.q_offset);
                 let budget = friction.budget(out.torque, external, v) + friction.viscous * v.abs();
                 let net = out.torque + external;
@@ -142,9 +160,9 @@ fn replay(log: &BenchLog, params: &ServoParams, options: &ReplayOptions, mut rec
             Step::Exact => {
                 let h = dt / options.substeps as f64;
                 for s in 0..options.substeps {
-                    let out = bench.servo.tick(&mut firmware, entry.goal, q, v, h, supply, entry.enabled);
-                    if s == 0 {
-                        record(row, q, v, &out);
+                    let out = bench.servo.tick(&mut firmware, goal, q, v, h, supply, enabled);
+                    if s == 0 && !record(row, q, v, &out) {
+                        return;
                     }
                     let external = bench.pendulum.gravity_torque(q + bench.q_offset);
                     let band = h * friction.budget(out.torque, external, v);
@@ -158,6 +176,24 @@ fn replay(log: &BenchLog, params: &ServoParams, options: &ReplayOptions, mut rec
     }
 }
 
+/// The goal and torque enable the firmware acts on at `row`: those sent `delay_rows` rows before
+/// (the goal interpolated between rows; before the log's first row, its first).
+fn delayed_command(log: &BenchLog, row: usize, delay_rows: f64) -> (f64, bool) {
+    let entries = &log.entries;
+    if delay_rows == 0.0 {
+        return (entries[row].goal, entries[row].enabled);
+    }
+    let at = row as f64 - delay_rows;
+    if at <= 0.0 {
+        return (entries[0].goal, entries[0].enabled);
+    }
+    let i = at.floor() as usize;
+    let w = at - i as f64;
+    let next = &entries[(i + 1).min(row)];
+    let goal = entries[i].goal + w * (next.goal - entries[i].goal);
+    (goal, if w < 0.5 { entries[i].enabled } else { next.enabled })
+}
+
 /// The whole rollout.
 pub fn rollout(log: &BenchLog, params: &ServoParams, options: &ReplayOptions) -> Rollout {
     let n = log.entries.len();
@@ -169,13 +205,25 @@ pub fn rollout(log: &BenchLog, params: &ServoParams, options: &ReplayOptions) ->
         out.current.push(servo.current);
         out.torque.push(servo.torque);
         out.supply.push(servo.supply);
+        true
     });
     out
 }
 
 /// The position MAE alone, without keeping the rollout (for identification).
 pub fn mae(log: &BenchLog, params: &ServoParams, options: &ReplayOptions) -> f64 {
+    mae_within(log, params, options, f64::INFINITY)
+}
+
+/// The position MAE, the replay stopped as soon as it exceeds `limit` (rad): then the MAE so far,
+/// above `limit` and below the whole replay's (every row adds to the sum), is returned.
+pub fn mae_within(log: &BenchLog, params: &ServoParams, options: &ReplayOptions, limit: f64) -> f64 {
+    let rows = log.entries.len() as f64;
+    let budget = limit * rows;
     let mut sum = 0.0;
-    replay(log, params, options, |row, q, _, _| sum += (q - log.entries[row].position).abs());
-    sum / log.entries.len() as f64
+    replay(log, params, options, |row, q, _, _| {
+        sum += (q - log.entries[row].position).abs();
+        sum <= budget
+    });
+    sum / rows
 }

@@ -97,6 +97,7 @@ pub fn record(params: &ServoParams, bench: &Bench, trajectory: Trajectory, optio
         trajectory: Some(trajectory.name().to_string()),
         dt: bench.dt,
         resampled: false,
+        glitches: 0,
         entries,
     };
     let truth = rollout(&log, params, options);

@@ -1,5 +1,5 @@
 //! Servo benches: replaying a 6 s bench log (BAM's explicit step, armscope's exact one; the bar is
-//! under 5 ms) and identifying a servo from 8 logs (the bar is under 60 s on 2 cores). The logs are
+//! under 5 ms) and identifying a servo from 8 logs (the bar for 60 real logs is under 60 s on 2 cores). The logs are
 //! made here (a known XL330-like servo on BAM's bench, its positions rounded to the encoder): BAM's
 //! real logs are not in the repository; `.ci/servo-vs-bam.py` times `armscope identify` on the 8 it
 //! can read.
@@ -28,7 +28,7 @@ fn servo() -> ServoParams {
         load_external_quad: 0.004,
         ..Default::default()
     };
-    ServoParams { family: XL330, kt: 0.35, resistance: 2.8, armature: 0.002, q_offset: 0.02, friction, error_gain_ratio: 1.0, max_velocity: f64::INFINITY, supply_resistance: 0.0, motor_voltage_limit: f64::INFINITY }
+    ServoParams { family: XL330, kt: 0.35, resistance: 2.8, armature: 0.002, q_offset: 0.02, friction, error_gain_ratio: 1.0, max_velocity: f64::INFINITY, supply_resistance: 0.0, motor_voltage_limit: f64::INFINITY, command_delay: 0.0 }
 }
 
 fn replay(c: &mut Criterion) {
@@ -46,7 +46,7 @@ fn identify(c: &mut Criterion) {
     let logs: Vec<_> = [100.0, 400.0].iter().flat_map(|&kp| Trajectory::ALL.map(|t| record(&params, &Bench { kp, ..Default::default() }, t, &options))).collect();
     let mut group = c.benchmark_group("identify");
     group.sample_size(10);
-    group.bench_function("m6_8_logs_default_search", |b| b.iter(|| black_box(fit(&Space::new(XL330, FrictionModel::M6, false, false), &logs, options, &FitOptions::default()).unwrap().loss)));
+    group.bench_function("m6_8_logs_default_search", |b| b.iter(|| black_box(fit(&Space::new(XL330, FrictionModel::M6, false, false, true), &logs, options, &FitOptions::default(), &|_| {}).unwrap().loss)));
     group.finish();
 }
 

@@ -15,6 +15,11 @@ pub fn so101_motors() -> PathBuf {
     super::repo().join("assets/motors/so101.toml")
 }
 
+/// The SO-101 on BAM's 12 V STS3215 parameters: the servo the protection tests' scenarios were built on.
+pub fn so101_motors_bam12v() -> PathBuf {
+    super::repo().join("tests/fixtures/motors/so101_bam12v.toml")
+}
+
 /// The commands both tests drive: every joint swinging about its centre.
 pub fn so101_commands() -> Vec<Sines> {
     let s = |center: f64, a: f64, w: f64| Sines { center, terms: vec![(a, w, 0.3)] };
@@ -40,6 +45,11 @@ impl Recorder for Capture {
 /// The SO-101 simulated along `motion` (its exact commands every millisecond, from where they start)
 /// for `seconds` with `payload` at the tool: its positions every millisecond.
 pub fn follow(dir: &Path, motion: &[Sines], payload: f64, seconds: f64) -> Vec<Vec<f64>> {
+    follow_on(dir, motion, payload, seconds, &so101_motors())
+}
+
+/// [`follow`] with the servos of the motor file `motors`.
+pub fn follow_on(dir: &Path, motion: &[Sines], payload: f64, seconds: f64, motors: &Path) -> Vec<Vec<f64>> {
     let schedule = dir.join("exact_commands.csv");
     let mut text = String::from("t,q1,q2,q3,q4,q5,q6\n");
     for k in 0..=(seconds * 1e3).round() as usize {
@@ -52,7 +62,7 @@ pub fn follow(dir: &Path, motion: &[Sines], payload: f64, seconds: f64) -> Vec<V
     }
     std::fs::write(&schedule, text).unwrap();
     let start: Vec<String> = motion.iter().map(|m| format!("{:?}", m.q(0.0))).collect();
-    let config = RunConfig { urdf: so101(), motors: Some(so101_motors()), payload, trajectory: Some(schedule), duration: seconds, q0: Some(start.join(",")), ..RunConfig::default() };
+    let config = RunConfig { urdf: so101(), motors: Some(motors.to_path_buf()), payload, trajectory: Some(schedule), duration: seconds, q0: Some(start.join(",")), ..RunConfig::default() };
     let experiment = Experiment::prepare(config).unwrap();
     let mut capture = Capture(Vec::new());
     armscope::sim::simulate(&experiment, &mut [&mut capture], None).unwrap();

@@ -94,10 +94,19 @@ pub const STS3215: Family = Family {
 /// Every family armscope knows, by BAM's actuator name.
 pub const FAMILIES: [Family; 5] = [XL330, XL320, MX64, MX106, STS3215];
 
-/// The family of BAM's actuator name; BAM's published 12 V STS3215 file names it "sts321512v",
-/// which no BAM version knows: it is the STS3215's firmware.
+/// Names of the 12 V STS3215 that no BAM version knows, each the STS3215's firmware: BAM's published
+/// 12 V file says "sts321512v", K-Scale Labs' parameter files (kscalelabs/sysid) "sts3215v12".
+pub const STS3215_ALIASES: [&str; 2] = ["sts321512v", "sts3215v12"];
+
+/// Whether `name` is one of [`STS3215_ALIASES`] (a parameter file's reader says it read it as
+/// "sts3215").
+pub fn is_alias(name: &str) -> bool {
+    STS3215_ALIASES.iter().any(|a| a.eq_ignore_ascii_case(name))
+}
+
+/// The family of BAM's actuator name, or of one of [`STS3215_ALIASES`].
 pub fn family(name: &str) -> Option<Family> {
-    let name = if name.eq_ignore_ascii_case("sts321512v") { "sts3215" } else { name };
+    let name = if is_alias(name) { "sts3215" } else { name };
     FAMILIES.into_iter().find(|f| f.name.eq_ignore_ascii_case(name))
 }
 
@@ -205,6 +214,7 @@ mod tests {
         let duty = fw.tick(&mut state, 1.0, 0.0, 0.0, 0.005, 7.4, 0.36, 2.8);
         assert!((duty - 2.8 / 7.4).abs() < 1e-12);
         assert_eq!(family("STS321512V").map(|f| f.name), Some("sts3215"));
+        assert_eq!(family("sts3215v12").map(|f| f.name), Some("sts3215"));
         assert!(family("xm430").is_none());
     }
 }

@@ -53,6 +53,8 @@ pub struct BusServo {
     pub supply_resistance: f64,
     /// The largest voltage the servo puts across its motor, V (infinite: none).
     pub motor_voltage_limit: f64,
+    /// How long after a goal is sent the firmware acts on it, s.
+    pub command_delay: f64,
     /// The datasheet's stall torque (N·m) and no-load speed (rad/s) at the output, where given:
     /// the torque stays within that line (with the motion; its stall torque braking).
     pub envelope: Option<(f64, f64)>,
@@ -79,7 +81,7 @@ impl BusServo {
         let mut firmware = Firmware::new(params.family, kp);
         firmware.error_gain_ratio = params.error_gain_ratio;
         firmware.max_velocity = params.max_velocity;
-        Self { name: name.into(), firmware, kt: params.kt, resistance: params.resistance, armature: params.armature, friction: params.friction, supply, supply_resistance: params.supply_resistance, motor_voltage_limit: params.motor_voltage_limit, envelope: None }
+        Self { name: name.into(), firmware, kt: params.kt, resistance: params.resistance, armature: params.armature, friction: params.friction, supply, supply_resistance: params.supply_resistance, motor_voltage_limit: params.motor_voltage_limit, command_delay: params.command_delay, envelope: None }
     }
 
     /// The identified parameters back (q_offset 0: a bench's, not the servo's).
@@ -95,6 +97,7 @@ impl BusServo {
             max_velocity: self.firmware.max_velocity,
             supply_resistance: self.supply_resistance,
             motor_voltage_limit: self.motor_voltage_limit,
+            command_delay: self.command_delay,
         }
     }
 
@@ -228,6 +231,7 @@ mod tests {
             max_velocity: f64::INFINITY,
             supply_resistance: 0.0,
             motor_voltage_limit: f64::INFINITY,
+            command_delay: 0.0,
         };
         BusServo::from_params("XL330", &params, 400.0, 7.4)
     }

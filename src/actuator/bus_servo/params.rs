@@ -32,11 +32,18 @@ pub struct ServoParams {
     /// The largest voltage the servo puts across its motor, V (armscope's; infinite: the duty
     /// times the supply, as BAM assumes).
     pub motor_voltage_limit: f64,
+    /// How long after a goal is sent the firmware acts on it, s (armscope's; 0 as BAM assumes):
+    /// the bus's transfer, the firmware's read of its goal register and its control period.
+    pub command_delay: f64,
 }
 
 /// The keys armscope writes beyond BAM's.
 pub const SUPPLY_RESISTANCE_KEY: &str = "supply_resistance";
 pub const MOTOR_VOLTAGE_LIMIT_KEY: &str = "motor_voltage_limit";
+pub const COMMAND_DELAY_KEY: &str = "command_delay";
+/// The longest command delay a parameter file may give, s: a servo that answers a second late is
+/// not a servo's loop.
+pub const COMMAND_DELAY_MAX: f64 = 1.0;
 
 impl ServoParams {
     /// Parse BAM's JSON; errors name the file and the field. `notices` gets one line per key that
@@ -54,8 +61,8 @@ impl ServoParams {
         };
         let actuator = string("actuator")?;
         let family = family(actuator).ok_or_else(|| format!("{file}: field 'actuator' is '{actuator}', not a servo armscope knows ({})", family_names()))?;
-        if actuator.eq_ignore_ascii_case("sts321512v") {
-            notices.push(format!("{file}: actuator 'sts321512v' read as 'sts3215' (the same firmware; BAM's own code knows no such name)"));
+        if super::firmware::is_alias(actuator) {
+            notices.push(format!("{file}: actuator '{actuator}' read as 'sts3215' (the 12 V STS3215: the same firmware; BAM's own code knows no such name)"));
         }
         let model_name = string("model")?;
         let model = FrictionModel::from_name(model_name).ok_or_else(|| format!("{file}: field 'model' is '{model_name}', expected m1 … m6"))?;
@@ -115,8 +122,13 @@ impl ServoParams {
                 Some(x) => x,
                 None => f64::INFINITY,
             },
+            command_delay: match number(COMMAND_DELAY_KEY)? {
+                Some(x) if !(0.0..=COMMAND_DELAY_MAX).contains(&x) => return Err(format!("{file}: field '{COMMAND_DELAY_KEY}' must be between 0 and {COMMAND_DELAY_MAX} s (got {x})")),
+                Some(x) => x,
+                None => 0.0,
+            },
         };
-        let known: Vec<&str> = ["kt", "R", "armature", "q_offset", "model", "actuator", "error_gain_ratio", "max_velocity", SUPPLY_RESISTANCE_KEY, MOTOR_VOLTAGE_LIMIT_KEY].into_iter().chain(model.keys()).collect();
+        let known: Vec<&str> = ["kt", "R", "armature", "q_offset", "model", "actuator", "error_gain_ratio", "max_velocity", SUPPLY_RESISTANCE_KEY, MOTOR_VOLTAGE_LIMIT_KEY, COMMAND_DELAY_KEY].into_iter().chain(model.keys()).collect();
         for key in map.keys().filter(|k| !known.contains(&k.as_str())) {
             // another model's keys, or a later BAM's: not part of this model
             notices.push(format!("{file}: field '{key}' is not a parameter of a {} {} model: ignored", family.name, model.name()));
@@ -155,6 +167,9 @@ impl ServoParams {
         if self.motor_voltage_limit.is_finite() {
             put(MOTOR_VOLTAGE_LIMIT_KEY, self.motor_voltage_limit);
         }
+        if self.command_delay > 0.0 {
+            put(COMMAND_DELAY_KEY, self.command_delay);
+        }
         map.insert("model".into(), Value::String(self.friction.model.name().into()));
         map.insert("actuator".into(), Value::String(self.family.name.into()));
         Value::Object(map)
@@ -180,6 +195,23 @@ mod tests {
         assert_eq!(p.family.name, "xl330");
         let back = ServoParams::from_json(&p.to_json().to_string(), Path::new("again.json"), &mut notices).unwrap();
         assert_eq!(back, p);
+        // armscope's command delay is written where it is not BAM's 0, and read back
+        let delayed = ServoParams { command_delay: 0.034, ..p.clone() };
+        assert_eq!(ServoParams::from_json(&delayed.to_json().to_string(), Path::new("d.json"), &mut notices).unwrap(), delayed);
+        assert!(!p.to_json().as_object().unwrap().contains_key(COMMAND_DELAY_KEY));
+    }
+
+    #[test]
+    fn k_scale_labs_files_name_the_12_v_sts3215_sts3215v12() {
+        // kscalelabs/sysid's parameter files: BAM's keys, the actuator "sts3215v12", and the
+        // optimiser's "score" and "trial_number"
+        let text = r#"{"kt": 3.5555, "R": 7.1214, "armature": 0.0283, "q_offset": -0.014, "friction_base": 6e-05, "friction_viscous": 0.0762, "score": 0.0309, "trial_number": 4998, "model": "m1", "actuator": "sts3215v12"}"#;
+        let mut notices = Vec::new();
+        let p = ServoParams::from_json(text, Path::new("m1.json"), &mut notices).unwrap();
+        assert_eq!(p.family.name, "sts3215");
+        assert_eq!(notices.len(), 3, "{notices:?}");
+        assert!(notices[0].contains("actuator 'sts3215v12' read as 'sts3215'"), "{}", notices[0]);
+        assert!(notices[1].contains("field 'score' is not a parameter"));
     }
 
     #[test]
@@ -191,6 +223,9 @@ mod tests {
         let unknown = M6.replace("\"xl330\"", "\"xm430\"");
         let e = ServoParams::from_json(&unknown, Path::new("p.json"), &mut notices).unwrap_err();
         assert!(e.contains("field 'actuator' is 'xm430'"), "{e}");
+        let late = M6.replace("\"alpha\"", "\"command_delay\": 1.5, \"alpha\"");
+        let e = ServoParams::from_json(&late, Path::new("p.json"), &mut notices).unwrap_err();
+        assert!(e.contains("field 'command_delay' must be between 0 and 1 s"), "{e}");
         let negative = M6.replace("\"R\": 2.81", "\"R\": -1");
         assert!(ServoParams::from_json(&negative, Path::new("p.json"), &mut notices).unwrap_err().contains("field 'R' must be positive"));
     }
