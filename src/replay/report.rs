@@ -115,7 +115,7 @@ fn joint_sentences(j: &JointVerdict) -> String {
     let shown = 3;
     for i in j.over.iter().take(shown) {
         let span = if i.first == i.last { format!("at {:.2} s (one sample)", i.start) } else { format!("from {:.2} s to {:.2} s ({:.2} s)", i.start, i.end, i.duration()) };
-        out += &format!("  {} needed more than {what} {span}: at worst {:.3} N·m ({:.0} %) over, at {:.2} s\n", j.joint, i.worst_excess, i.worst_percent, i.worst_time);
+        out += &format!("  {} needed more than {what} {span}: at worst {:.3} N·m ({}) over, at {:.2} s\n", j.joint, i.worst_excess, percent_over(i.worst_percent), i.worst_time);
     }
     if j.over.len() > shown {
         out += &format!("  {} … and {} more times; {:.2} s over in all\n", j.joint, j.over.len() - shown, j.time_over);
@@ -133,17 +133,28 @@ fn joint_sentences(j: &JointVerdict) -> String {
     out
 }
 
+/// A load (needed / had) as the ranking shows it: a percentage, or, where the joint needed torque at
+/// a speed its motor gives none at, those words (a division by nothing is no number to print).
+fn load_cell(load: f64) -> String {
+    if load.is_finite() { format!("{:.0}%", 100.0 * load) } else { "too fast".into() }
+}
+
+/// A shortfall as a percentage of what the joint had, or, where it had nothing at that speed, why.
+fn percent_over(percent: f64) -> String {
+    if percent.is_finite() { format!("{percent:.0} %") } else { "at a speed its motor gives no torque at".into() }
+}
+
 /// How many episodes the ranking lists.
 const RANKED: usize = 20;
 
 /// A dataset's episodes, worst first: one line each (the most loaded [`RANKED`]).
 pub fn ranking_text(summaries: &[EpisodeSummary]) -> String {
-    let mut out = format!("{} episodes, the most loaded first (load: the largest needed/had of any joint):\n", summaries.len());
+    let mut out = format!("{} episodes, the most loaded first (load: the largest needed/had of any joint; too fast: it needed torque at a speed past its motor's no-load speed):\n", summaries.len());
     let w = summaries.iter().map(|s| s.label.chars().count()).max().unwrap_or(7).max(7) + 2;
     out += &format!("  {:<w$}{:>8}  {:<16}{}\n", "episode", "load", "joint", "over");
     for s in summaries.iter().take(RANKED) {
         let over: Vec<String> = s.joints.iter().filter(|j| !j.over.is_empty()).map(|j| format!("{} {:.2} s", j.joint, j.time_over)).collect();
-        out += &format!("  {:<w$}{:>7.0}%  {:<16}{}\n", s.label, 100.0 * s.peak_load, s.worst_joint, if over.is_empty() { "–".into() } else { over.join(", ") });
+        out += &format!("  {:<w$}{:>8}  {:<16}{}\n", s.label, load_cell(s.peak_load), s.worst_joint, if over.is_empty() { "–".into() } else { over.join(", ") });
     }
     if summaries.len() > RANKED {
         let overloaded = summaries.iter().filter(|s| s.overloaded()).count();
@@ -165,4 +176,20 @@ pub fn summary_json(replayer: &Replayer, source: &str, summaries: &[EpisodeSumma
         "notices": replayer.model.notices,
         "episodes": summaries,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_joint_that_needed_torque_past_its_motors_speed_is_said_in_words() {
+        // needed/available with nothing available is infinite: never printed as a number
+        let summary = |label: &str, load: f64| EpisodeSummary { label: label.into(), index: None, duration: 1.0, samples: 30, peak_load: load, worst_joint: "elbow_flex".into(), joints: Vec::new(), smoothing: Vec::new(), measured_vs_model: Vec::new(), notices: Vec::new() };
+        let text = ranking_text(&[summary("episode 0", f64::INFINITY), summary("episode 1", 0.42)]);
+        assert!(text.contains("too fast") && text.contains("42%"), "{text}");
+        assert!(!text.contains("inf") && !text.contains("NaN"), "{text}");
+        assert_eq!(percent_over(f64::INFINITY), "at a speed its motor gives no torque at");
+        assert_eq!(percent_over(12.4), "12 %");
+    }
 }
