@@ -112,7 +112,7 @@ fn forward_replay_from_the_command_line_writes_its_findings_and_needs_a_dataset(
     let root = dataset(dir.path());
     let json = dir.path().join("forward.json");
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_armscope"))
-        .args(["replay", root.to_str().unwrap(), "--urdf", so101().to_str().unwrap(), "--motors", motors().to_str().unwrap(), "--payload", "0.2", "--forward", "--summary-json", json.to_str().unwrap()])
+        .args(["replay", root.to_str().unwrap(), "--urdf", so101().to_str().unwrap(), "--motors", motors().to_str().unwrap(), "--payload", "0.2", "--units", "degrees", "--forward", "--summary-json", json.to_str().unwrap()])
         .current_dir(dir.path())
         .output()
         .unwrap();
@@ -174,7 +174,7 @@ fn a_datasets_episodes_are_replayed_forward_together_the_widest_gap_first_and_re
     Spec { fps: 30.0, frames: FRAMES, episodes: vec![motion.clone(), motion], storage, observed: Some(observed) }.write_v3(&root);
     let json = dir.path().join("forward.json");
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_armscope"))
-        .args(["replay", root.to_str().unwrap(), "--urdf", so101().to_str().unwrap(), "--motors", motors().to_str().unwrap(), "--payload", "0.2", "--forward", "--jobs", "2", "--no-rrd", "--summary-json", json.to_str().unwrap()])
+        .args(["replay", root.to_str().unwrap(), "--urdf", so101().to_str().unwrap(), "--motors", motors().to_str().unwrap(), "--payload", "0.2", "--units", "degrees", "--forward", "--jobs", "2", "--no-rrd", "--summary-json", json.to_str().unwrap()])
         .current_dir(dir.path())
         .output()
         .unwrap();

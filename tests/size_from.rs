@@ -37,7 +37,7 @@ fn size_from(dataset: &Path, out: &Path, extra: &[&str]) -> Value {
     let args: Vec<String> = ["armscope", "size", "--urdf", so101().to_str().unwrap(), "--from", dataset.to_str().unwrap()]
         .iter()
         .chain(extra)
-        .chain(&["--payload", "0.1", "--parts-in-urdf", "--candidates", CANDIDATES, "--ratios", "1-20", "--efficiency", "0.9", "--out", out.to_str().unwrap()])
+        .chain(&["--units", "degrees", "--payload", "0.1", "--parts-in-urdf", "--candidates", CANDIDATES, "--ratios", "1-20", "--efficiency", "0.9", "--out", out.to_str().unwrap()])
         .map(|s| s.to_string())
         .collect();
     assert_eq!(armscope::cli::main_with_args(args), 0, "size --from {extra:?} must find a verified set");

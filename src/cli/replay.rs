@@ -68,8 +68,13 @@ pub struct ReplayArgs {
 pub fn replay(args: &ReplayArgs) -> Result<i32, Error> {
     let model = crate::model::load_urdf(&args.urdf)?;
     let recorded = &args.recorded;
-    let (source, episodes, map) = match open_mapped(&args.source, recorded.topic.as_deref(), recorded.episode.as_deref(), &recorded.feature, recorded.joint_map.as_deref(), &model)? {
-        Mapped::Ready(r) => (r.source, r.episodes, r.map),
+    let (source, episodes, map) = match open_mapped(&args.source, recorded.topic.as_deref(), recorded.episode.as_deref(), &recorded.feature, recorded.joint_map.as_deref(), recorded.reading(), &model)? {
+        Mapped::Ready(r) => {
+            for notice in &r.notices {
+                eprintln!("armscope: notice: {notice}");
+            }
+            (r.source, r.episodes, r.map)
+        }
         Mapped::NeedsMap { template } => {
             println!("{template}");
             return Err(needs_map(&args.source, &args.urdf));

@@ -231,8 +231,13 @@ fn recorded_motions(args: &SizeArgs, source: &std::path::Path, base: RunConfig) 
     use crate::replay::{ReplayOptions, Replayer, inverse_replay, schedule};
     let model = crate::model::load_urdf(&args.urdf)?;
     let recorded = &args.recorded;
-    let mapped = match open_mapped(source, recorded.topic.as_deref(), recorded.episode.as_deref(), &recorded.feature, recorded.joint_map.as_deref(), &model)? {
-        Mapped::Ready(r) => r,
+    let mapped = match open_mapped(source, recorded.topic.as_deref(), recorded.episode.as_deref(), &recorded.feature, recorded.joint_map.as_deref(), recorded.reading(), &model)? {
+        Mapped::Ready(r) => {
+            for notice in &r.notices {
+                eprintln!("armscope: notice: {notice}");
+            }
+            r
+        }
         Mapped::NeedsMap { template } => {
             println!("{template}");
             return Err(super::replay::needs_map(source, &args.urdf));

@@ -126,4 +126,20 @@ pub struct RecordedMotionArgs {
     /// A bag's joint-state topic (default: /joint_states, or the only one).
     #[arg(long)]
     pub topic: Option<String>,
+    /// A LeRobot dataset's body joints' unit for the built-in map: degrees or range (LeRobot's
+    /// RANGE_M100_100); default: what the values tell (a value beyond ±100 is degrees, values at
+    /// exactly ±100 a range), else armscope asks.
+    #[arg(long, value_enum)]
+    pub units: Option<crate::motion::BodyUnits>,
+    /// A LeRobot calibration file (the follower's `<id>.json`: per motor range_min, range_max,
+    /// drive_mode) for the built-in map: a range value becomes the motor's angle exactly.
+    #[arg(long, value_name = "FILE")]
+    pub calibration: Option<PathBuf>,
+}
+
+impl RecordedMotionArgs {
+    /// How the values are to be read, as the flags say.
+    pub fn reading(&self) -> crate::motion::Reading<'_> {
+        crate::motion::Reading { units: self.units, calibration: self.calibration.as_deref() }
+    }
 }

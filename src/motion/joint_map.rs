@@ -10,10 +10,16 @@
 //! ```
 //!
 //! A range maps linearly onto the joint's URDF limits (0…100 or −100…100 from lower to upper; sign
-//! −1 from upper to lower). With a LeRobot calibration file (`range_min`, `range_max`, `drive_mode`
-//! per motor) the value is turned back into the motor's tick t, as LeRobot's normalization made
-//! it, and the angle measured from the calibration pose, which reads tick 2047:
-//! q = sign·s·(t − 2047)·2π/4096 + offset, s = −1 where `drive_mode` is 1.
+//! −1 from upper to lower): approximate, a real arm's calibrated range is not its URDF's. With a
+//! LeRobot calibration file (`range_min`, `range_max`, `drive_mode` per motor) the value is turned
+//! back into the motor's tick t, as LeRobot's normalization made it (a `drive_mode` 1 range is
+//! negated), and the angle measured from the middle of the calibrated range, where LeRobot's
+//! DEGREES mode has its zero: q = sign·(t − (lo + hi)/2)·2π/4095 + offset (LeRobot's degrees are
+//! 360/4095 a tick), the same q a DEGREES recording of the arm gives.
+//!
+//! The SO-101's LeRobot datasets have a built-in map; their body joints' unit (degrees, or LeRobot's
+//! RANGE_M100_100, the SO followers' default before 2026-02-13) is not in the dataset:
+//! [`decide_body_unit`] tells it from the values where they tell it.
 
 use super::{Episode, SourceKind};
 use crate::error::Error;
@@ -37,7 +43,7 @@ pub enum Unit {
 }
 
 impl Unit {
-    fn name(self) -> &'static str {
+    pub fn name(self) -> &'static str {
         match self {
             Unit::Deg => "deg",
             Unit::Rad => "rad",
@@ -62,7 +68,8 @@ pub struct MotorCalibration {
 /// The encoder's ticks per turn on LeRobot's Feetech and Dynamixel servos, and the tick the
 /// calibration pose reads.
 const TICKS_PER_TURN: f64 = 4096.0;
-const CALIBRATION_TICK: f64 = 2047.0;
+/// LeRobot's degrees: 360° over 4095 ticks (`_normalize` divides by `resolution − 1`).
+const TICKS_PER_360: f64 = TICKS_PER_TURN - 1.0;
 
 #[derive(Clone, Debug)]
 pub struct Entry {
@@ -122,8 +129,7 @@ impl JointMap {
         let calibration: Option<BTreeMap<String, MotorCalibration>> = match &file.calibration {
             Some(c) => {
                 let c = if c.is_relative() { path.parent().unwrap_or(Path::new(".")).join(c) } else { c.clone() };
-                let text = std::fs::read_to_string(&c).map_err(|e| Error::flag(c.display().to_string(), e.to_string()))?;
-                Some(serde_json::from_str(&text).map_err(|e| Error::flag(c.display().to_string(), format!("not a LeRobot calibration file: {e}")))?)
+                Some(read_calibration(&c)?)
             }
             None => None,
         };
@@ -173,13 +179,37 @@ impl JointMap {
                 let mut entries = Vec::new();
                 for (name, unit) in SO101_JOINTS {
                     let joint = model.joint_index(name)?;
-                    let column = format!("{name}.pos");
-                    episode.column(&column)?;
+                    // LeRobot's names since June 2025, or the older layout's (`main_shoulder_pan`)
+                    let column = [format!("{name}.pos"), format!("main_{name}")].into_iter().find(|c| episode.column(c).is_some())?;
                     entries.push(Entry { joint, column, unit, sign: 1.0, offset: 0.0, calibration: None });
                 }
                 Some(Self { entries, source: "built-in SO-101 map (LeRobot's degrees, sign +1, offset 0; gripper 0…100 over its limits)".into() })
             }
         }
+    }
+
+    /// The built-in SO-101 map with its body joints in `unit` (degrees or LeRobot's range) and, with
+    /// `calibration`, each body motor's calibration record (by the motor's name: the column without
+    /// `.pos` or `main_`).
+    pub fn with_body_unit(mut self, unit: Unit, calibration: Option<(&Path, &BTreeMap<String, MotorCalibration>)>) -> Result<Self, Error> {
+        // the gripper keeps its 0…100 over its URDF limits: where its URDF zero lies in its
+        // calibrated travel, nothing says
+        for e in self.entries.iter_mut().filter(|e| e.unit != Unit::Range0To100) {
+            e.unit = unit;
+            if let Some((path, records)) = calibration {
+                let motor = motor_of(&e.column);
+                e.calibration = Some(*records.get(motor).ok_or_else(|| Error::flag(path.display().to_string(), format!("no motor '{motor}' (column {}): a calibration file for other motors? (motors: {})", e.column, records.keys().cloned().collect::<Vec<_>>().join(", "))))?);
+            }
+        }
+        let unit = match unit {
+            Unit::RangeM100To100 => "LeRobot's RANGE_M100_100",
+            _ => "LeRobot's degrees",
+        };
+        self.source = match calibration {
+            Some((path, _)) => format!("built-in SO-101 map (body joints in {unit}, angles from {}; gripper 0…100 over its limits)", path.display()),
+            None => format!("built-in SO-101 map (body joints in {unit}, sign +1, offset 0; gripper 0…100 over its limits)"),
+        };
+        Ok(self)
     }
 
     /// A map file to fill in for this model and recording: each joint with the column of the same
@@ -221,15 +251,16 @@ impl Entry {
     pub fn to_coordinate(&self, value: f64, lower: f64, upper: f64) -> f64 {
         if let Some(c) = &self.calibration {
             let (lo, hi) = (c.range_min, c.range_max);
-            // back to the motor's tick, as LeRobot normalized it (`_normalize`)
+            let reversed = c.drive_mode == 1;
+            // back to the motor's tick, as LeRobot normalized it (`_normalize`: a range negated
+            // where drive_mode is 1; degrees are not)
             let tick = match self.unit {
-                Unit::Deg => value * (TICKS_PER_TURN - 1.0) / 360.0 + 0.5 * (lo + hi),
-                Unit::Rad | Unit::M => value * (TICKS_PER_TURN - 1.0) / TAU + 0.5 * (lo + hi),
-                Unit::RangeM100To100 => (value + 100.0) / 200.0 * (hi - lo) + lo,
-                Unit::Range0To100 => value / 100.0 * (hi - lo) + lo,
+                Unit::Deg => value * TICKS_PER_360 / 360.0 + 0.5 * (lo + hi),
+                Unit::Rad | Unit::M => value * TICKS_PER_360 / TAU + 0.5 * (lo + hi),
+                Unit::RangeM100To100 => ((if reversed { -value } else { value }) + 100.0) / 200.0 * (hi - lo) + lo,
+                Unit::Range0To100 => (if reversed { 100.0 - value } else { value }) / 100.0 * (hi - lo) + lo,
             };
-            let drive = if c.drive_mode == 1 { -1.0 } else { 1.0 };
-            return self.sign * drive * (tick - CALIBRATION_TICK) * TAU / TICKS_PER_TURN + self.offset;
+            return self.sign * (tick - 0.5 * (lo + hi)) * TAU / TICKS_PER_360 + self.offset;
         }
         match self.unit {
             Unit::Deg => self.sign * value.to_radians() + self.offset,
@@ -243,6 +274,83 @@ impl Entry {
     }
 }
 
+/// The motor a LeRobot column names (`shoulder_pan.pos`, the older `main_shoulder_pan`).
+fn motor_of(column: &str) -> &str {
+    let name = column.strip_suffix(".pos").unwrap_or(column);
+    name.strip_prefix("main_").unwrap_or(name)
+}
+
+/// A LeRobot calibration file: per motor its `range_min`, `range_max`, `drive_mode`.
+pub fn read_calibration(path: &Path) -> Result<BTreeMap<String, MotorCalibration>, Error> {
+    let fail = |m: String| Error::flag(path.display().to_string(), m);
+    let text = std::fs::read_to_string(path).map_err(|e| fail(e.to_string()))?;
+    let records: BTreeMap<String, MotorCalibration> = serde_json::from_str(&text).map_err(|e| fail(format!("not a LeRobot calibration file: {e}")))?;
+    if let Some((motor, c)) = records.iter().find(|(_, c)| !(c.range_max > c.range_min)) {
+        return Err(fail(format!("motor '{motor}': range_max {} is not above range_min {}", c.range_max, c.range_min)));
+    }
+    Ok(records)
+}
+
+/// Body values beyond this are no LeRobot range (it clamps one to ±100).
+const RANGE_LIMIT: f64 = 100.0;
+
+/// The body joints' unit as the values tell it, and why (one line): a value beyond ±100 is degrees
+/// (LeRobot clamps RANGE_M100_100 to ±100); values all within ±100 with some exactly at ±100 are a
+/// range (a joint driven to its calibrated end reads its clamp exactly; degrees land on 360/4095 a
+/// tick and reach 100.0 only by chance). Neither: Err, why the values cannot tell.
+pub fn decide_body_unit(columns: &[(&str, &[f64])]) -> Result<(Unit, String), String> {
+    let mut widest: Option<(&str, f64)> = None;
+    let mut at_clamp = 0usize;
+    for (name, values) in columns {
+        for &v in values.iter().filter(|v| v.is_finite()) {
+            if widest.is_none_or(|(_, w)| v.abs() > w.abs()) {
+                widest = Some((name, v));
+            }
+            at_clamp += usize::from(v.abs() == RANGE_LIMIT);
+        }
+    }
+    match widest {
+        Some((name, v)) if v.abs() > RANGE_LIMIT => Ok((Unit::Deg, format!("read as degrees: {name} reaches {v:.1}, beyond the ±100 LeRobot clamps its range normalisation to"))),
+        Some(_) if at_clamp > 0 => Ok((Unit::RangeM100To100, format!("read as LeRobot's RANGE_M100_100: every value within ±100, {at_clamp} exactly at ±100 (where LeRobot clamps a range)"))),
+        Some((name, v)) => Err(format!("every value is within ±100 (the widest {name} at {v:.1}) and none at ±100: degrees or LeRobot's RANGE_M100_100 (the SO followers' default before 2026-02-13) alike")),
+        None => Err("no values".into()),
+    }
+}
+
 fn joint_names(model: &Model) -> String {
     model.joints.iter().map(|j| j.name.as_str()).collect::<Vec<_>>().join(", ")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_values_tell_degrees_or_a_range_where_they_can() {
+        let (unit, why) = decide_body_unit(&[("shoulder_pan.pos", &[10.0, -40.0]), ("elbow_flex.pos", &[95.0, 134.2])]).unwrap();
+        assert_eq!(unit, Unit::Deg);
+        assert!(why.contains("elbow_flex.pos reaches 134.2"), "{why}");
+        let (unit, why) = decide_body_unit(&[("shoulder_pan.pos", &[10.0, -40.0]), ("elbow_flex.pos", &[99.6, 100.0, 100.0])]).unwrap();
+        assert_eq!(unit, Unit::RangeM100To100);
+        assert!(why.contains("2 exactly at ±100"), "{why}");
+        let why = decide_body_unit(&[("shoulder_pan.pos", &[10.0, -40.0]), ("elbow_flex.pos", &[99.6])]).unwrap_err();
+        assert!(why.contains("the widest elbow_flex.pos at 99.6") && why.contains("none at ±100"), "{why}");
+    }
+
+    #[test]
+    fn a_calibrated_range_value_is_the_motors_angle_from_its_ranges_middle() {
+        // lerobot-format.md §5.3: deg = value/100 · (hi − lo)/2 · 360/4095, zero at (lo + hi)/2, the
+        // same angle a DEGREES recording of the tick gives; a drive_mode 1 range is negated
+        let c = MotorCalibration { drive_mode: 0, homing_offset: 0, range_min: 1000.0, range_max: 3000.0 };
+        let entry = |unit: Unit, c: MotorCalibration| Entry { joint: 0, column: "elbow_flex.pos".into(), unit, sign: 1.0, offset: 0.0, calibration: Some(c) };
+        let tick = 2600.0;
+        let range_value = (tick - 1000.0) / 2000.0 * 200.0 - 100.0;
+        let degrees_value = (tick - 2000.0) * 360.0 / 4095.0;
+        let q = entry(Unit::RangeM100To100, c).to_coordinate(range_value, -1.0, 1.0);
+        assert!((q - degrees_value.to_radians()).abs() < 1e-12, "{q}");
+        assert!((entry(Unit::Deg, c).to_coordinate(degrees_value, -1.0, 1.0) - q).abs() < 1e-12);
+        assert!((entry(Unit::RangeM100To100, MotorCalibration { drive_mode: 1, ..c }).to_coordinate(-range_value, -1.0, 1.0) - q).abs() < 1e-12);
+        // ±100 are the calibrated ends: ±(hi − lo)/2 ticks
+        assert!((entry(Unit::RangeM100To100, c).to_coordinate(100.0, -1.0, 1.0) - 1000.0 * TAU / 4095.0).abs() < 1e-12);
+    }
 }

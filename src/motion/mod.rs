@@ -149,12 +149,35 @@ pub fn check_increasing(time: &[f64], what: &str) -> Result<(), String> {
     Ok(())
 }
 
-/// A recording ready to use on an arm: its source, the episodes asked for, and the joint map.
+/// A recording ready to use on an arm: its source, the episodes asked for, the joint map, and what
+/// was decided on the user's behalf (one notice each).
 pub struct MappedRecording {
     pub source: Source,
     pub episodes: Vec<i64>,
     pub map: JointMap,
+    pub notices: Vec<String>,
 }
+
+/// The unit of a LeRobot dataset's body joints, as `--units` names it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum BodyUnits {
+    /// LeRobot's DEGREES normalisation (the SO followers' default since 2026-02-13).
+    Degrees,
+    /// LeRobot's RANGE_M100_100 normalisation (the default before).
+    Range,
+}
+
+/// How the recording's values are to be read, where the user says: the body joints' unit and a
+/// LeRobot calibration file (both for the built-in map; a map file gives its own).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Reading<'a> {
+    pub units: Option<BodyUnits>,
+    pub calibration: Option<&'a Path>,
+}
+
+/// The episodes the unit of a dataset's body joints is decided on (a bounded read of a dataset of
+/// hundreds).
+const UNIT_EPISODES: usize = 10;
 
 /// What opening a recording for an arm gave: ready, or no map known from its columns to the arm's
 /// joints (then a template of one to fill in).
@@ -164,8 +187,10 @@ pub enum Mapped {
 }
 
 /// Open a recording for `model`: the episodes asked for (default: all), and the joint map — the
-/// user's file, else a built-in map chosen by the recording's columns (those of its first episode).
-pub fn open_mapped(path: &Path, topic: Option<&str>, episodes: Option<&[i64]>, feature: &str, joint_map: Option<&Path>, model: &crate::model::Model) -> Result<Mapped, Error> {
+/// user's file, else a built-in map chosen by the recording's columns (those of its first episode);
+/// a LeRobot dataset's body joints in the unit `reading` gives, else the one its values tell (its
+/// `action` and `feature` over its first episodes), else an error asking for it.
+pub fn open_mapped(path: &Path, topic: Option<&str>, episodes: Option<&[i64]>, feature: &str, joint_map: Option<&Path>, reading: Reading, model: &crate::model::Model) -> Result<Mapped, Error> {
     let source = Source::open(path, topic)?;
     let episodes = match episodes {
         Some(list) => list.to_vec(),
@@ -174,15 +199,75 @@ pub fn open_mapped(path: &Path, topic: Option<&str>, episodes: Option<&[i64]>, f
     if episodes.is_empty() {
         return Err(Error::flag(path.display().to_string(), "no episodes"));
     }
+    let mut notices = Vec::new();
     let map = match joint_map {
-        Some(file) => JointMap::load(file, model)?,
+        Some(file) => {
+            if reading.units.is_some() {
+                return Err(Error::flag("--units", format!("{} gives each joint's unit (its 'unit' fields)", file.display())));
+            }
+            if reading.calibration.is_some() {
+                return Err(Error::flag("--calibration", format!("{} names its calibration file itself (its 'calibration' field)", file.display())));
+            }
+            JointMap::load(file, model)?
+        }
         None => {
             let first = source.read(episodes[0], feature)?;
             match JointMap::builtin(source.kind(), model, &first) {
-                Some(map) => map,
+                Some(map) if source.kind() == SourceKind::LeRobot => {
+                    let (unit, why) = body_unit(&source, &episodes, feature, &map, reading.units, path)?;
+                    let calibration = match reading.calibration {
+                        Some(c) => Some((c, joint_map::read_calibration(c)?)),
+                        None => None,
+                    };
+                    let map = map.with_body_unit(unit, calibration.as_ref().map(|(p, r)| (*p, r)))?;
+                    let how = match (unit, reading.calibration) {
+                        (joint_map::Unit::RangeM100To100, None) => "; without its calibration file (--calibration) −100…100 is mapped onto each joint's URDF limits: approximate".to_string(),
+                        (_, Some(c)) => format!("; angles from the middle of each motor's calibrated range in {}", c.display()),
+                        _ => String::new(),
+                    };
+                    if let Some(why) = why {
+                        notices.push(format!("{}: the body joints {why}{how}", path.display()));
+                    } else if !how.is_empty() {
+                        notices.push(format!("{}: the body joints in {}{how}", path.display(), unit.name()));
+                    }
+                    map
+                }
+                Some(map) => {
+                    if reading.units.is_some() || reading.calibration.is_some() {
+                        return Err(Error::flag(if reading.units.is_some() { "--units" } else { "--calibration" }, format!("{}: for a LeRobot dataset's built-in map; this recording's columns are named by joint in SI units", path.display())));
+                    }
+                    map
+                }
                 None => return Ok(Mapped::NeedsMap { template: JointMap::template(model, &first.column_names()) }),
             }
         }
     };
-    Ok(Mapped::Ready(MappedRecording { source, episodes, map }))
+    Ok(Mapped::Ready(MappedRecording { source, episodes, map, notices }))
+}
+
+/// The unit of a dataset's body joints: `units` where given (no reason to say), else what the
+/// values of its first episodes tell (and why), else one line asking for it.
+fn body_unit(source: &Source, episodes: &[i64], feature: &str, map: &JointMap, units: Option<BodyUnits>, path: &Path) -> Result<(joint_map::Unit, Option<String>), Error> {
+    match units {
+        Some(BodyUnits::Degrees) => return Ok((joint_map::Unit::Deg, None)),
+        Some(BodyUnits::Range) => return Ok((joint_map::Unit::RangeM100To100, None)),
+        None => {}
+    }
+    let body: Vec<&str> = map.entries.iter().filter(|e| e.unit != joint_map::Unit::Range0To100).map(|e| e.column.as_str()).collect();
+    let mut series: Vec<(String, Vec<f64>)> = Vec::new();
+    for &index in episodes.iter().take(UNIT_EPISODES) {
+        for group in [feature, "action"] {
+            let Ok(episode) = source.read(index, group) else { continue };
+            for column in &body {
+                if let Some(c) = episode.column(column) {
+                    series.push((column.to_string(), c.values.clone()));
+                }
+            }
+        }
+    }
+    let columns: Vec<(&str, &[f64])> = series.iter().map(|(n, v)| (n.as_str(), v.as_slice())).collect();
+    match joint_map::decide_body_unit(&columns) {
+        Ok((unit, why)) => Ok((unit, Some(why))),
+        Err(why) => Err(Error::flag(path.display().to_string(), format!("the body joints' unit cannot be told from the data: {why}; say which with --units degrees or --units range (or a joint map's unit)"))),
+    }
 }

@@ -56,6 +56,56 @@ impl Motion {
 /// The fewest samples a motion can be differentiated from (the derivative stencils' width).
 pub const MIN_SAMPLES: usize = 5;
 
+/// Past its URDF range by more than this a recorded position cannot be the arm's, rad (20°: a real
+/// arm's calibrated range passes its URDF's by a few degrees; more is a wrong unit, sign or offset).
+pub const REVOLUTE_EXCESS_MAX: f64 = 20.0 * std::f64::consts::PI / 180.0;
+/// The same for a prismatic joint, m.
+pub const PRISMATIC_EXCESS_MAX: f64 = 0.02;
+/// Excesses below this are round-off, followed to the limit without a word, rad (m).
+const ROUND_OFF: f64 = 1e-9;
+
+/// A joint's range, [−∞, ∞] where the URDF gives none.
+fn range_of(model: &Model, j: usize) -> (f64, f64) {
+    let joint = &model.joints[j];
+    let (lower, upper) = (joint.lower.min(joint.upper), joint.upper.max(joint.lower));
+    if lower.is_finite() && upper.is_finite() { (lower, upper) } else { (f64::NEG_INFINITY, f64::INFINITY) }
+}
+
+/// The recorded positions followed to each joint's limit where they pass it (one notice: the
+/// largest excess per joint, and where); a position past it by more than [`REVOLUTE_EXCESS_MAX`]
+/// ([`PRISMATIC_EXCESS_MAX`]) refused, naming the joint, episode, frame and value.
+fn follow_to_limits(model: &Model, episode: &Episode, mut mapped: Vec<Option<Vec<f64>>>, notices: &mut Vec<String>) -> Result<Vec<Option<Vec<f64>>>, Error> {
+    let mut past = Vec::new();
+    for (j, series) in mapped.iter_mut().enumerate() {
+        let Some(values) = series else { continue };
+        let (lower, upper) = range_of(model, j);
+        let joint = &model.joints[j];
+        let prismatic = joint.kind == crate::model::JointKind::Prismatic;
+        let (limit, unit, scale) = if prismatic { (PRISMATIC_EXCESS_MAX, "mm", 1e3) } else { (REVOLUTE_EXCESS_MAX, "°", 180.0 / std::f64::consts::PI) };
+        let mut worst = (0.0, 0usize);
+        for (k, v) in values.iter_mut().enumerate() {
+            let excess = (*v - upper).max(lower - *v);
+            if excess > limit {
+                return Err(Error::flag(
+                    episode.label.clone(),
+                    format!("joint '{}': frame {k} ({:.2} s) at {:.4} is {:.1}{unit} past its URDF range [{lower}, {upper}], more than the {:.0}{unit} a real arm's calibration passes it by: not a pose of this arm (a wrong unit, sign or offset in the joint map?)", joint.name, episode.time[k], *v, excess * scale, limit * scale),
+                ));
+            }
+            if excess > worst.0 {
+                worst = (excess, k);
+            }
+            *v = v.clamp(lower, upper);
+        }
+        if worst.0 > ROUND_OFF {
+            past.push(format!("{} by up to {:.1}{unit} (frame {}, {:.2} s)", joint.name, worst.0 * scale, worst.1, episode.time[worst.1]));
+        }
+    }
+    if !past.is_empty() {
+        notices.push(format!("{}: past the URDF's limits, followed to the limit: {}", episode.label, past.join(", ")));
+    }
+    Ok(mapped)
+}
+
 /// Smooth an episode mapped onto the model's coordinates and work out the torques it needed.
 /// Joints the map leaves out are held at their start pose `hold` (zero speed).
 pub fn inverse_replay(model: &Model, map: &JointMap, episode: &Episode, hold: &[f64]) -> Result<Motion, Error> {
@@ -64,13 +114,13 @@ pub fn inverse_replay(model: &Model, map: &JointMap, episode: &Episode, hold: &[
     if samples < MIN_SAMPLES {
         return Err(Error::flag(episode.label.clone(), format!("{samples} samples: a replay needs at least {MIN_SAMPLES}")));
     }
-    let mapped = map.apply(model, episode)?;
+    let mut notices = episode.notices.clone();
+    let mapped = follow_to_limits(model, episode, map.apply(model, episode)?, &mut notices)?;
     let mut smoother = Smoother::new(&episode.time);
     let mut q = Vec::with_capacity(n);
     let mut qd = Vec::with_capacity(n);
     let mut qdd = Vec::with_capacity(n);
     let mut smoothing = Vec::with_capacity(n);
-    let mut notices = episode.notices.clone();
     let mut held = Vec::new();
     for (j, series) in mapped.iter().enumerate() {
         match series {
@@ -78,7 +128,10 @@ pub fn inverse_replay(model: &Model, map: &JointMap, episode: &Episode, hold: &[
                 if let Some((k, _)) = values.iter().enumerate().find(|(_, v)| !v.is_finite()) {
                     return Err(Error::flag(episode.label.clone(), format!("joint '{}': value at sample {k} ({} s) is not a number", model.joints[j].name, episode.time[k])));
                 }
-                let Smoothed { q: sq, qd: sqd, qdd: sqdd, noise, quantum, lambda, cutoff_hz } = smoother.smooth(values);
+                let Smoothed { q: mut sq, qd: sqd, qdd: sqdd, noise, quantum, lambda, cutoff_hz } = smoother.smooth(values);
+                // the smoothing may overshoot a limit the values were followed to
+                let (lower, upper) = range_of(model, j);
+                sq.iter_mut().for_each(|x| *x = x.clamp(lower, upper));
                 q.push(sq);
                 qd.push(sqd);
                 qdd.push(sqdd);

@@ -34,6 +34,9 @@ impl Sines {
 pub enum Storage {
     Degrees { sign: f64, offset: f64 },
     Range0To100 { lower: f64, upper: f64 },
+    /// LeRobot's RANGE_M100_100 with a calibrated range of ticks: the tick is q's from the range's
+    /// middle (LeRobot's DEGREES zero, 4095 ticks a turn), clamped into the range.
+    RangeM100To100 { range_min: f64, range_max: f64 },
 }
 
 pub const RANGE_TICKS: f64 = 1400.0;
@@ -49,6 +52,10 @@ impl Storage {
             Storage::Range0To100 { lower, upper } => {
                 let tick = ((q - lower) / (upper - lower) * RANGE_TICKS).round();
                 (tick / RANGE_TICKS * 100.0) as f32
+            }
+            Storage::RangeM100To100 { range_min, range_max } => {
+                let tick = (0.5 * (range_min + range_max) + q.to_degrees() * 4095.0 / 360.0).round().clamp(range_min, range_max);
+                ((tick - range_min) / (range_max - range_min) * 200.0 - 100.0) as f32
             }
         }
     }

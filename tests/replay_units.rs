@@ -1,0 +1,135 @@
+//! LeRobot datasets read right (issue 51 items 1–2): the body joints' unit decided from the values
+//! where they decide it and asked for in one line where they do not; a calibration file turning a
+//! range value into the motor's angle exactly; a real arm's poses a few degrees past its URDF's
+//! limits followed to the limit with one notice, and a pose that cannot be the arm's refused.
+
+mod common;
+
+use armscope::model::load_urdf;
+use common::lerobot::{Sines, Spec, Storage};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn so101() -> PathBuf {
+    common::repo().join("tests/fixtures/robots/so101.urdf")
+}
+
+fn run(args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_armscope")).args(args).output().unwrap();
+    (out.status.code().unwrap_or(-1), String::from_utf8_lossy(&out.stdout).to_string(), String::from_utf8_lossy(&out.stderr).to_string())
+}
+
+/// Each body joint's calibrated range (ticks): 1400 ticks around 2048, elbow_flex's narrower so that
+/// its motion runs into its ends, where LeRobot's range clamps.
+const RANGES: [(f64, f64); 5] = [(1348.0, 2748.0), (1348.0, 2748.0), (1598.0, 2498.0), (1348.0, 2748.0), (1348.0, 2748.0)];
+
+fn motions() -> Vec<Sines> {
+    let s = |center: f64, a: f64, w: f64| Sines { center, terms: vec![(a, w, 0.0)] };
+    vec![s(0.1, 0.6, 1.1), s(0.2, 0.7, 1.6), s(-0.3, 0.9, 1.7), s(0.0, 0.5, 2.1), s(0.0, 0.9, 0.9), s(0.8, 0.6, 1.9)]
+}
+
+fn write(dir: &Path, name: &str, body: impl Fn(usize) -> Storage, motion: Vec<Sines>) -> PathBuf {
+    let model = load_urdf(&so101()).unwrap();
+    let gripper = &model.joints[model.joint_index("gripper").unwrap()];
+    let mut storage: Vec<Storage> = (0..5).map(body).collect();
+    storage.push(Storage::Range0To100 { lower: gripper.lower, upper: gripper.upper });
+    let root = dir.join(name);
+    Spec { fps: 30.0, frames: 121, episodes: vec![motion], storage, observed: None }.write_v3(&root);
+    root
+}
+
+fn calibration(dir: &Path) -> PathBuf {
+    let names = ["shoulder_pan", "shoulder_lift", "elbow_flex", "wrist_flex", "wrist_roll"];
+    let mut records: Vec<String> = names.iter().zip(RANGES).enumerate().map(|(k, (n, (lo, hi)))| format!(r#""{n}": {{"id": {}, "drive_mode": 0, "homing_offset": 0, "range_min": {lo}, "range_max": {hi}}}"#, k + 1)).collect();
+    records.push(r#""gripper": {"id": 6, "drive_mode": 0, "homing_offset": 0, "range_min": 2000, "range_max": 3400}"#.into());
+    let path = dir.join("so101_follower.json");
+    std::fs::write(&path, format!("{{{}}}", records.join(", "))).unwrap();
+    path
+}
+
+fn trace_q(path: &Path) -> Vec<Vec<f64>> {
+    let table = common::read_csv(path);
+    table.rows.iter().map(|r| r[1..7].to_vec()).collect()
+}
+
+#[test]
+fn a_range_dataset_is_read_as_a_range_and_its_calibration_gives_the_motors_angles() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = write(dir.path(), "range", |j| Storage::RangeM100To100 { range_min: RANGES[j].0, range_max: RANGES[j].1 }, motions());
+    let (root_s, urdf) = (root.to_str().unwrap(), so101());
+    // no flag: the values at exactly ±100 (elbow_flex held at its calibrated ends) decide it, and the
+    // mapping onto the URDF's limits is said to be approximate
+    let (code, _, stderr) = run(&["replay", root_s, "--urdf", urdf.to_str().unwrap(), "--no-rrd", "--no-mcap"]);
+    assert_eq!(code, 0, "{stderr}");
+    let notice = stderr.lines().find(|l| l.contains("the body joints read as LeRobot's RANGE_M100_100")).unwrap_or_else(|| panic!("{stderr}"));
+    assert!(notice.contains("exactly at ±100") && notice.contains("approximate"), "{notice}");
+    // with the calibration: each value is the motor's angle from its range's middle, the true motion
+    // within the tick's quantum (360/4095°, 1.53 mrad) and the smoothing, where no end clamped it
+    let cal = calibration(dir.path());
+    let trace = dir.path().join("q.csv");
+    let (code, _, stderr) = run(&["replay", root_s, "--urdf", urdf.to_str().unwrap(), "--calibration", cal.to_str().unwrap(), "--trace", trace.to_str().unwrap(), "--no-rrd", "--no-mcap"]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(stderr.contains(&format!("angles from the middle of each motor's calibrated range in {}", cal.display())), "{stderr}");
+    let q = trace_q(&trace);
+    let truth = motions();
+    for j in [0, 1, 3, 4] {
+        let worst = q.iter().enumerate().map(|(k, row)| (row[j] - truth[j].q(k as f64 / 30.0)).abs()).fold(0.0, f64::max);
+        assert!(worst < 2.5e-3, "joint {j}: {worst} rad from the true motion");
+    }
+    // a calibration file of other motors: one line naming the file and the motor
+    let other = dir.path().join("other.json");
+    std::fs::write(&other, r#"{"joint_a": {"id": 1, "drive_mode": 0, "homing_offset": 0, "range_min": 0, "range_max": 4095}}"#).unwrap();
+    let (code, _, stderr) = run(&["replay", root_s, "--urdf", urdf.to_str().unwrap(), "--calibration", other.to_str().unwrap(), "--no-rrd", "--no-mcap"]);
+    assert_eq!(code, 2);
+    let error: Vec<&str> = stderr.lines().filter(|l| l.starts_with("armscope: error:")).collect();
+    assert!(error.len() == 1 && error[0].contains("other.json") && error[0].contains("no motor 'shoulder_pan'"), "{stderr}");
+}
+
+#[test]
+fn a_dataset_whose_values_cannot_tell_its_unit_is_asked_for_it_in_one_line() {
+    // small motions stored in degrees: within ±100, none at ±100 — degrees or a range alike
+    let dir = tempfile::tempdir().unwrap();
+    let root = write(dir.path(), "small", |_| Storage::Degrees { sign: 1.0, offset: 0.0 }, motions());
+    let (root_s, urdf) = (root.to_str().unwrap(), so101());
+    let (code, _, stderr) = run(&["replay", root_s, "--urdf", urdf.to_str().unwrap(), "--no-rrd", "--no-mcap"]);
+    assert_eq!(code, 2);
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    assert!(stderr.contains(root_s) && stderr.contains("cannot be told from the data") && stderr.contains("--units degrees or --units range"), "{stderr}");
+    let (code, _, stderr) = run(&["replay", root_s, "--urdf", urdf.to_str().unwrap(), "--units", "degrees", "--no-rrd", "--no-mcap"]);
+    assert_eq!(code, 0, "{stderr}");
+    // a value beyond ±100 decides degrees
+    let mut wide = motions();
+    wide[0] = Sines { center: 0.5, terms: vec![(1.4, 1.1, 0.0)] };
+    let root = write(dir.path(), "wide", |_| Storage::Degrees { sign: 1.0, offset: 0.0 }, wide);
+    let (code, _, stderr) = run(&["replay", root.to_str().unwrap(), "--urdf", urdf.to_str().unwrap(), "--no-rrd", "--no-mcap"]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(stderr.contains("the body joints read as degrees: shoulder_pan.pos reaches"), "{stderr}");
+}
+
+#[test]
+fn poses_past_a_urdf_limit_are_followed_to_it_and_impossible_ones_refused() {
+    // elbow_flex's URDF limit is ±1.69 rad: a real arm's 3° past it is followed to the limit and
+    // said once; 25° past it is no pose of this arm
+    let dir = tempfile::tempdir().unwrap();
+    let urdf = so101();
+    let model = load_urdf(&urdf).unwrap();
+    let limit = model.joints[model.joint_index("elbow_flex").unwrap()].upper;
+    let mut past = motions();
+    past[2] = Sines { center: limit - 0.3, terms: vec![(0.3 + 3f64.to_radians(), 1.0, 0.0)] };
+    past[0] = Sines { center: 0.5, terms: vec![(1.4, 1.1, 0.0)] }; // degrees decided
+    let root = write(dir.path(), "past", |_| Storage::Degrees { sign: 1.0, offset: 0.0 }, past.clone());
+    let trace = dir.path().join("q.csv");
+    let (code, _, stderr) = run(&["replay", root.to_str().unwrap(), "--urdf", urdf.to_str().unwrap(), "--trace", trace.to_str().unwrap(), "--no-rrd", "--no-mcap"]);
+    assert_eq!(code, 0, "{stderr}");
+    let notice = stderr.lines().find(|l| l.contains("past the URDF's limits, followed to the limit")).unwrap_or_else(|| panic!("{stderr}"));
+    // 3° at the peak, less the frames' miss of it and the degrees' quantum (0.09°)
+    let by: f64 = notice.split("elbow_flex by up to ").nth(1).and_then(|r| r.split('°').next()).and_then(|x| x.parse().ok()).unwrap_or_else(|| panic!("{notice}"));
+    assert!((2.8..=3.1).contains(&by) && notice.contains("episode 0"), "{notice}");
+    assert!(trace_q(&trace).iter().all(|row| row[2] <= limit + 1e-12));
+    past[2].terms[0].0 = 0.3 + 25f64.to_radians();
+    let root = write(dir.path(), "impossible", |_| Storage::Degrees { sign: 1.0, offset: 0.0 }, past);
+    let (code, _, stderr) = run(&["replay", root.to_str().unwrap(), "--urdf", urdf.to_str().unwrap(), "--no-rrd", "--no-mcap"]);
+    assert_eq!(code, 2);
+    let error: Vec<&str> = stderr.lines().filter(|l| l.starts_with("armscope: error:")).collect();
+    assert!(error.len() == 1 && error[0].contains("episode 0: joint 'elbow_flex': frame") && error[0].contains("past its URDF range"), "{stderr}");
+}
