@@ -191,7 +191,20 @@ pub fn identify(args: &IdentifyArgs) -> Result<i32, Error> {
         }
         println!("  mean MAE: trained on {:.2} mrad{}", 1e3 * mean(&train_maes), if validate.is_empty() { String::new() } else { format!(", held out {:.2} mrad", 1e3 * mean(&validate_maes)) });
         let p = &found.params;
-        println!("  k_t {:.4} N·m/A, R {:.3} Ω (stall at {} V: {:.3} N·m), armature {:.3e} kg·m², q_offset {:.4} rad{}", p.kt, p.resistance, train[0].vin, p.kt * train[0].vin * family.max_duty / (p.resistance + p.supply_resistance), p.armature, p.q_offset, if args.fit_supply_resistance { format!(", supply resistance {:.3} Ω", p.supply_resistance) } else { String::new() });
+        // the supply the first log was replayed on: its header's, or what its servo measured
+        let volts = if replay.supply.measured_for(&train[0]) { train[0].measured_supply().unwrap_or(train[0].vin) } else { train[0].vin };
+        println!(
+            "  k_t {:.4} N·m/A, R {:.3} Ω (stall at {volts:.1} V: {:.3} N·m), armature {:.3e} kg·m², q_offset {:.4} rad{}",
+            p.kt,
+            p.resistance,
+            p.kt * volts * family.max_duty / (p.resistance + p.supply_resistance),
+            p.armature,
+            p.q_offset,
+            if args.fit_supply_resistance { format!(", supply resistance {:.3} Ω", p.supply_resistance) } else { String::new() }
+        );
+        if p.command_delay > 0.0 {
+            println!("  command delay {:.1} ms", 1e3 * p.command_delay);
+        }
         if args.fit_motor_voltage_limit {
             println!("  motor voltage limit {:.3} V", p.motor_voltage_limit);
         }
