@@ -192,7 +192,7 @@ pub fn identify(args: &IdentifyArgs) -> Result<i32, Error> {
         println!("  mean MAE: trained on {:.2} mrad{}", 1e3 * mean(&train_maes), if validate.is_empty() { String::new() } else { format!(", held out {:.2} mrad", 1e3 * mean(&validate_maes)) });
         let p = &found.params;
         // the supply the first log was replayed on: its header's, or what its servo measured
-        let volts = if replay.supply.measured_for(&train[0]) { train[0].measured_supply().unwrap_or(train[0].vin) } else { train[0].vin };
+        let volts = if replay.supply.measured_for(&train[0]) { train[0].measured_supply.unwrap_or(train[0].vin) } else { train[0].vin };
         println!(
             "  k_t {:.4} N·m/A, R {:.3} Ω (stall at {volts:.1} V: {:.3} N·m), armature {:.3e} kg·m², q_offset {:.4} rad{}",
             p.kt,

@@ -56,6 +56,9 @@ pub struct BenchLog {
     pub resampled: bool,
     /// Isolated samples at −π (encoder read glitches) dropped from the log.
     pub glitches: usize,
+    /// The median of the supply the servo measured, V (None: the log has no `input_volts`); worked
+    /// out once, when the log is read (a replay asks for it, and a fit replays a log 10⁵ times).
+    pub measured_supply: Option<f64>,
     pub entries: Vec<Entry>,
 }
 
@@ -194,23 +197,14 @@ impl BenchLog {
                 (step, resample(&raw, step), true)
             }
         };
-        Ok(Self { path: path.to_path_buf(), mass, arm_mass, length, kp, vin, actuator, trajectory, dt, resampled, glitches, entries })
-    }
-
-    /// The median of the supply the servo measured, V (None: the log has no `input_volts`).
-    pub fn measured_supply(&self) -> Option<f64> {
-        let mut volts: Vec<f64> = self.entries.iter().filter_map(|e| e.volts).collect();
-        if volts.is_empty() {
-            return None;
-        }
-        volts.sort_by(f64::total_cmp);
-        Some(volts[volts.len() / 2])
+        let measured_supply = median_supply(&entries);
+        Ok(Self { path: path.to_path_buf(), mass, arm_mass, length, kp, vin, actuator, trajectory, dt, resampled, glitches, measured_supply, entries })
     }
 
     /// Whether the header's `vin` disagrees with the measured supply by more than
     /// [`SUPPLY_DISAGREEMENT`] (None: nothing measured).
     pub fn supply_disagrees(&self) -> Option<bool> {
-        self.measured_supply().map(|v| (v - self.vin).abs() > SUPPLY_DISAGREEMENT * self.vin)
+        self.measured_supply.map(|v| (v - self.vin).abs() > SUPPLY_DISAGREEMENT * self.vin)
     }
 
     /// The log's name: its file name without `.json` (and `.processed` / `.raw`).
@@ -230,6 +224,16 @@ impl BenchLog {
 /// it. BAM's XL330 logs (vin 7.4 V) read 5.8–9.2 V row by row, medians within 3 % of 7.4; K-Scale's
 /// STS3215 logs say 15 V and read 11.7–12.2 V (20 % below).
 pub const SUPPLY_DISAGREEMENT: f64 = 0.1;
+
+/// The median of the entries' measured supply, V (None: none measured).
+pub fn median_supply(entries: &[Entry]) -> Option<f64> {
+    let mut volts: Vec<f64> = entries.iter().filter_map(|e| e.volts).collect();
+    if volts.is_empty() {
+        return None;
+    }
+    volts.sort_by(f64::total_cmp);
+    Some(volts[volts.len() / 2])
+}
 
 /// Drop runs of at most [`GLITCH_MAX_ROWS`] rows at −π whose neighbours (on each side the log has
 /// one) are at least [`GLITCH_JUMP`] away; the count dropped.
@@ -327,7 +331,7 @@ mod tests {
         assert!(log.entries.iter().all(|e| e.position > -3.2));
         assert!((log.entries[8].position - (-3.14)).abs() < 1e-12);
         // the supply: 12 V measured against the header's 7.4 (the raw_log header) disagrees
-        assert_eq!(log.measured_supply(), Some(12.0));
+        assert_eq!(log.measured_supply, Some(12.0));
         assert_eq!(log.supply_disagrees(), Some(true));
     }
 

@@ -21,7 +21,7 @@ pub fn notices(logs: &[BenchLog], supply: Supply) -> Vec<String> {
             first.path.display()
         ));
     }
-    let disagreeing: Vec<(&BenchLog, f64)> = logs.iter().filter(|l| l.supply_disagrees() == Some(true)).filter_map(|l| Some((l, l.measured_supply()?))).collect();
+    let disagreeing: Vec<(&BenchLog, f64)> = logs.iter().filter(|l| l.supply_disagrees() == Some(true)).filter_map(|l| Some((l, l.measured_supply?))).collect();
     if let Some((first, measured)) = disagreeing.first() {
         let what = format!(
             "{} of {} log{}: the header's vin ({} V in {}) disagrees with the supply the servo measured (median {measured:.1} V)",
@@ -43,7 +43,7 @@ pub fn notices(logs: &[BenchLog], supply: Supply) -> Vec<String> {
 /// The first log `supply` cannot replay: a measured supply asked of a log without `input_volts`,
 /// as one line naming the file.
 pub fn check_supply(logs: &[BenchLog], supply: Supply) -> Result<(), String> {
-    match logs.iter().find(|l| supply == Supply::Measured && l.measured_supply().is_none()) {
+    match logs.iter().find(|l| supply == Supply::Measured && l.measured_supply.is_none()) {
         Some(log) => Err(format!("{}: no entry has 'input_volts', the supply the servo measured: --supply measured needs it (--supply nominal replays on the header's vin)", log.path.display())),
         None => Ok(()),
     }

@@ -98,6 +98,7 @@ pub fn record(params: &ServoParams, bench: &Bench, trajectory: Trajectory, optio
         dt: bench.dt,
         resampled: false,
         glitches: 0,
+        measured_supply: None,
         entries,
     };
     let truth = rollout(&log, params, options);
@@ -110,6 +111,7 @@ pub fn record(params: &ServoParams, bench: &Bench, trajectory: Trajectory, optio
         entry.duty = Some(*duty);
         entry.volts = Some(bench.vin);
     }
+    log.measured_supply = super::log::median_supply(&log.entries);
     log
 }
 
