@@ -24,9 +24,16 @@ fn motors() -> PathBuf {
     common::follower::so101_motors()
 }
 
-/// The "real" follower at the frames: the arm simulated along the exact commands with `payload`.
+/// The "real" follower at the frames: the arm simulated along the exact commands with `payload`,
+/// each reaching it a frame after it was recorded (LeRobot's loop reads the follower, then the leader,
+/// then sends the action).
 fn follower(dir: &Path, motion: &[Sines], payload: f64, motors: &Path) -> Vec<Vec<f64>> {
-    let every_ms = common::follower::follow_on(dir, motion, payload, 6.0, motors);
+    follower_after(dir, motion, payload, motors, 1.0 / 30.0)
+}
+
+/// [`follower`] with the commands reaching its servos `latency` s after their frame.
+fn follower_after(dir: &Path, motion: &[Sines], payload: f64, motors: &Path, latency: f64) -> Vec<Vec<f64>> {
+    let every_ms = common::follower::follow_on(dir, motion, payload, 6.0, motors, latency);
     (0..FRAMES).map(|f| every_ms[(f as f64 / 30.0 / 1e-3).round() as usize].clone()).collect()
 }
 
@@ -55,7 +62,7 @@ fn replay_forward_on(root: &Path, dir: &Path, payload: f64, motors: &Path) -> ar
     let commands = source.read(0, "action").unwrap();
     let map = JointMap::builtin(source.kind(), &model, &observed).expect("the SO-101's built-in map");
     let replayer = Replayer::new(model, &ReplayOptions { payload, motors: Some(motors.to_path_buf()), ..Default::default() }, map).unwrap();
-    let options = ForwardOptions { motors: motors.to_path_buf(), payload, tool: None, schedule: dir.join(format!("commands_{payload}.csv")), recordings: None };
+    let options = ForwardOptions { motors: motors.to_path_buf(), payload, tool: None, schedule: dir.join(format!("commands_{payload}.csv")), recordings: None, latency: None };
     forward(&replayer, &options, &commands, &observed).unwrap()
 }
 
@@ -189,4 +196,57 @@ fn a_datasets_episodes_are_replayed_forward_together_the_widest_gap_first_and_re
     assert!(stdout.contains("recorded: episode 1, the widest gap"), "{stdout}");
     assert!(dir.path().join("recordings/forward_so101_two_loads_episode_1.mcap").exists());
     assert!(!dir.path().join("recordings/forward_so101_two_loads_episode_0.mcap").exists());
+}
+
+#[test]
+fn a_follower_whose_commands_arrive_late_is_met_once_the_replay_is_told_the_latency() {
+    // the "real" follower's commands reach it 100 ms (3 frames) after their frame: the default one
+    // frame's replay parts from it on a fast joint; --latency 0.1 meets it within the encoder's quantum
+    let dir = tempfile::tempdir().unwrap();
+    let model = load_urdf(&so101()).unwrap();
+    let gripper = &model.joints[model.joint_index("gripper").unwrap()];
+    let mut storage: Vec<Storage> = (0..5).map(|_| Storage::Degrees { sign: 1.0, offset: 0.0 }).collect();
+    storage.push(Storage::Range0To100 { lower: gripper.lower, upper: gripper.upper });
+    let motion = common::follower::so101_commands();
+    let root = dir.path().join("so101_late");
+    let observed = vec![follower_after(dir.path(), &motion, PAYLOAD, &motors(), 0.1)];
+    Spec { fps: 30.0, frames: FRAMES, episodes: vec![motion], storage, observed: Some(observed) }.write_v3(&root);
+    let (urdf, motor_file) = (so101(), motors());
+    let replay = |latency: Option<&str>| {
+        let json = dir.path().join("late.json");
+        let mut args = vec!["replay", root.to_str().unwrap(), "--urdf", urdf.to_str().unwrap(), "--motors", motor_file.to_str().unwrap(), "--payload", "0.2", "--units", "degrees", "--forward", "--no-rrd", "--no-mcap", "--summary-json", json.to_str().unwrap()];
+        if let Some(l) = latency {
+            args.extend(["--latency", l]);
+        }
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_armscope")).args(&args).current_dir(dir.path()).output().unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let doc: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+        (String::from_utf8_lossy(&out.stdout).to_string(), doc["episodes"][0].clone())
+    };
+    let (text, one_frame) = replay(None);
+    assert!(text.contains("commands reach the model's servos 33.3 ms after their frame (one frame; --latency sets another)"), "{text}");
+    assert!((one_frame["latency_s"].as_f64().unwrap() - 1.0 / 30.0).abs() < 1e-6);
+    let (text, told) = replay(Some("0.1"));
+    assert!(text.contains("100.0 ms after their frame (--latency)"), "{text}");
+    let gap = |doc: &serde_json::Value, j: usize| doc["joints"][j]["gap_mae"].as_f64().unwrap();
+    for j in 0..5 {
+        assert!(gap(&told, j) < 2e-3, "joint {j}: {:.2} mrad with the latency told", gap(&told, j) * 1e3);
+    }
+    // shoulder_pan swings at 0.6 rad/s: 67 ms untold is about 40 mrad of it
+    assert!(gap(&one_frame, 0) > 10.0 * gap(&told, 0), "shoulder_pan: {:.2} mrad a frame late, {:.2} told", gap(&one_frame, 0) * 1e3, gap(&told, 0) * 1e3);
+    // the tracking figures keep their meaning: each follower against the command as recorded
+    let tracking = |doc: &serde_json::Value| doc["joints"][0]["real_tracking_mae"].as_f64().unwrap();
+    assert_eq!(tracking(&told), tracking(&one_frame));
+    // a latency no teleop loop has: one line naming the flag
+    for bad in ["--latency=-0.01", "--latency=2", "--latency=NaN"] {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_armscope"))
+            .args(["replay", root.to_str().unwrap(), "--urdf", so101().to_str().unwrap(), "--motors", motors().to_str().unwrap(), "--units", "degrees", "--forward", "--no-rrd", "--no-mcap", bad])
+            .current_dir(dir.path())
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{err}");
+        let lines: Vec<&str> = err.lines().filter(|l| !l.starts_with("armscope: notice")).collect();
+        assert!(lines.len() == 1 && lines[0].contains("--latency") && !lines[0].contains("NaN") && !lines[0].contains("inf"), "{err}");
+    }
 }

@@ -57,12 +57,14 @@ fn a_range_dataset_is_read_as_a_range_and_its_calibration_gives_the_motors_angle
     let dir = tempfile::tempdir().unwrap();
     let root = write(dir.path(), "range", |j| Storage::RangeM100To100 { range_min: RANGES[j].0, range_max: RANGES[j].1 }, motions());
     let (root_s, urdf) = (root.to_str().unwrap(), so101());
-    // no flag: the values at exactly ±100 (elbow_flex held at its calibrated ends) decide it, and the
-    // mapping onto the URDF's limits is said to be approximate
-    let (code, _, stderr) = run(&["replay", root_s, "--urdf", urdf.to_str().unwrap(), "--no-rrd", "--no-mcap"]);
+    // no flag: the values at exactly ±100 (elbow_flex held at its calibrated ends) decide it, and
+    // each range's width is read from the tick lattice of the values (LeRobot normalises whole ticks)
+    let bare = dir.path().join("bare.csv");
+    let (code, _, stderr) = run(&["replay", root_s, "--urdf", urdf.to_str().unwrap(), "--trace", bare.to_str().unwrap(), "--no-rrd", "--no-mcap"]);
     assert_eq!(code, 0, "{stderr}");
     let notice = stderr.lines().find(|l| l.contains("the body joints read as LeRobot's RANGE_M100_100")).unwrap_or_else(|| panic!("{stderr}"));
-    assert!(notice.contains("exactly at ±100") && notice.contains("approximate"), "{notice}");
+    assert!(notice.contains("exactly at ±100") && notice.contains("tick lattice") && !notice.contains("approximate"), "{notice}");
+    assert!(notice.contains("shoulder_pan 1400") && notice.contains("elbow_flex 900"), "{notice}");
     // with the calibration: each value is the motor's angle from its range's middle, the true motion
     // within the tick's quantum (360/4095°, 1.53 mrad) and the smoothing, where no end clamped it
     let cal = calibration(dir.path());
@@ -76,6 +78,20 @@ fn a_range_dataset_is_read_as_a_range_and_its_calibration_gives_the_motors_angle
         let worst = q.iter().enumerate().map(|(k, row)| (row[j] - truth[j].q(k as f64 / 30.0)).abs()).fold(0.0, f64::max);
         assert!(worst < 2.5e-3, "joint {j}: {worst} rad from the true motion");
     }
+    // the lattice's widths are the file's: the same angles to round-off (only hi − lo enters them)
+    let from_lattice = trace_q(&bare);
+    for (a, b) in from_lattice.iter().zip(&q) {
+        for j in 0..5 {
+            assert!((a[j] - b[j]).abs() < 1e-9, "{a:?} vs {b:?}");
+        }
+    }
+    // a joint that barely moves leaves too few values to tell its range: its limits, said approximate
+    let mut still = motions();
+    still[4] = Sines { center: 0.0, terms: vec![(0.004, 0.9, 0.0)] };
+    let root = write(dir.path(), "still", |j| Storage::RangeM100To100 { range_min: RANGES[j].0, range_max: RANGES[j].1 }, still);
+    let (code, _, stderr) = run(&["replay", root.to_str().unwrap(), "--urdf", urdf.to_str().unwrap(), "--no-rrd", "--no-mcap"]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(stderr.contains("mapped onto the URDF limits of wrist_roll (too few distinct values to tell the range): approximate") && stderr.contains("shoulder_pan 1400"), "{stderr}");
     // a calibration file of other motors: one line naming the file and the motor
     let other = dir.path().join("other.json");
     std::fs::write(&other, r#"{"joint_a": {"id": 1, "drive_mode": 0, "homing_offset": 0, "range_min": 0, "range_max": 4095}}"#).unwrap();

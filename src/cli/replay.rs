@@ -62,6 +62,12 @@ pub struct ReplayArgs {
     /// controller's order (comma list, as the joint states name them).
     #[arg(long, value_name = "JOINTS", value_delimiter = ',', num_args = 1, requires = "forward")]
     pub command_joints: Option<Vec<String>>,
+    /// With --forward: how long after its frame a command reaches the simulated servos, s (0–1;
+    /// default: the recording's frame period, the teleop loop's one frame: LeRobot's loop reads the
+    /// follower, then the leader, then sends the action). The servos' own bus and firmware delay is
+    /// their parameters' `command_delay`, on top of this.
+    #[arg(long, value_name = "SECONDS", requires = "forward")]
+    pub latency: Option<f64>,
 }
 
 /// `armscope replay`.
@@ -144,8 +150,13 @@ pub fn replay(args: &ReplayArgs) -> Result<i32, Error> {
 
 /// `replay --forward`: each episode's commands through the simulated arm's motors, against the follower.
 fn forward(args: &ReplayArgs, replayer: &Replayer, source: &crate::motion::Source, episodes: &[i64]) -> Result<i32, Error> {
-    use crate::replay::forward::{ForwardOptions, forward, forward_episodes, schedule_path};
+    use crate::replay::forward::{ForwardOptions, Latency, forward, forward_episodes, schedule_path};
     let motors = args.motors.clone().ok_or_else(|| Error::flag("--forward", "needs --motors: the servos that follow the commands"))?;
+    if let Some(latency) = args.latency
+        && !(0.0..=crate::replay::forward::MAX_LATENCY).contains(&latency)
+    {
+        return Err(Error::flag("--latency", if latency.is_finite() { format!("{latency} s: a command latency is between 0 and {} s", crate::replay::forward::MAX_LATENCY) } else { format!("must be a number of seconds between 0 and {}", crate::replay::forward::MAX_LATENCY) }));
+    }
     // the command schedules go where the recordings go
     let dir = args.files.folder();
     std::fs::create_dir_all(&dir).map_err(|e| Error::output(&dir, e))?;
@@ -167,6 +178,13 @@ fn forward(args: &ReplayArgs, replayer: &Replayer, source: &crate::motion::Sourc
         tool: args.tool.clone(),
         schedule: schedule_path(&dir, &name_of(index)),
         recordings: (record && wants_recordings).then(|| outputs(index)),
+        // a teleop dataset's action reaches the servos a frame late; a bag's set point is what its
+        // controller acted on then
+        latency: match args.latency {
+            Some(seconds) => Some(Latency::given(seconds, "--latency")),
+            None if dataset => None,
+            None => Some(Latency::given(0.0, "a controller's set point, acted on when recorded")),
+        },
     };
     let wrote = |options: &ForwardOptions| {
         for path in options.recordings.iter().flat_map(|r| r.rrd.iter().chain(&r.mcap)) {

@@ -69,7 +69,7 @@ pub struct MotorCalibration {
 /// calibration pose reads.
 const TICKS_PER_TURN: f64 = 4096.0;
 /// LeRobot's degrees: 360° over 4095 ticks (`_normalize` divides by `resolution − 1`).
-const TICKS_PER_360: f64 = TICKS_PER_TURN - 1.0;
+pub const TICKS_PER_360: f64 = TICKS_PER_TURN - 1.0;
 
 #[derive(Clone, Debug)]
 pub struct Entry {

@@ -9,6 +9,7 @@ pub mod commands;
 pub mod csv;
 pub mod joint_map;
 pub mod lerobot;
+pub mod tick_lattice;
 
 pub use joint_map::JointMap;
 
@@ -219,9 +220,9 @@ pub fn open_mapped(path: &Path, topic: Option<&str>, episodes: Option<&[i64]>, f
                         Some(c) => Some((c, joint_map::read_calibration(c)?)),
                         None => None,
                     };
-                    let map = map.with_body_unit(unit, calibration.as_ref().map(|(p, r)| (*p, r)))?;
+                    let mut map = map.with_body_unit(unit, calibration.as_ref().map(|(p, r)| (*p, r)))?;
                     let how = match (unit, reading.calibration) {
-                        (joint_map::Unit::RangeM100To100, None) => "; without its calibration file (--calibration) −100…100 is mapped onto each joint's URDF limits: approximate".to_string(),
+                        (joint_map::Unit::RangeM100To100, None) => lattice_ranges(&source, &episodes, feature, &mut map, model)?,
                         (_, Some(c)) => format!("; angles from the middle of each motor's calibrated range in {}", c.display()),
                         _ => String::new(),
                     };
@@ -245,6 +246,52 @@ pub fn open_mapped(path: &Path, topic: Option<&str>, episodes: Option<&[i64]>, f
     Ok(Mapped::Ready(MappedRecording { source, episodes, map, notices }))
 }
 
+/// Without a calibration file, each body joint's calibrated range as the tick lattice of its values
+/// (`feature`'s: the follower's calibration turns its goals into ticks too) tells it
+/// ([`tick_lattice`]); a joint whose values do not tell it maps onto its URDF limits. What was
+/// done, as the tail of the unit's notice.
+fn lattice_ranges(source: &Source, episodes: &[i64], feature: &str, map: &mut JointMap, model: &crate::model::Model) -> Result<String, Error> {
+    let body: Vec<String> = map.entries.iter().filter(|e| e.unit == joint_map::Unit::RangeM100To100).map(|e| e.column.clone()).collect();
+    let values = column_values(source, episodes, &[feature], &body);
+    let (mut read, mut unread) = (Vec::new(), Vec::new());
+    for entry in map.entries.iter_mut().filter(|e| e.unit == joint_map::Unit::RangeM100To100) {
+        let name = &model.joints[entry.joint].name;
+        let all: Vec<f64> = values.iter().filter(|(c, _)| *c == entry.column).flat_map(|(_, v)| v.iter().copied()).collect();
+        match tick_lattice::range_width(&all) {
+            Some(width) => {
+                entry.calibration = Some(joint_map::MotorCalibration { drive_mode: 0, homing_offset: 0, range_min: 0.0, range_max: f64::from(width) });
+                read.push(format!("{name} {width} ({:.3} rad)", f64::from(width) * std::f64::consts::TAU / joint_map::TICKS_PER_360));
+            }
+            None => unread.push(name.clone()),
+        }
+    }
+    let mut how = String::from("; without its calibration file (--calibration)");
+    if !read.is_empty() {
+        how += &format!(" each joint's calibrated range read from the tick lattice of its {feature} values (ticks: {}), angles from the range's middle (where LeRobot's degrees have their zero; the URDF's zero assumed there)", read.join(", "));
+    }
+    if !unread.is_empty() {
+        how += &format!("{} −100…100 mapped onto the URDF limits of {} (too few distinct values to tell the range): approximate", if read.is_empty() { "" } else { ";" }, unread.join(", "));
+    }
+    Ok(how)
+}
+
+/// The values of `columns` in `groups` (a dataset's features) over the first episodes, per column
+/// and episode (a bounded read of a dataset of hundreds).
+fn column_values(source: &Source, episodes: &[i64], groups: &[&str], columns: &[String]) -> Vec<(String, Vec<f64>)> {
+    let mut series = Vec::new();
+    for &index in episodes.iter().take(UNIT_EPISODES) {
+        for group in groups {
+            let Ok(episode) = source.read(index, group) else { continue };
+            for column in columns {
+                if let Some(c) = episode.column(column) {
+                    series.push((column.clone(), c.values.clone()));
+                }
+            }
+        }
+    }
+    series
+}
+
 /// The unit of a dataset's body joints: `units` where given (no reason to say), else what the
 /// values of its first episodes tell (and why), else one line asking for it.
 fn body_unit(source: &Source, episodes: &[i64], feature: &str, map: &JointMap, units: Option<BodyUnits>, path: &Path) -> Result<(joint_map::Unit, Option<String>), Error> {
@@ -253,18 +300,8 @@ fn body_unit(source: &Source, episodes: &[i64], feature: &str, map: &JointMap, u
         Some(BodyUnits::Range) => return Ok((joint_map::Unit::RangeM100To100, None)),
         None => {}
     }
-    let body: Vec<&str> = map.entries.iter().filter(|e| e.unit != joint_map::Unit::Range0To100).map(|e| e.column.as_str()).collect();
-    let mut series: Vec<(String, Vec<f64>)> = Vec::new();
-    for &index in episodes.iter().take(UNIT_EPISODES) {
-        for group in [feature, "action"] {
-            let Ok(episode) = source.read(index, group) else { continue };
-            for column in &body {
-                if let Some(c) = episode.column(column) {
-                    series.push((column.to_string(), c.values.clone()));
-                }
-            }
-        }
-    }
+    let body: Vec<String> = map.entries.iter().filter(|e| e.unit != joint_map::Unit::Range0To100).map(|e| e.column.clone()).collect();
+    let series = column_values(source, episodes, &[feature, "action"], &body);
     let columns: Vec<(&str, &[f64])> = series.iter().map(|(n, v)| (n.as_str(), v.as_slice())).collect();
     match joint_map::decide_body_unit(&columns) {
         Ok((unit, why)) => Ok((unit, Some(why))),

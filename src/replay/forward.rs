@@ -51,6 +51,8 @@ pub struct ForwardReplay {
     pub protection_trips: Vec<(String, crate::actuator::bus_servo::Trip)>,
     /// The recorded joints no command named: sent where the real joint was, not compared.
     pub uncommanded: Vec<String>,
+    /// The command latency the model was given.
+    pub latency: Latency,
 }
 
 /// What the run needs beyond the replayer: the motor file (required: the joints' servos), payload and
@@ -62,6 +64,26 @@ pub struct ForwardOptions {
     pub schedule: PathBuf,
     /// The recordings of the simulated arm, the real follower beside it (None: none).
     pub recordings: Option<super::recording::RecordingOutputs>,
+    /// How long after its frame a command reaches the servos (None: the recording's frame period,
+    /// a teleop loop's one frame).
+    pub latency: Option<Latency>,
+}
+
+/// The longest command latency accepted, s: a teleop loop slower than this is not one.
+pub const MAX_LATENCY: f64 = 1.0;
+
+/// The latency a forward replay models and where it came from.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct Latency {
+    pub seconds: f64,
+    /// Why that long ("one frame", "--latency", …).
+    pub from: String,
+}
+
+impl Latency {
+    pub fn given(seconds: f64, from: &str) -> Self {
+        Self { seconds, from: from.to_string() }
+    }
 }
 
 /// Follow `commands` on the simulated arm from where they start, and compare with `observed`.
@@ -82,22 +104,30 @@ pub fn forward(replayer: &Replayer, options: &ForwardOptions, commands: &Episode
     if mapped.is_empty() {
         return Err(Error::flag(commands.label.clone(), format!("its commands name none of the recorded joints (commands: {})", commands.column_names().join(", "))));
     }
-    schedule::write(&options.schedule, &command)?;
-    // the run starts where the commands start: a servo's firmware holds its goal there, sagged under
-    // the weight as the real follower's did (a motor with no firmware model starts on the pose)
-    let (length, first_command) = schedule::span(&command);
-    let start: Vec<String> = first_command.iter().map(|q| format!("{q:?}")).collect();
-    let config = RunConfig {
+    // LeRobot's loop reads the follower, then the leader, then sends the action: frame t's command
+    // reaches the servos after observation t, the bus and the firmware add theirs (the servos' own
+    // command_delay)
+    let latency = options.latency.clone().unwrap_or_else(|| Latency::given(schedule::frame_period(&command), "one frame"));
+    schedule::write_delayed(&options.schedule, &command, latency.seconds)?;
+    // the run starts at rest where the real follower starts (one whose first frame is far from its
+    // leader's catches up, as the real one did), its servos holding the goal at which they sag to
+    // that pose under the weight: the set-up sags the arm from the goal it is given, so the goal is
+    // the pose less the sag there
+    let (length, _) = schedule::span(&command);
+    let observed_start: Vec<f64> = reality.q.iter().map(|joint| joint[0]).collect();
+    let config_from = |start: &[f64]| RunConfig {
         urdf: model.source.clone(),
         motors: Some(options.motors.clone()),
         payload: options.payload,
         tool: options.tool.clone(),
         trajectory: Some(options.schedule.clone()),
         duration: length,
-        q0: Some(start.join(",")),
+        q0: Some(start.iter().map(|q| format!("{q:?}")).collect::<Vec<_>>().join(",")),
         ..RunConfig::default()
     };
-    let experiment = Experiment::with_model(config, model.clone())?;
+    let sagged = Experiment::with_model(config_from(&observed_start), model.clone())?.initial_state().0;
+    let goal: Vec<f64> = (0..n).map(|j| (2.0 * observed_start[j] - sagged[j]).clamp(model.joints[j].lower.min(model.joints[j].upper), model.joints[j].upper.max(model.joints[j].lower))).collect();
+    let experiment = Experiment::with_model(config_from(&goal), model.clone())?;
     let dt = experiment.dt();
     let t0 = command.time[0];
     let time: Vec<f64> = command.time.iter().map(|t| t - t0).collect();
@@ -151,7 +181,7 @@ pub fn forward(replayer: &Replayer, options: &ForwardOptions, commands: &Episode
     }
     let protection_trips = summary.servos.iter().enumerate().filter_map(|(j, s)| Some((model.joints[j].name.clone(), s.as_ref()?.protection_trip?))).collect();
     let uncommanded = uncommanded.iter().map(|&j| model.joints[j].name.clone()).collect();
-    Ok(ForwardReplay { label: commands.label.clone(), time, commanded, observed, simulated, joints, protection_trips, uncommanded })
+    Ok(ForwardReplay { label: commands.label.clone(), time, commanded, observed, simulated, joints, protection_trips, uncommanded, latency })
 }
 
 /// The run's joint positions at the control steps nearest the episode's frames (only those: memory
@@ -197,6 +227,8 @@ impl Recorder for Capture {
 /// The forward replay as a person reads it: a row per joint, mrad (mm on a prismatic joint).
 pub fn text(replay: &ForwardReplay) -> String {
     let mut out = format!("{}: the simulated arm following its commands, against the real follower (mrad)\n", replay.label);
+    let from = if replay.latency.from == "--latency" { "--latency".to_string() } else { format!("{}; --latency sets another", replay.latency.from) };
+    out += &format!("  commands reach the model's servos {:.1} ms after their frame ({from}); tracking measured against the commands as recorded\n", replay.latency.seconds * 1e3);
     out += &format!("  {:<16} {:>18} {:>18} {:>22}  {}\n", "joint", "real tracking", "model tracking", "gap model − real", "parts (gap > 50 mrad)");
     out += &format!("  {:<16} {:>18} {:>18} {:>22}\n", "", "mean / max", "mean / max", "mean / max (at)");
     for g in &replay.joints {
@@ -239,7 +271,7 @@ pub struct ForwardSummary {
 impl ForwardSummary {
     pub fn of(index: i64, replay: &ForwardReplay, notices: Vec<String>) -> Self {
         let trips: Vec<serde_json::Value> = replay.protection_trips.iter().map(|(joint, trip)| serde_json::json!({ "joint": joint, "trip": trip })).collect();
-        let document = serde_json::json!({ "episode": index, "joints": replay.joints, "protection_trips": trips, "uncommanded": replay.uncommanded });
+        let document = serde_json::json!({ "episode": index, "latency_s": replay.latency.seconds, "latency_from": replay.latency.from, "joints": replay.joints, "protection_trips": trips, "uncommanded": replay.uncommanded });
         let widest_gap = replay.joints.iter().map(|g| g.gap_mae).fold(0.0, f64::max);
         Self { index, widest_gap, text: text(replay), document, notices }
     }

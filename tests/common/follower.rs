@@ -45,18 +45,19 @@ impl Recorder for Capture {
 /// The SO-101 simulated along `motion` (its exact commands every millisecond, from where they start)
 /// for `seconds` with `payload` at the tool: its positions every millisecond.
 pub fn follow(dir: &Path, motion: &[Sines], payload: f64, seconds: f64) -> Vec<Vec<f64>> {
-    follow_on(dir, motion, payload, seconds, &so101_motors())
+    follow_on(dir, motion, payload, seconds, &so101_motors(), 0.0)
 }
 
-/// [`follow`] with the servos of the motor file `motors`.
-pub fn follow_on(dir: &Path, motion: &[Sines], payload: f64, seconds: f64, motors: &Path) -> Vec<Vec<f64>> {
+/// [`follow`] with the servos of the motor file `motors`, each command reaching them `latency` s
+/// after it was sent (the first held until then: a teleop loop's delay).
+pub fn follow_on(dir: &Path, motion: &[Sines], payload: f64, seconds: f64, motors: &Path, latency: f64) -> Vec<Vec<f64>> {
     let schedule = dir.join("exact_commands.csv");
     let mut text = String::from("t,q1,q2,q3,q4,q5,q6\n");
     for k in 0..=(seconds * 1e3).round() as usize {
         let t = k as f64 * 1e-3;
         text += &format!("{t:?}");
         for m in motion {
-            text += &format!(",{:?}", m.q(t));
+            text += &format!(",{:?}", m.q((t - latency).max(0.0)));
         }
         text.push('\n');
     }
