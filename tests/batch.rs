@@ -132,9 +132,35 @@ fn shards_cover_the_manifest_and_merge_into_the_whole() {
         }
     }
     assert!(shared.join("comparison.rrd").exists(), "merge builds the comparison recording");
-    // an incomplete set of shards is refused
+    let merge_error = |dir: &Path| {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_armscope")).args(["batch", "merge", dir.to_str().unwrap()]).output().unwrap();
+        assert_eq!(out.status.code(), Some(2));
+        let err = String::from_utf8_lossy(&out.stderr).to_string();
+        assert_eq!(err.lines().count(), 1, "{err}");
+        err
+    };
+    // the same folder reused with another shard count: the merge names the mixed counts
+    armscope(&["batch", manifest.to_str().unwrap(), "--out", shared.to_str().unwrap(), "--shard", "0/2", "--no-compare"]);
+    let err = merge_error(&shared);
+    assert!(err.contains("shards of 2 counts here (1 of 2, 3 of 3)") && err.contains("another --shard N"), "{err}");
+    std::fs::remove_file(shared.join("summary.shard-0-of-2.json")).unwrap();
+    // an incomplete set of shards is refused, naming the missing one; shard 0 missing is what an
+    // array started at 1 leaves
     std::fs::remove_file(shared.join("summary.shard-1-of-3.json")).unwrap();
-    assert_eq!(armscope(&["batch", "merge", shared.to_str().unwrap()]), 2);
+    let err = merge_error(&shared);
+    assert!(err.contains("shard 1 of 3 missing"), "{err}");
+    std::fs::remove_file(shared.join("summary.shard-0-of-3.json")).unwrap();
+    let err = merge_error(&shared);
+    assert!(err.contains("shard 0, 1 of 3 missing") && err.contains("a Slurm array must start at 0"), "{err}");
+    // more shards than experiments: the empty one is written, and said
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_armscope"))
+        .args(["batch", manifest.to_str().unwrap(), "--out", dir.path().join("many").to_str().unwrap(), "--shard", "6/7", "--no-compare"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("shard 6 of 7 holds none of the manifest's 5 experiments"), "{err}");
+    assert!(dir.path().join("many/summary.shard-6-of-7.json").exists());
 }
 
 #[test]

@@ -154,8 +154,12 @@ pub fn parse_shard(text: &str) -> Result<(usize, usize), Error> {
     let bad = || Error::flag("--shard", format!("expected I/N with 0 ≤ I < N, got '{text}'"));
     let (i, n) = text.split_once('/').ok_or_else(bad)?;
     let (i, n): (usize, usize) = (i.trim().parse().map_err(|_| bad())?, n.trim().parse().map_err(|_| bad())?);
-    if n == 0 || i >= n {
+    if n == 0 {
         return Err(bad());
+    }
+    if i >= n {
+        // a Slurm array written --array=1-N hands the last task I = N
+        return Err(Error::flag("--shard", format!("shard {i} of {n}: shards count from 0 (0…{}); a Slurm array must start at 0 (--array=0-{})", n - 1, n - 1)));
     }
     Ok((i, n))
 }
@@ -210,6 +214,8 @@ mod tests {
             assert_eq!(seen, (0..11).collect::<Vec<_>>(), "{n} shards");
         }
         assert!(parse_shard("2/2").is_err() && parse_shard("x").is_err() && parse_shard("1/0").is_err());
+        let from_one = parse_shard("4/4").unwrap_err().to_string();
+        assert!(from_one.contains("shards count from 0 (0…3)") && from_one.contains("--array=0-3"), "{from_one}");
         assert_eq!(parse_shard("3/4").unwrap(), (3, 4));
     }
 

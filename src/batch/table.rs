@@ -152,7 +152,8 @@ pub fn write_tables(dir: &Path, summary: &BatchSummary) -> Result<Vec<PathBuf>, 
 /// Joins the shard summaries found in `dirs` into one, in manifest order; every experiment must
 /// appear exactly once.
 pub fn merge_summaries(dirs: &[PathBuf]) -> Result<BatchSummary, Error> {
-    let mut parts: Vec<BatchSummary> = Vec::new();
+    // each summary with the file it came from (the messages name them)
+    let mut parts: Vec<(PathBuf, BatchSummary)> = Vec::new();
     for dir in dirs {
         let entries = std::fs::read_dir(dir).map_err(|e| Error::flag("batch merge", format!("{}: {e}", dir.display())))?;
         for entry in entries.flatten() {
@@ -160,19 +161,33 @@ pub fn merge_summaries(dirs: &[PathBuf]) -> Result<BatchSummary, Error> {
             if name.starts_with("summary.shard-") && name.ends_with(".json") {
                 let text = std::fs::read_to_string(entry.path()).map_err(|e| Error::output(&entry.path(), e))?;
                 let part: BatchSummary = serde_json::from_str(&text).map_err(|e| Error::flag("batch merge", format!("{}: {e}", entry.path().display())))?;
-                parts.push(part);
+                parts.push((entry.path(), part));
             }
         }
     }
-    let first = parts.first().ok_or_else(|| Error::flag("batch merge", "no summary.shard-*.json in the given folders"))?.clone();
-    let total = first.shard.map_or(1, |[_, n]| n);
-    let mut shards: Vec<usize> = parts.iter().filter_map(|p| p.shard.map(|[i, _]| i)).collect();
+    parts.sort_by(|a, b| a.0.cmp(&b.0));
+    let first = parts.first().ok_or_else(|| Error::flag("batch merge", "no summary.shard-*.json in the given folders"))?.1.clone();
+    if let Some((path, other)) = parts.iter().find(|(_, p)| p.batch != first.batch) {
+        return Err(Error::flag("batch merge", format!("{} is of batch '{}', the others of '{}': merge one batch's shards at a time", path.display(), other.batch, first.batch)));
+    }
+    // a folder reused with another shard count holds two sets that overlap
+    let mut counts: Vec<usize> = parts.iter().map(|(_, p)| p.shard.map_or(1, |[_, n]| n)).collect();
+    counts.sort();
+    counts.dedup();
+    if counts.len() > 1 {
+        let sets: Vec<String> = counts.iter().map(|n| format!("{} of {n}", parts.iter().filter(|(_, p)| p.shard.map_or(1, |[_, m]| m) == *n).count())).collect();
+        return Err(Error::flag("batch merge", format!("batch '{}' has shards of {} counts here ({}): a folder reused with another --shard N? remove the summary.shard-*-of-N.* files of the run that is not wanted", first.batch, counts.len(), sets.join(", "))));
+    }
+    let total = counts[0];
+    let mut shards: Vec<usize> = parts.iter().filter_map(|(_, p)| p.shard.map(|[i, _]| i)).collect();
     shards.sort();
     shards.dedup();
-    if shards.len() != total || parts.iter().any(|p| p.batch != first.batch) {
-        return Err(Error::flag("batch merge", format!("found shards {shards:?} of batch '{}'; expected all {total}", first.batch)));
+    if shards.len() != total {
+        let missing: Vec<String> = (0..total).filter(|i| !shards.contains(i)).map(|i| i.to_string()).collect();
+        let hint = if missing.first().is_some_and(|m| m == "0") { " (shards count from 0: a Slurm array must start at 0, --array=0-N−1)" } else { " (still running, or failed before writing its summary?)" };
+        return Err(Error::flag("batch merge", format!("batch '{}': shard {} of {total} missing{hint}", first.batch, missing.join(", "))));
     }
-    let mut experiments: Vec<ExperimentOutcome> = parts.into_iter().flat_map(|p| p.experiments).collect();
+    let mut experiments: Vec<ExperimentOutcome> = parts.into_iter().flat_map(|(_, p)| p.experiments).collect();
     experiments.sort_by_key(|e| e.index);
     if let Some(dup) = experiments.windows(2).find(|w| w[0].index == w[1].index) {
         return Err(Error::flag("batch merge", format!("experiment '{}' appears in two shards", dup[0].name)));

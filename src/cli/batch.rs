@@ -13,7 +13,8 @@ pub struct BatchArgs {
     /// Experiments run at once (default: the number of cores).
     #[arg(long)]
     pub jobs: Option<usize>,
-    /// Run only shard I of N (I from 0), e.g. a Slurm array task: --shard $SLURM_ARRAY_TASK_ID/4.
+    /// Run only shard I of N (I from 0), e.g. a Slurm array task (--array=0-3):
+    /// --shard $SLURM_ARRAY_TASK_ID/$SLURM_ARRAY_TASK_COUNT.
     #[arg(long, value_name = "I/N")]
     pub shard: Option<String>,
     /// Output folder (default: recordings/BATCH, BATCH the manifest's name).
@@ -74,6 +75,10 @@ pub fn batch(args: &BatchArgs) -> Result<i32, Error> {
             install_interrupt_handler();
             INTERRUPTED.store(false, Ordering::SeqCst);
             let (summary, files) = crate::batch::run_batch(&options, Some(&INTERRUPTED))?;
+            if let (Some((i, n)), true) = (options.shard, summary.experiments.is_empty()) {
+                let all = crate::batch::load_manifest(&options.manifest)?.experiments.len();
+                eprintln!("armscope: notice: shard {i} of {n} holds none of the manifest's {all} experiments (more shards than experiments): its empty summary is written for the merge");
+            }
             report_batch(&summary, &files);
             summary
         }
