@@ -9,15 +9,18 @@ use crate::testbench::{BenchLog, ReplayOptions, Step, Supply, mae};
 #[derive(Args, Debug)]
 pub struct IdentifyArgs {
     /// Training logs (BAM's JSON, processed or raw).
-    #[arg(required = true, value_name = "LOG.json")]
+    #[arg(required_unless_present = "from", conflicts_with = "from", value_name = "LOG.json")]
     pub logs: Vec<PathBuf>,
     /// The servo: xl330, xl320, mx64, mx106, sts3215.
-    #[arg(long, value_name = "NAME")]
-    pub actuator: String,
+    #[arg(long, value_name = "NAME", required_unless_present = "from", conflicts_with = "from")]
+    pub actuator: Option<String>,
+    #[command(flatten)]
+    pub arm: super::identify_arm::ArmArgs,
     /// The friction model to fit (BAM's M1–M6).
     #[arg(long, value_enum, default_value_t = FrictionModel::M6)]
     pub friction_model: FrictionModel,
-    /// Where to write the parameters (BAM's JSON; `armscope testbench --servo-params` reads it).
+    /// Where to write the parameters (BAM's JSON; `armscope testbench --servo-params` reads it);
+    /// with --from, the motor file (FILE.toml, its servos' parameters beside it in FILE.NAME.json).
     #[arg(long, value_name = "P.json")]
     pub out: PathBuf,
     /// Held-out logs: replayed with the fit, not fitted to.
@@ -56,9 +59,10 @@ pub struct IdentifyArgs {
     /// parameters, rounded up to a multiple of the cores).
     #[arg(long, default_value_t = FitOptions::default().population)]
     pub population: usize,
-    /// Generations at most of each search on the windowed replay (the first stage).
-    #[arg(long, default_value_t = FitOptions::default().generations)]
-    pub generations: usize,
+    /// Generations at most of each search on the windowed replay (the first stage; default 200);
+    /// with --from, of the search on the episodes (default 60).
+    #[arg(long)]
+    pub generations: Option<usize>,
     /// Generations at most of the refinement on the free-running replay (the second stage).
     #[arg(long, default_value_t = FitOptions::default().refine_generations)]
     pub refine_generations: usize,
@@ -110,14 +114,19 @@ fn mean(list: &[LogMae]) -> f64 {
 
 /// `armscope identify`.
 pub fn identify(args: &IdentifyArgs) -> Result<i32, Error> {
-    let family = firmware::family(&args.actuator).ok_or_else(|| Error::flag("--actuator", format!("'{}' is not a servo armscope knows ({})", args.actuator, firmware::family_names())))?;
+    if let Some(dataset) = &args.arm.from {
+        return super::identify_arm::identify_arm(args, dataset);
+    }
+    let actuator = args.actuator.as_deref().unwrap_or_default();
+    let family = firmware::family(actuator).ok_or_else(|| Error::flag("--actuator", format!("'{actuator}' is not a servo armscope knows ({})", firmware::family_names())))?;
+    let generations = args.generations.unwrap_or(FitOptions::default().generations);
     if args.substeps == 0 {
         return Err(Error::flag("--substeps", "must be at least 1"));
     }
     if args.population == 1 {
         return Err(Error::flag("--population", "must be at least 2 (or 0 for CMA-ES's default)"));
     }
-    if args.generations == 0 {
+    if generations == 0 {
         return Err(Error::flag("--generations", "must be at least 1"));
     }
     if !(args.dt.is_finite() && args.dt > 0.0) {
@@ -147,7 +156,7 @@ pub fn identify(args: &IdentifyArgs) -> Result<i32, Error> {
         None => None,
     };
     let space = Space::new(family, args.friction_model, args.fit_supply_resistance, args.fit_motor_voltage_limit, !args.no_command_delay);
-    let options = FitOptions { searches: args.searches, population: args.population, generations: args.generations, refine_generations: args.refine_generations, seed: args.seed, start };
+    let options = FitOptions { searches: args.searches, population: args.population, generations, refine_generations: args.refine_generations, seed: args.seed, start };
     let started = std::time::Instant::now();
     let bar = ProgressBar::new(0);
     if args.quiet {

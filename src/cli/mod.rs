@@ -6,6 +6,7 @@ mod catalogue;
 mod compare;
 mod envelope;
 mod identify;
+mod identify_arm;
 mod model;
 mod reference;
 mod replay;

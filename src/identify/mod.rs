@@ -1,6 +1,7 @@
 //! Identifying a servo from bench logs (`armscope identify`): which parameters and where to look
-//! ([`space`]), and the fit ([`fit`]) with CMA-ES ([`cmaes`]).
+//! ([`space`]), and the fit ([`fit`]) with CMA-ES ([`cmaes`]); an arm from its own episodes ([`arm`]).
 
+pub mod arm;
 pub mod cmaes;
 pub mod fit;
 pub mod space;

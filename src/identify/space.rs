@@ -119,6 +119,21 @@ impl Space {
         p
     }
 
+    /// The space of `keys` only (those it has), in its order.
+    pub fn only(mut self, keys: &[&str]) -> Self {
+        self.dimensions.retain(|d| keys.contains(&d.key));
+        self
+    }
+
+    /// `base` with the parameters of this space set to those at point `u`.
+    pub fn params_from(&self, base: &ServoParams, u: &[f64]) -> ServoParams {
+        let mut p = base.clone();
+        for (d, &u) in self.dimensions.iter().zip(u) {
+            set(&mut p, d.key, d.value(u));
+        }
+        p
+    }
+
     /// The point of the unit cube of `params` (values outside a range clamped into it).
     pub fn point(&self, params: &ServoParams) -> Vec<f64> {
         self.dimensions.iter().map(|d| d.coordinate(get(params, d.key))).collect()

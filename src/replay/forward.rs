@@ -33,6 +33,12 @@ pub struct JointGap {
     pub gap_max_at: f64,
     /// The first time the gap exceeds [`PARTS_ABOVE`], s.
     pub parts_at: Option<f64>,
+    /// False where the real joint stayed put while its commands swept (a servo off, a cable
+    /// loose): its gap is no model's, and it is left out of the ranking and of identification.
+    pub follows: bool,
+    /// How far the commands and the real joint ranged, rad (m).
+    pub commanded_sweep: f64,
+    pub observed_sweep: f64,
 }
 
 /// One episode replayed forward.
@@ -86,53 +92,109 @@ impl Latency {
     }
 }
 
-/// Follow `commands` on the simulated arm from where they start, and compare with `observed`.
+/// Follow `commands` on the simulated arm from where the real follower starts, and compare with
+/// `observed`.
 pub fn forward(replayer: &Replayer, options: &ForwardOptions, commands: &Episode, observed: &Episode) -> Result<ForwardReplay, Error> {
-    let model = &replayer.base_model;
-    let mut command = inverse_replay(&replayer.model, &replayer.map.only_columns_of(commands), commands, &replayer.hold)?;
-    let reality = inverse_replay(&replayer.model, &replayer.map, observed, &replayer.hold)?;
-    if command.len() != reality.len() || command.time.iter().zip(&reality.time).any(|(a, b)| (a - b).abs() > 1e-9) {
-        return Err(Error::flag(commands.label.clone(), format!("its commands ({} frames) and observations ({} frames) are not sampled at the same times", command.len(), reality.len())));
+    let case = ForwardCase::prepare(replayer, commands, observed, &options.schedule, options.latency.clone())?;
+    follow(&replayer.base_model, &case, &Drives::File(&options.motors), options.payload, options.tool.as_deref(), options.recordings.as_ref())
+}
+
+/// An episode made ready to be followed, as many times as asked (identification follows it once per
+/// candidate): its commands and the real follower in the model's coordinates, its command schedule
+/// written.
+pub struct ForwardCase {
+    pub label: String,
+    command: super::Motion,
+    reality: super::Motion,
+    /// The joints both commanded and recorded (compared), and those recorded only (sent where the
+    /// real joint was).
+    mapped: Vec<usize>,
+    uncommanded: Vec<usize>,
+    latency: Latency,
+    schedule: PathBuf,
+}
+
+impl ForwardCase {
+    /// Map and smooth the episode's commands and observations, and write the schedule the simulated
+    /// servos follow (`latency` after each frame; None: one frame) to `schedule`.
+    pub fn prepare(replayer: &Replayer, commands: &Episode, observed: &Episode, schedule: &Path, latency: Option<Latency>) -> Result<Self, Error> {
+        let model = &replayer.base_model;
+        let mut command = inverse_replay(&replayer.model, &replayer.map.only_columns_of(commands), commands, &replayer.hold)?;
+        let reality = inverse_replay(&replayer.model, &replayer.map, observed, &replayer.hold)?;
+        if command.len() != reality.len() || command.time.iter().zip(&reality.time).any(|(a, b)| (a - b).abs() > 1e-9) {
+            return Err(Error::flag(commands.label.clone(), format!("its commands ({} frames) and observations ({} frames) are not sampled at the same times", command.len(), reality.len())));
+        }
+        let n = model.dof();
+        // a joint no command names (a bag's other controller) is sent where the real joint was
+        let uncommanded: Vec<usize> = (0..n).filter(|&j| command.recorded[j].is_none() && reality.recorded[j].is_some()).collect();
+        for &j in &uncommanded {
+            command.q[j] = reality.q[j].clone();
+        }
+        let mapped: Vec<usize> = (0..n).filter(|&j| command.recorded[j].is_some() && reality.recorded[j].is_some()).collect();
+        if mapped.is_empty() {
+            return Err(Error::flag(commands.label.clone(), format!("its commands name none of the recorded joints (commands: {})", commands.column_names().join(", "))));
+        }
+        // LeRobot's loop reads the follower, then the leader, then sends the action: frame t's command
+        // reaches the servos after observation t, the bus and the firmware add theirs (the servos' own
+        // command_delay)
+        let latency = latency.unwrap_or_else(|| Latency::given(schedule::frame_period(&command), "one frame"));
+        schedule::write_delayed(schedule, &command, latency.seconds)?;
+        Ok(Self { label: commands.label.clone(), command, reality, mapped, uncommanded, latency, schedule: schedule.to_path_buf() })
     }
-    let n = model.dof();
-    // a joint no command names (a bag's other controller) is sent where the real joint was
-    let uncommanded: Vec<usize> = (0..n).filter(|&j| command.recorded[j].is_none() && reality.recorded[j].is_some()).collect();
-    for &j in &uncommanded {
-        command.q[j] = reality.q[j].clone();
+
+    /// The compared joints (the model's coordinates).
+    pub fn compared(&self) -> &[usize] {
+        &self.mapped
     }
-    let mapped: Vec<usize> = (0..n).filter(|&j| command.recorded[j].is_some() && reality.recorded[j].is_some()).collect();
-    if mapped.is_empty() {
-        return Err(Error::flag(commands.label.clone(), format!("its commands name none of the recorded joints (commands: {})", commands.column_names().join(", "))));
+
+    /// The episode's length, s.
+    pub fn duration(&self) -> f64 {
+        schedule::span(&self.command).0
     }
-    // LeRobot's loop reads the follower, then the leader, then sends the action: frame t's command
-    // reaches the servos after observation t, the bus and the firmware add theirs (the servos' own
-    // command_delay)
-    let latency = options.latency.clone().unwrap_or_else(|| Latency::given(schedule::frame_period(&command), "one frame"));
-    schedule::write_delayed(&options.schedule, &command, latency.seconds)?;
+}
+
+/// Where the simulated follower's drives come from: the motor file, or a motor set made afresh for
+/// each experiment built (identification's candidates: the file's with other servo parameters).
+pub enum Drives<'a> {
+    File(&'a Path),
+    Made { file: &'a Path, make: &'a (dyn Fn() -> Result<crate::actuator::MotorSet, Error> + Sync) },
+}
+
+/// Follow `case` on the simulated arm (`model`, with `payload` kg at `tool`) through `drives`, and
+/// compare with the real follower; the run's recordings where asked.
+pub fn follow(model: &crate::model::Model, case: &ForwardCase, drives: &Drives, payload: f64, tool: Option<&str>, recordings: Option<&super::recording::RecordingOutputs>) -> Result<ForwardReplay, Error> {
+    let (command, reality, n) = (&case.command, &case.reality, model.dof());
     // the run starts at rest where the real follower starts (one whose first frame is far from its
     // leader's catches up, as the real one did), its servos holding the goal at which they sag to
     // that pose under the weight: the set-up sags the arm from the goal it is given, so the goal is
     // the pose less the sag there
-    let (length, _) = schedule::span(&command);
+    let length = case.duration();
     let observed_start: Vec<f64> = reality.q.iter().map(|joint| joint[0]).collect();
+    let motor_file = match drives {
+        Drives::File(file) | Drives::Made { file, .. } => file.to_path_buf(),
+    };
     let config_from = |start: &[f64]| RunConfig {
         urdf: model.source.clone(),
-        motors: Some(options.motors.clone()),
-        payload: options.payload,
-        tool: options.tool.clone(),
-        trajectory: Some(options.schedule.clone()),
+        motors: Some(motor_file.clone()),
+        payload,
+        tool: tool.map(str::to_string),
+        trajectory: Some(case.schedule.clone()),
         duration: length,
         q0: Some(start.iter().map(|q| format!("{q:?}")).collect::<Vec<_>>().join(",")),
         ..RunConfig::default()
     };
-    let sagged = Experiment::with_model(config_from(&observed_start), model.clone())?.initial_state().0;
+    let experiment_from = |start: &[f64]| match drives {
+        Drives::File(_) => Experiment::with_model(config_from(start), model.clone()),
+        Drives::Made { make, .. } => Experiment::with_motors(config_from(start), model.clone(), Some(make()?)),
+    };
+    let sagged = experiment_from(&observed_start)?.initial_state().0;
     let goal: Vec<f64> = (0..n).map(|j| (2.0 * observed_start[j] - sagged[j]).clamp(model.joints[j].lower.min(model.joints[j].upper), model.joints[j].upper.max(model.joints[j].lower))).collect();
-    let experiment = Experiment::with_model(config_from(&goal), model.clone())?;
+    let experiment = experiment_from(&goal)?;
     let dt = experiment.dt();
     let t0 = command.time[0];
     let time: Vec<f64> = command.time.iter().map(|t| t - t0).collect();
     let mut capture = Capture::at_steps(time.iter().map(|t| (t / dt).round() as usize).collect());
-    let mut files = options.recordings.as_ref().map_or_else(|| Ok(Vec::new()), |r| r.open())?;
+    let mut files = recordings.map_or_else(|| Ok(Vec::new()), |r| r.open())?;
     let mut recorders: Vec<&mut dyn Recorder> = vec![&mut capture];
     recorders.extend(files.iter_mut().map(|r| &mut **r as &mut dyn Recorder));
     // the real follower as recorded (before smoothing), beside the simulated one
@@ -140,14 +202,33 @@ pub fn forward(replayer: &Replayer, options: &ForwardOptions, commands: &Episode
     let summary = crate::sim::simulate_beside(&experiment, &mut recorders, None, Some(&follower))?;
     drop(recorders);
     if !matches!(summary.status, crate::summary::RunStatus::Completed) {
-        return Err(Error::Diverged(format!("{}: the forward replay did not complete: {:?}", commands.label, summary.status)));
+        return Err(Error::Diverged(format!("{}: the forward replay did not complete: {:?}", case.label, summary.status)));
     }
     let simulated_at = capture.finish();
     let (mut commanded, mut observed, mut simulated, mut joints) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-    for &j in &mapped {
+    for &j in &case.mapped {
         let c: Vec<f64> = command.recorded[j].clone().unwrap_or_default();
         let o: Vec<f64> = reality.recorded[j].clone().unwrap_or_default();
         let s: Vec<f64> = simulated_at.iter().map(|q| q[j]).collect();
+        joints.push(JointGap::of(&model.joints[j].name, &time, &c, &o, &s));
+        commanded.push(c);
+        observed.push(o);
+        simulated.push(s);
+    }
+    let protection_trips = summary.servos.iter().enumerate().filter_map(|(j, s)| Some((model.joints[j].name.clone(), s.as_ref()?.protection_trip?))).collect();
+    let uncommanded = case.uncommanded.iter().map(|&j| model.joints[j].name.clone()).collect();
+    Ok(ForwardReplay { label: case.label.clone(), time, commanded, observed, simulated, joints, protection_trips, uncommanded, latency: case.latency.clone() })
+}
+
+/// A joint whose commands sweep at least this far (rad, 10°) is expected to move.
+const SWEEP_EXPECTED: f64 = 0.17;
+/// A joint that moves less than this fraction of its commands' sweep does not follow them (a servo
+/// off, a cable loose): a real follower lags and sags, but covers most of the way.
+const FOLLOWS_FRACTION: f64 = 0.1;
+
+impl JointGap {
+    /// The figures of one joint from its commanded, observed and simulated positions at `time`.
+    fn of(joint: &str, time: &[f64], c: &[f64], o: &[f64], s: &[f64]) -> Self {
         let stats = |a: &[f64], b: &[f64]| -> (f64, f64, usize) {
             let mut worst = (0.0f64, 0usize);
             let mut sum = 0.0;
@@ -160,12 +241,13 @@ pub fn forward(replayer: &Replayer, options: &ForwardOptions, commands: &Episode
             }
             (sum / a.len() as f64, worst.0, worst.1)
         };
-        let (real_mae, real_max, _) = stats(&o, &c);
-        let (sim_mae, sim_max, _) = stats(&s, &c);
-        let (gap_mae, gap_max, at) = stats(&s, &o);
+        let (real_mae, real_max, _) = stats(o, c);
+        let (sim_mae, sim_max, _) = stats(s, c);
+        let (gap_mae, gap_max, at) = stats(s, o);
         let parts_at = (0..time.len()).find(|&k| (s[k] - o[k]).abs() > PARTS_ABOVE).map(|k| time[k]);
-        joints.push(JointGap {
-            joint: model.joints[j].name.clone(),
+        let (commanded_sweep, observed_sweep) = (sweep(c), sweep(o));
+        JointGap {
+            joint: joint.to_string(),
             real_tracking_mae: real_mae,
             real_tracking_max: real_max,
             sim_tracking_mae: sim_mae,
@@ -174,14 +256,17 @@ pub fn forward(replayer: &Replayer, options: &ForwardOptions, commands: &Episode
             gap_max,
             gap_max_at: time[at],
             parts_at,
-        });
-        commanded.push(c);
-        observed.push(o);
-        simulated.push(s);
+            follows: !(commanded_sweep >= SWEEP_EXPECTED && observed_sweep < FOLLOWS_FRACTION * commanded_sweep),
+            commanded_sweep,
+            observed_sweep,
+        }
     }
-    let protection_trips = summary.servos.iter().enumerate().filter_map(|(j, s)| Some((model.joints[j].name.clone(), s.as_ref()?.protection_trip?))).collect();
-    let uncommanded = uncommanded.iter().map(|&j| model.joints[j].name.clone()).collect();
-    Ok(ForwardReplay { label: commands.label.clone(), time, commanded, observed, simulated, joints, protection_trips, uncommanded, latency })
+}
+
+/// How far a series spans, max − min.
+fn sweep(x: &[f64]) -> f64 {
+    let (lo, hi) = x.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| (lo.min(v), hi.max(v)));
+    if hi >= lo { hi - lo } else { 0.0 }
 }
 
 /// The run's joint positions at the control steps nearest the episode's frames (only those: memory
@@ -232,6 +317,10 @@ pub fn text(replay: &ForwardReplay) -> String {
     out += &format!("  {:<16} {:>18} {:>18} {:>22}  {}\n", "joint", "real tracking", "model tracking", "gap model − real", "parts (gap > 50 mrad)");
     out += &format!("  {:<16} {:>18} {:>18} {:>22}\n", "", "mean / max", "mean / max", "mean / max (at)");
     for g in &replay.joints {
+        if !g.follows {
+            out += &format!("  {:<16} does not follow its commands: they sweep {:.0}°, the real joint moved {:.1}° (a servo off, a cable loose?); left out of the ranking\n", g.joint, g.commanded_sweep.to_degrees(), g.observed_sweep.to_degrees());
+            continue;
+        }
         let parts = g.parts_at.map_or("never".to_string(), |t| format!("at {t:.2} s"));
         out += &format!(
             "  {:<16} {:>8.1} / {:>7.1} {:>8.1} / {:>7.1} {:>8.1} / {:>6.1} ({:>5.2} s)  {parts}\n",
@@ -272,7 +361,7 @@ impl ForwardSummary {
     pub fn of(index: i64, replay: &ForwardReplay, notices: Vec<String>) -> Self {
         let trips: Vec<serde_json::Value> = replay.protection_trips.iter().map(|(joint, trip)| serde_json::json!({ "joint": joint, "trip": trip })).collect();
         let document = serde_json::json!({ "episode": index, "latency_s": replay.latency.seconds, "latency_from": replay.latency.from, "joints": replay.joints, "protection_trips": trips, "uncommanded": replay.uncommanded });
-        let widest_gap = replay.joints.iter().map(|g| g.gap_mae).fold(0.0, f64::max);
+        let widest_gap = replay.joints.iter().filter(|g| g.follows).map(|g| g.gap_mae).fold(0.0, f64::max);
         Self { index, widest_gap, text: text(replay), document, notices }
     }
 }

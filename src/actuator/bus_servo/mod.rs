@@ -84,6 +84,21 @@ impl BusServo {
         Self { name: name.into(), firmware, kt: params.kt, resistance: params.resistance, armature: params.armature, friction: params.friction, supply, supply_resistance: params.supply_resistance, motor_voltage_limit: params.motor_voltage_limit, command_delay: params.command_delay, envelope: None }
     }
 
+    /// The servo with identified parameters `params` in place of its own, its P gain, supply,
+    /// protections and datasheet envelope kept (they are the arm's settings, not the servo's
+    /// physics).
+    pub fn set_params(&mut self, params: &ServoParams) {
+        self.firmware.error_gain_ratio = params.error_gain_ratio;
+        self.firmware.max_velocity = params.max_velocity;
+        self.kt = params.kt;
+        self.resistance = params.resistance;
+        self.armature = params.armature;
+        self.friction = params.friction;
+        self.supply_resistance = params.supply_resistance;
+        self.motor_voltage_limit = params.motor_voltage_limit;
+        self.command_delay = params.command_delay;
+    }
+
     /// The identified parameters back (q_offset 0: a bench's, not the servo's).
     pub fn params(&self) -> ServoParams {
         ServoParams {

@@ -1,0 +1,342 @@
+//! `armscope identify --from DATASET`: an arm's servo parameters, command delay and payload from its
+//! own teleoperated episodes, written as a motor file `run`, `replay` and `size` read.
+
+use super::*;
+use std::path::Path;
+use crate::identify::arm::{ArmFitOptions, ArmObjective, ArmSpace, fit_arm};
+use crate::motion::{Mapped, open_mapped};
+use crate::replay::forward::{Drives, ForwardCase, ForwardReplay, ForwardSummary, Latency, follow};
+use crate::replay::{ReplayOptions, Replayer};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+
+/// The flags of `identify --from`.
+#[derive(Args, Debug)]
+pub struct ArmArgs {
+    /// Identify an arm from its own teleoperated episodes instead of a servo from bench logs: a
+    /// LeRobot dataset (its `action` followed, its follower's `observation.state` matched) or a ROS 2
+    /// bag with its controller's commands. Needs --urdf, --motors and --out FILE.toml.
+    #[arg(long, value_name = "DATASET")]
+    pub from: Option<PathBuf>,
+    /// With --from: the arm's URDF.
+    #[arg(long, value_name = "PATH", requires = "from")]
+    pub urdf: Option<PathBuf>,
+    /// With --from: the motor file to start from (each joint's servo; the catalogue's parameters).
+    #[arg(long, value_name = "FILE", requires = "from")]
+    pub motors: Option<PathBuf>,
+    /// With --from: the episodes fitted to (default: all but --validate-episodes).
+    #[arg(long, value_delimiter = ',', num_args = 1, requires = "from")]
+    pub episode: Option<Vec<i64>>,
+    /// With --from: episodes replayed with the fit, not fitted to (the gap reported on them).
+    #[arg(long, value_delimiter = ',', num_args = 1, requires = "from")]
+    pub validate_episodes: Vec<i64>,
+    /// With --from: the follower's feature.
+    #[arg(long, default_value = "observation.state")]
+    pub feature: String,
+    /// With --from: a joint map (see `replay --joint-map`).
+    #[arg(long, value_name = "FILE", requires = "from")]
+    pub joint_map: Option<PathBuf>,
+    /// With --from: the body joints' unit (see `replay --units`).
+    #[arg(long, value_enum, requires = "from")]
+    pub units: Option<crate::motion::BodyUnits>,
+    /// With --from: the follower's LeRobot calibration file (see `replay --calibration`).
+    #[arg(long, value_name = "FILE", requires = "from")]
+    pub calibration: Option<PathBuf>,
+    /// With --from: a payload known to be at the tool, kg.
+    #[arg(long, default_value_t = 0.0)]
+    pub payload: f64,
+    /// With --from: fit the payload at the tool too (0 to --payload-max kg).
+    #[arg(long, requires = "from", conflicts_with = "payload")]
+    pub fit_payload: bool,
+    /// With --fit-payload: the heaviest payload searched, kg.
+    #[arg(long, default_value_t = 0.5, requires = "fit_payload")]
+    pub payload_max: f64,
+    /// With --from: the link whose origin is the tool.
+    #[arg(long, value_name = "LINK", requires = "from")]
+    pub tool: Option<String>,
+    /// With --from: the joints whose gap is fitted (default: every compared joint but a gripper's,
+    /// which closes on objects the simulation does not have, and one that does not follow).
+    #[arg(long, value_delimiter = ',', num_args = 1, requires = "from")]
+    pub fit_joints: Option<Vec<String>>,
+    /// With --from: the teleop loop's latency, s (as `replay --forward --latency`; default one frame).
+    #[arg(long, value_name = "SECONDS", requires = "from")]
+    pub latency: Option<f64>,
+    /// With --from: candidates run at once (default: every core).
+    #[arg(long, requires = "from")]
+    pub jobs: Option<usize>,
+}
+
+/// An episode shorter than this (s) holds too little motion to identify from.
+const SHORTEST_EPISODE: f64 = 2.0;
+
+/// Default of `--generations` with --from.
+const GENERATIONS: usize = 60;
+
+/// `identify --from`.
+pub fn identify_arm(args: &IdentifyArgs, dataset: &Path) -> Result<i32, Error> {
+    let arm = &args.arm;
+    let urdf = arm.urdf.as_ref().ok_or_else(|| Error::flag("--from", "needs --urdf: the arm's URDF"))?;
+    let motors = arm.motors.as_ref().ok_or_else(|| Error::flag("--from", "needs --motors: the motor file to start from"))?;
+    if !(arm.payload.is_finite() && arm.payload >= 0.0) {
+        return Err(Error::flag("--payload", "must be a mass of 0 kg or more"));
+    }
+    if !(arm.payload_max.is_finite() && arm.payload_max > 0.0) {
+        return Err(Error::flag("--payload-max", "must be a positive mass, kg"));
+    }
+    if let Some(l) = arm.latency
+        && !(0.0..=crate::replay::forward::MAX_LATENCY).contains(&l)
+    {
+        return Err(Error::flag("--latency", format!("must be a number of seconds between 0 and {}", crate::replay::forward::MAX_LATENCY)));
+    }
+    let generations = args.generations.unwrap_or(GENERATIONS);
+    if generations == 0 {
+        return Err(Error::flag("--generations", "must be at least 1"));
+    }
+    if args.population == 1 {
+        return Err(Error::flag("--population", "must be at least 2 (or 0 for CMA-ES's default)"));
+    }
+    let started = std::time::Instant::now();
+    let model = crate::model::load_urdf(urdf)?;
+    for notice in &model.notices {
+        eprintln!("armscope: notice: {notice}");
+    }
+    let reading = crate::motion::Reading { units: arm.units, calibration: arm.calibration.as_deref() };
+    let opened = match open_mapped(dataset, None, None, &arm.feature, arm.joint_map.as_deref(), reading, &model)? {
+        Mapped::Ready(r) => r,
+        Mapped::NeedsMap { template } => {
+            println!("{template}");
+            return Err(super::replay::needs_map(dataset, urdf));
+        }
+    };
+    for notice in &opened.notices {
+        eprintln!("armscope: notice: {notice}");
+    }
+    let known = |flag: &str, list: &[i64]| -> Result<(), Error> {
+        match list.iter().find(|e| !opened.episodes.contains(e)) {
+            Some(e) => Err(Error::flag(flag, format!("episode {e}: not in {} (episodes: {})", dataset.display(), opened.episodes.iter().map(i64::to_string).collect::<Vec<_>>().join(", ")))),
+            None => Ok(()),
+        }
+    };
+    known("--validate-episodes", &arm.validate_episodes)?;
+    let train: Vec<i64> = match &arm.episode {
+        Some(list) => {
+            known("--episode", list)?;
+            if let Some(e) = list.iter().find(|e| arm.validate_episodes.contains(e)) {
+                return Err(Error::flag("--validate-episodes", format!("episode {e} is also fitted to (--episode): held out means not fitted to")));
+            }
+            list.clone()
+        }
+        None => opened.episodes.iter().copied().filter(|e| !arm.validate_episodes.contains(e)).collect(),
+    };
+    if train.is_empty() {
+        return Err(Error::flag("--episode", format!("no episode of {} left to fit to", dataset.display())));
+    }
+    let replayer = Replayer::new(model.clone(), &ReplayOptions { payload: 0.0, tool: arm.tool.clone(), motors: Some(motors.clone()) }, opened.map)?;
+    let scratch = tempfile::Builder::new().prefix("armscope-identify-").tempdir().map_err(|e| Error::output(&std::env::temp_dir(), e))?;
+    let latency = arm.latency.map(|s| Latency::given(s, "--latency"));
+    let prepare = |index: i64| -> Result<ForwardCase, Error> {
+        let (commands, observed) = opened.source.read_forward(index, &arm.feature, &Default::default())?;
+        let case = ForwardCase::prepare(&replayer, &commands, &observed, &scratch.path().join(format!("episode_{index}.csv")), latency.clone())?;
+        if case.duration() < SHORTEST_EPISODE {
+            return Err(Error::flag(commands.label.clone(), format!("{:.2} s long: too short to identify from (at least {SHORTEST_EPISODE} s of motion)", case.duration())));
+        }
+        Ok(case)
+    };
+    let train_cases = train.iter().map(|&e| prepare(e)).collect::<Result<Vec<_>, _>>()?;
+    let validate_cases = arm.validate_episodes.iter().map(|&e| prepare(e)).collect::<Result<Vec<_>, _>>()?;
+
+    // the joints fitted: every compared one but a gripper's and one that does not follow
+    let compared: Vec<usize> = train_cases[0].compared().to_vec();
+    let name = |j: usize| model.joints[j].name.clone();
+    let payload_now = arm.payload;
+    let before: Vec<ForwardReplay> = train_cases.iter().map(|c| follow(&model, c, &Drives::File(motors), payload_now, arm.tool.as_deref(), None)).collect::<Result<_, _>>()?;
+    let still: Vec<usize> = compared.iter().copied().filter(|&j| before.iter().any(|r| r.joints.iter().any(|g| g.joint == name(j) && !g.follows))).collect();
+    let mut left_out: Vec<(String, String)> = Vec::new();
+    let fitted: Vec<usize> = match &arm.fit_joints {
+        Some(list) => {
+            let mut fitted = Vec::new();
+            for joint in list {
+                let j = model.joint_index(joint).ok_or_else(|| Error::flag("--fit-joints", format!("no joint '{joint}' in {} (joints: {})", urdf.display(), model.joints.iter().map(|j| j.name.as_str()).collect::<Vec<_>>().join(", "))))?;
+                if !compared.contains(&j) {
+                    return Err(Error::flag("--fit-joints", format!("joint '{joint}': {} records no command and follower for it", dataset.display())));
+                }
+                fitted.push(j);
+            }
+            fitted
+        }
+        None => compared
+            .iter()
+            .copied()
+            .filter(|&j| {
+                let n = name(j).to_lowercase();
+                if n.contains("gripper") || n.contains("jaw") {
+                    left_out.push((name(j), "a gripper: it closes on objects the simulation does not have (--fit-joints fits it)".into()));
+                    false
+                } else if still.contains(&j) {
+                    left_out.push((name(j), "it does not follow its commands (the real joint stayed put while they swept)".into()));
+                    false
+                } else {
+                    true
+                }
+            })
+            .collect(),
+    };
+    for (joint, why) in &left_out {
+        eprintln!("armscope: notice: {joint} left out of the fit: {why}");
+    }
+    let start_set = crate::actuator::load_motor_file(motors, &model)?;
+    let space = ArmSpace::new(&start_set, &fitted, arm.fit_payload.then_some(arm.payload_max));
+    if space.kinds.is_empty() {
+        return Err(Error::flag("--motors", format!("{}: no fitted joint has a servo with a firmware model (identify --from fits bus servos' parameters)", motors.display())));
+    }
+    let mut is_fitted = vec![false; model.dof()];
+    for &j in &fitted {
+        is_fitted[j] = true;
+    }
+    let objective = ArmObjective { model: &model, motor_file: motors, tool: arm.tool.as_deref(), space: &space, cases: &train_cases, fitted: is_fitted.clone() };
+    let jobs = arm.jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get())).max(1);
+    let options = ArmFitOptions { population: args.population, generations, seed: args.seed, jobs, ..ArmFitOptions::default() };
+    let bar = ProgressBar::new(generations as u64);
+    if args.quiet {
+        bar.set_draw_target(ProgressDrawTarget::hidden());
+    } else {
+        bar.set_style(ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:30} {pos}/{len} generations  {msg}").unwrap_or_else(|_| ProgressStyle::default_bar()));
+        bar.enable_steady_tick(std::time::Duration::from_millis(200));
+    }
+    let progress = |generation: usize, best: f64| {
+        bar.set_position(generation as u64);
+        bar.set_message(format!("best {:.2} mrad", 1e3 * best));
+    };
+    let found = fit_arm(&objective, &options, &progress)?;
+    bar.finish_and_clear();
+    let seconds = started.elapsed().as_secs_f64();
+
+    let servo_files = write_motor_file(&args.out, motors, &model, &start_set, &space, &found.params, dataset, &train, &found)?;
+    // the file as written, replayed: what `replay --forward --motors FILE` will give
+    let payload = if arm.fit_payload { found.payload } else { arm.payload };
+    let replay_with = |cases: &[ForwardCase]| -> Result<Vec<ForwardReplay>, Error> { cases.iter().map(|c| follow(&model, c, &Drives::File(&args.out), payload, arm.tool.as_deref(), None)).collect() };
+    let trained = replay_with(&train_cases)?;
+    let validated = replay_with(&validate_cases)?;
+    let fitted_names: Vec<String> = fitted.iter().map(|&j| name(j)).collect();
+    let mean_gap = |replays: &[ForwardReplay]| -> Option<f64> {
+        let gaps: Vec<f64> = replays.iter().flat_map(|r| r.joints.iter().filter(|g| fitted_names.contains(&g.joint)).map(|g| g.gap_mae)).collect();
+        (!gaps.is_empty()).then(|| gaps.iter().sum::<f64>() / gaps.len() as f64)
+    };
+    if !args.quiet {
+        println!(
+            "{} fitted to {} episode(s) of {} on {} in {seconds:.1} s ({} candidates): mean gap {:.2} mrad (the motor file's parameters: {:.2})",
+            space.kinds.iter().map(|k| k.name.as_str()).collect::<Vec<_>>().join(", "),
+            train.len(),
+            dataset.display(),
+            fitted_names.join(", "),
+            found.evaluations,
+            1e3 * found.loss,
+            1e3 * found.start_loss
+        );
+        for (kind, p) in space.kinds.iter().zip(&found.params) {
+            println!(
+                "  {}: command delay {:.1} ms, k_t {:.4} N·m/A, error gain ×{:.3}, armature {:.3e} kg·m², friction base {:.4} N·m, viscous {:.4} N·m·s/rad",
+                kind.name,
+                1e3 * p.command_delay,
+                p.kt,
+                p.error_gain_ratio,
+                p.armature,
+                p.friction.get("friction_base").unwrap_or(0.0),
+                p.friction.get("friction_viscous").unwrap_or(0.0)
+            );
+        }
+        if arm.fit_payload {
+            println!("  payload {:.3} kg", found.payload);
+        }
+        for r in trained.iter().chain(&validated) {
+            let held = validated.iter().any(|v| v.label == r.label);
+            println!("{}{}", if held { "held out: " } else { "fitted to: " }, crate::replay::forward::text(r).trim_end());
+        }
+        if let Some(gap) = mean_gap(&validated) {
+            println!("mean gap on the held-out episodes: {:.2} mrad", 1e3 * gap);
+        }
+        println!("wrote {} ({})", args.out.display(), servo_files.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", "));
+    }
+    if let Some(path) = &args.summary_json {
+        let kinds: Vec<serde_json::Value> = space.kinds.iter().zip(&found.params).map(|(k, p)| serde_json::json!({ "servo": k.name, "joints": k.joints.iter().map(|&j| name(j)).collect::<Vec<_>>(), "params": p.to_json() })).collect();
+        let documents = |replays: &[ForwardReplay], episodes: &[i64]| -> Vec<serde_json::Value> { replays.iter().zip(episodes).map(|(r, &e)| ForwardSummary::of(e, r, Vec::new()).document).collect() };
+        let doc = serde_json::json!({
+            "from": dataset.display().to_string(),
+            "motor_file": args.out.display().to_string(),
+            "train_episodes": train,
+            "validate_episodes": arm.validate_episodes,
+            "fitted_joints": fitted_names,
+            "left_out": left_out.iter().map(|(j, why)| serde_json::json!({ "joint": j, "why": why })).collect::<Vec<_>>(),
+            "payload_kg": payload,
+            "payload_fitted": arm.fit_payload,
+            "servos": kinds,
+            "start_gap_rad": found.start_loss,
+            "gap_rad": found.loss,
+            "validate_gap_rad": mean_gap(&validated),
+            "evaluations": found.evaluations,
+            "seconds": seconds,
+            "train": documents(&trained, &train),
+            "validate": documents(&validated, &arm.validate_episodes),
+        });
+        let text = serde_json::to_string_pretty(&doc).map_err(|e| Error::output(path, e))?;
+        crate::runner::create_parent(path)?;
+        std::fs::write(path, text + "\n").map_err(|e| Error::output(path, e))?;
+    }
+    Ok(0)
+}
+
+/// Write the motor file `out`: `motors`' own, every joint of a fitted servo kind pointed at that
+/// kind's parameters (`OUT_STEM.KIND.json`, beside it), the files it names made absolute so that it
+/// reads from anywhere. Returns the parameter files written.
+#[allow(clippy::too_many_arguments)]
+fn write_motor_file(out: &Path, motors: &Path, model: &crate::model::Model, set: &crate::actuator::MotorSet, space: &ArmSpace, params: &[crate::actuator::bus_servo::ServoParams], dataset: &Path, train: &[i64], found: &crate::identify::arm::ArmFit) -> Result<Vec<PathBuf>, Error> {
+    use toml::Value;
+    let fail = |m: String| Error::flag(motors.display().to_string(), m);
+    let text = crate::builtin::read_to_string(motors).map_err(|e| fail(format!("cannot read: {e}")))?;
+    let mut table: toml::Table = text.parse().map_err(|e: toml::de::Error| fail(e.message().to_string()))?;
+    let here = motors.parent().filter(|p| !p.as_os_str().is_empty()).map_or_else(|| PathBuf::from("."), Path::to_path_buf);
+    let absolute = |file: &str| -> String { std::path::absolute(here.join(file)).unwrap_or_else(|_| here.join(file)).display().to_string() };
+    if let Some(Value::String(c)) = table.get("catalogue").cloned() {
+        table.insert("catalogue".into(), Value::String(absolute(&c)));
+    }
+    crate::runner::create_parent(out)?;
+    let stem = out.file_stem().map_or("identified".into(), |s| s.to_string_lossy().into_owned());
+    let out_dir = out.parent().filter(|p| !p.as_os_str().is_empty()).map_or_else(|| PathBuf::from("."), Path::to_path_buf);
+    let mut written = Vec::new();
+    let mut file_of_kind = Vec::new();
+    for (kind, p) in space.kinds.iter().zip(params) {
+        let name = format!("{stem}.{}.json", crate::runner::file_safe(&kind.name));
+        let path = out_dir.join(&name);
+        std::fs::write(&path, serde_json::to_string_pretty(&p.to_json()).unwrap_or_default() + "\n").map_err(|e| Error::output(&path, e))?;
+        written.push(path);
+        file_of_kind.push(name);
+    }
+    let joints = match table.get_mut("joints") {
+        Some(Value::Table(t)) => t,
+        _ => return Err(fail("no [joints] table: identify --from writes the servos' parameters into it".into())),
+    };
+    for (key, entry) in joints.iter_mut() {
+        let Value::Table(entry) = entry else { continue };
+        let servo = model.joint_index(key).and_then(|j| set.joints[j].as_ref()).and_then(|d| d.servo.as_ref());
+        match servo.and_then(|s| space.kinds.iter().position(|k| k.name == s.name)) {
+            Some(k) => {
+                entry.insert("servo_params".into(), Value::String(file_of_kind[k].clone()));
+            }
+            None => {
+                if let Some(Value::String(f)) = entry.get("servo_params").cloned() {
+                    entry.insert("servo_params".into(), Value::String(absolute(&f)));
+                }
+            }
+        }
+    }
+    let header = format!(
+        "# Identified by `armscope identify --from {}` on episode(s) {} of it, from {}: the mean gap between the\n# simulated and the real follower {:.2} mrad ({:.2} with the parameters started from). Each servo's parameters are\n# in the file its servo_params names.\n",
+        dataset.display(),
+        train.iter().map(i64::to_string).collect::<Vec<_>>().join(", "),
+        motors.display(),
+        1e3 * found.loss,
+        1e3 * found.start_loss
+    );
+    let body = toml::to_string(&table).map_err(|e| fail(e.to_string()))?;
+    std::fs::write(out, header + &body).map_err(|e| Error::output(out, e))?;
+    Ok(written)
+}

@@ -1,0 +1,193 @@
+//! An arm identified from its own teleoperated episodes (`identify --from DATASET`): what the forward
+//! replay needs to follow the real follower — each servo kind's firmware, motor and friction
+//! parameters (shared by the servos of one kind: an arm's episodes cannot tell them apart), their
+//! command delay, and optionally the payload — fitted by CMA-ES on the mean gap between the simulated
+//! and the real follower over the training episodes, starting from the motor file's (the catalogue's)
+//! parameters, each kept within BAM's bounds (no negative friction, a delay within 0–0.1 s).
+
+use super::cmaes::Cmaes;
+use super::space::Space;
+use crate::actuator::bus_servo::ServoParams;
+use crate::actuator::{MotorSet, load_motor_file};
+use crate::error::Error;
+use crate::model::Model;
+use crate::replay::forward::{Drives, ForwardCase, follow};
+use std::path::Path;
+
+/// The servo parameters an arm's motion tells: the loop's gain and the motor's torque (k_t, the
+/// error gain), the rotor's inertia, the friction's base, load-dependent and viscous parts, and the
+/// command delay. The rest (the resistance beside k_t, the Stribeck shape, the goal-speed bound)
+/// trade off against these on an arm's slow motions and stay the motor file's.
+pub const ARM_KEYS: [&str; 9] = ["kt", "error_gain_ratio", "armature", "friction_base", "load_friction_base", "load_friction_motor", "load_friction_external", "friction_viscous", "command_delay"];
+
+/// The loss of a candidate whose run diverged or failed, rad: worse than any follower's gap.
+const FAILED: f64 = 10.0;
+
+/// One kind of servo on the arm: its name, the joints it drives, its parameters to start from, and
+/// the space they are searched in.
+#[derive(Clone, Debug)]
+pub struct ServoKind {
+    pub name: String,
+    pub joints: Vec<usize>,
+    pub start: ServoParams,
+    pub space: Space,
+}
+
+/// What is searched: each kind's parameters, then the payload (kg, 0 to its bound) where fitted.
+#[derive(Clone, Debug)]
+pub struct ArmSpace {
+    pub kinds: Vec<ServoKind>,
+    pub payload: Option<f64>,
+}
+
+impl ArmSpace {
+    /// The servo kinds of `motors` on the joints `fitted` (model coordinates), and the payload up to
+    /// `payload` kg where given.
+    pub fn new(motors: &MotorSet, fitted: &[usize], payload: Option<f64>) -> Self {
+        let mut kinds: Vec<ServoKind> = Vec::new();
+        for &j in fitted {
+            let Some(servo) = motors.joints[j].as_ref().and_then(|d| d.servo.as_ref()) else { continue };
+            match kinds.iter_mut().find(|k| k.name == servo.name) {
+                Some(kind) => kind.joints.push(j),
+                None => {
+                    let start = servo.params();
+                    let space = Space::new(start.family, start.friction.model, false, false, true).only(&ARM_KEYS);
+                    kinds.push(ServoKind { name: servo.name.clone(), joints: vec![j], start, space });
+                }
+            }
+        }
+        Self { kinds, payload }
+    }
+
+    pub fn len(&self) -> usize {
+        self.kinds.iter().map(|k| k.space.len()).sum::<usize>() + usize::from(self.payload.is_some())
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The start: each kind's own parameters, no payload.
+    pub fn start(&self) -> Vec<f64> {
+        let mut u: Vec<f64> = self.kinds.iter().flat_map(|k| k.space.point(&k.start)).collect();
+        if self.payload.is_some() {
+            u.push(0.0);
+        }
+        u
+    }
+
+    /// Each kind's parameters and the payload at point `u`.
+    pub fn decode(&self, u: &[f64]) -> (Vec<ServoParams>, f64) {
+        let mut at = 0;
+        let params = self
+            .kinds
+            .iter()
+            .map(|k| {
+                let p = k.space.params_from(&k.start, &u[at..at + k.space.len()]);
+                at += k.space.len();
+                p
+            })
+            .collect();
+        let payload = self.payload.map_or(0.0, |most| most * u[at].clamp(0.0, 1.0));
+        (params, payload)
+    }
+}
+
+/// The mean gap over the training episodes of a candidate: what the search minimises.
+pub struct ArmObjective<'a> {
+    pub model: &'a Model,
+    pub motor_file: &'a Path,
+    pub tool: Option<&'a str>,
+    pub space: &'a ArmSpace,
+    pub cases: &'a [ForwardCase],
+    /// Per model coordinate: in the loss.
+    pub fitted: Vec<bool>,
+}
+
+impl ArmObjective<'_> {
+    /// The motor file's drives with the servo parameters `params` (by kind).
+    pub fn motors(&self, params: &[ServoParams]) -> Result<MotorSet, Error> {
+        let mut set = load_motor_file(self.motor_file, self.model)?;
+        for (kind, p) in self.space.kinds.iter().zip(params) {
+            for d in set.joints.iter_mut().flatten() {
+                if let Some(servo) = d.servo.as_mut().filter(|s| s.name == kind.name) {
+                    servo.set_params(p);
+                }
+            }
+        }
+        Ok(set)
+    }
+
+    /// The mean |simulated − real| over the training episodes' frames and fitted joints, rad.
+    pub fn loss(&self, u: &[f64]) -> f64 {
+        let (params, payload) = self.space.decode(u);
+        let make = || self.motors(&params);
+        let (mut sum, mut count) = (0.0, 0usize);
+        for case in self.cases {
+            let Ok(replay) = follow(self.model, case, &Drives::Made { file: self.motor_file, make: &make }, payload, self.tool, None) else { return FAILED };
+            for (g, &j) in replay.joints.iter().zip(case.compared()) {
+                if self.fitted[j] {
+                    sum += g.gap_mae * replay.time.len() as f64;
+                    count += replay.time.len();
+                }
+            }
+        }
+        if count == 0 || !sum.is_finite() { FAILED } else { sum / count as f64 }
+    }
+}
+
+/// How the search runs.
+#[derive(Clone, Debug)]
+pub struct ArmFitOptions {
+    /// Candidates a generation (0: CMA-ES's default for the dimension, rounded up to the cores).
+    pub population: usize,
+    pub generations: usize,
+    /// The first step, on the unit cube.
+    pub sigma: f64,
+    pub seed: u64,
+    pub jobs: usize,
+}
+
+impl Default for ArmFitOptions {
+    fn default() -> Self {
+        Self { population: 0, generations: 60, sigma: 0.1, seed: 1, jobs: 1 }
+    }
+}
+
+/// The fit: the point found, its loss, the start's, and how many candidates were run.
+#[derive(Clone, Debug)]
+pub struct ArmFit {
+    pub point: Vec<f64>,
+    pub params: Vec<ServoParams>,
+    pub payload: f64,
+    pub loss: f64,
+    pub start_loss: f64,
+    pub evaluations: usize,
+}
+
+/// Minimise `objective` from its space's start; `progress` sees (generation, best loss so far).
+pub fn fit_arm(objective: &ArmObjective, options: &ArmFitOptions, progress: &(dyn Fn(usize, f64) + Sync)) -> Result<ArmFit, Error> {
+    use rayon::prelude::*;
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(options.jobs.max(1)).build().map_err(|e| Error::flag("--jobs", e.to_string()))?;
+    let start = objective.space.start();
+    let start_loss = objective.loss(&start);
+    let (mut best, mut best_loss) = (start.clone(), start_loss);
+    let jobs = options.jobs.max(1);
+    let population = if options.population >= 2 { options.population } else { (4 + (3.0 * (start.len() as f64).ln()).floor() as usize).div_ceil(jobs) * jobs };
+    let mut search = Cmaes::new(&start, options.sigma, population, options.seed);
+    let mut evaluations = 1;
+    for generation in 0..options.generations {
+        let candidates = search.ask();
+        let losses: Vec<f64> = pool.install(|| candidates.points.par_iter().map(|u| objective.loss(u)).collect());
+        evaluations += losses.len();
+        for (u, &l) in candidates.points.iter().zip(&losses) {
+            if l < best_loss {
+                (best, best_loss) = (u.clone(), l);
+            }
+        }
+        search.tell(candidates, &losses);
+        progress(generation + 1, best_loss);
+    }
+    let (params, payload) = objective.space.decode(&best);
+    Ok(ArmFit { point: best, params, payload, loss: best_loss, start_loss, evaluations })
+}
