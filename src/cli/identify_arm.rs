@@ -5,7 +5,7 @@ use super::*;
 use std::path::Path;
 use crate::identify::arm::{ArmFitOptions, ArmObjective, ArmSpace, fit_arm};
 use crate::motion::{Mapped, open_mapped};
-use crate::replay::forward::{Drives, ForwardCase, ForwardReplay, ForwardSummary, Latency, follow};
+use crate::replay::forward::{Drives, FollowSetup, ForwardCase, ForwardReplay, ForwardSummary, Latency, follow};
 use crate::replay::{ReplayOptions, Replayer};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
@@ -50,6 +50,14 @@ pub struct ArmArgs {
     /// With --fit-payload: the heaviest payload searched, kg.
     #[arg(long, default_value_t = 0.5, requires = "fit_payload")]
     pub payload_max: f64,
+    /// With --from: the servo parameters fitted, by BAM's names (default: kt, error_gain_ratio,
+    /// armature, the friction's base, load and viscous terms, command_delay).
+    #[arg(long, value_delimiter = ',', num_args = 1, requires = "from")]
+    pub fit_params: Option<Vec<String>>,
+    /// With --from: fit each fitted joint's calibration offset too (the recording's zero against the
+    /// URDF's, within ±0.15 rad).
+    #[arg(long, requires = "from")]
+    pub fit_offsets: bool,
     /// With --from: the link whose origin is the tool.
     #[arg(long, value_name = "LINK", requires = "from")]
     pub tool: Option<String>,
@@ -70,6 +78,37 @@ const SHORTEST_EPISODE: f64 = 2.0;
 
 /// Default of `--generations` with --from.
 const GENERATIONS: usize = 60;
+
+/// The motion the search runs on at most, s: whole episodes, spread over the training ones, up to
+/// this long (the fit's cost grows with the motion each candidate replays: 30 s take ~35 s on two
+/// cores; the fit is then reported on every training episode).
+const SEARCH_SECONDS: f64 = 30.0;
+
+/// The training episodes the search runs on: all if they are short enough together, else whole
+/// episodes evenly spread over them up to [`SEARCH_SECONDS`] (at least one).
+fn searched(durations: &[f64]) -> Vec<usize> {
+    let total: f64 = durations.iter().sum();
+    if total <= SEARCH_SECONDS {
+        return (0..durations.len()).collect();
+    }
+    let mut order: Vec<usize> = Vec::new();
+    // a stride over the list, then every stride's neighbours: spread before dense
+    let n = durations.len();
+    let wanted = ((SEARCH_SECONDS / (total / n as f64)).floor() as usize).clamp(1, n);
+    let stride = n as f64 / wanted as f64;
+    for k in 0..wanted {
+        order.push(((k as f64 + 0.5) * stride).floor() as usize);
+    }
+    let mut chosen = Vec::new();
+    let mut seconds = 0.0;
+    for i in order {
+        if chosen.is_empty() || seconds + durations[i] <= SEARCH_SECONDS {
+            seconds += durations[i];
+            chosen.push(i);
+        }
+    }
+    chosen
+}
 
 /// `identify --from`.
 pub fn identify_arm(args: &IdentifyArgs, dataset: &Path) -> Result<i32, Error> {
@@ -148,7 +187,7 @@ pub fn identify_arm(args: &IdentifyArgs, dataset: &Path) -> Result<i32, Error> {
     let compared: Vec<usize> = train_cases[0].compared().to_vec();
     let name = |j: usize| model.joints[j].name.clone();
     let payload_now = arm.payload;
-    let before: Vec<ForwardReplay> = train_cases.iter().map(|c| follow(&model, c, &Drives::File(motors), payload_now, arm.tool.as_deref(), None)).collect::<Result<_, _>>()?;
+    let before: Vec<ForwardReplay> = train_cases.iter().map(|c| follow(&model, c, &Drives::File(motors), &FollowSetup { payload: payload_now, tool: arm.tool.as_deref(), offsets: None }, None)).collect::<Result<_, _>>()?;
     let still: Vec<usize> = compared.iter().copied().filter(|&j| before.iter().any(|r| r.joints.iter().any(|g| g.joint == name(j) && !g.follows))).collect();
     let mut left_out: Vec<(String, String)> = Vec::new();
     let fitted: Vec<usize> = match &arm.fit_joints {
@@ -184,7 +223,22 @@ pub fn identify_arm(args: &IdentifyArgs, dataset: &Path) -> Result<i32, Error> {
         eprintln!("armscope: notice: {joint} left out of the fit: {why}");
     }
     let start_set = crate::actuator::load_motor_file(motors, &model)?;
-    let space = ArmSpace::new(&start_set, &fitted, arm.fit_payload.then_some(arm.payload_max));
+    let keys: Vec<&str> = match &arm.fit_params {
+        Some(list) => {
+            let known = crate::identify::arm::fittable(&start_set, &fitted);
+            for key in list {
+                if !known.contains(&key.as_str()) {
+                    return Err(Error::flag("--fit-params", format!("'{key}' is not a parameter of the fitted joints' servos (they have: {})", known.join(", "))));
+                }
+            }
+            list.iter().map(String::as_str).collect()
+        }
+        None => crate::identify::arm::ARM_KEYS.to_vec(),
+    };
+    let space = ArmSpace::new(&start_set, &fitted, &keys, arm.fit_payload.then_some(arm.payload_max), arm.fit_offsets);
+    if space.is_empty() {
+        return Err(Error::flag("--fit-params", "nothing left to fit"));
+    }
     if space.kinds.is_empty() {
         return Err(Error::flag("--motors", format!("{}: no fitted joint has a servo with a firmware model (identify --from fits bus servos' parameters)", motors.display())));
     }
@@ -192,7 +246,18 @@ pub fn identify_arm(args: &IdentifyArgs, dataset: &Path) -> Result<i32, Error> {
     for &j in &fitted {
         is_fitted[j] = true;
     }
-    let objective = ArmObjective { model: &model, motor_file: motors, tool: arm.tool.as_deref(), space: &space, cases: &train_cases, fitted: is_fitted.clone() };
+    let durations: Vec<f64> = train_cases.iter().map(ForwardCase::duration).collect();
+    let chosen = searched(&durations);
+    if chosen.len() < train_cases.len() {
+        eprintln!(
+            "armscope: notice: the search runs on episodes {} ({:.0} s of the training episodes' {:.0} s: a fit's cost grows with the motion it replays); the fit is reported on all of them",
+            chosen.iter().map(|&i| train[i].to_string()).collect::<Vec<_>>().join(", "),
+            chosen.iter().map(|&i| durations[i]).sum::<f64>(),
+            durations.iter().sum::<f64>()
+        );
+    }
+    let search_cases: Vec<ForwardCase> = chosen.iter().map(|&i| train_cases[i].clone()).collect();
+    let objective = ArmObjective { model: &model, motor_file: motors, tool: arm.tool.as_deref(), space: &space, cases: &search_cases, fitted: is_fitted.clone() };
     let jobs = arm.jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get())).max(1);
     let options = ArmFitOptions { population: args.population, generations, seed: args.seed, jobs, ..ArmFitOptions::default() };
     let bar = ProgressBar::new(generations as u64);
@@ -213,7 +278,7 @@ pub fn identify_arm(args: &IdentifyArgs, dataset: &Path) -> Result<i32, Error> {
     let servo_files = write_motor_file(&args.out, motors, &model, &start_set, &space, &found.params, dataset, &train, &found)?;
     // the file as written, replayed: what `replay --forward --motors FILE` will give
     let payload = if arm.fit_payload { found.payload } else { arm.payload };
-    let replay_with = |cases: &[ForwardCase]| -> Result<Vec<ForwardReplay>, Error> { cases.iter().map(|c| follow(&model, c, &Drives::File(&args.out), payload, arm.tool.as_deref(), None)).collect() };
+    let replay_with = |cases: &[ForwardCase]| -> Result<Vec<ForwardReplay>, Error> { cases.iter().map(|c| follow(&model, c, &Drives::File(&args.out), &FollowSetup { payload, tool: arm.tool.as_deref(), offsets: arm.fit_offsets.then_some(found.offsets.as_slice()) }, None)).collect() };
     let trained = replay_with(&train_cases)?;
     let validated = replay_with(&validate_cases)?;
     let fitted_names: Vec<String> = fitted.iter().map(|&j| name(j)).collect();
@@ -247,6 +312,9 @@ pub fn identify_arm(args: &IdentifyArgs, dataset: &Path) -> Result<i32, Error> {
         if arm.fit_payload {
             println!("  payload {:.3} kg", found.payload);
         }
+        if arm.fit_offsets {
+            println!("  calibration offsets (the arm's angle less the recording's): {}", fitted.iter().map(|&j| format!("{} {:+.1} mrad", name(j), 1e3 * found.offsets[j])).collect::<Vec<_>>().join(", "));
+        }
         for r in trained.iter().chain(&validated) {
             let held = validated.iter().any(|v| v.label == r.label);
             println!("{}{}", if held { "held out: " } else { "fitted to: " }, crate::replay::forward::text(r).trim_end());
@@ -268,9 +336,12 @@ pub fn identify_arm(args: &IdentifyArgs, dataset: &Path) -> Result<i32, Error> {
             "left_out": left_out.iter().map(|(j, why)| serde_json::json!({ "joint": j, "why": why })).collect::<Vec<_>>(),
             "payload_kg": payload,
             "payload_fitted": arm.fit_payload,
+            "offsets_rad": arm.fit_offsets.then(|| fitted.iter().map(|&j| (name(j), found.offsets[j])).collect::<std::collections::BTreeMap<_, _>>()),
             "servos": kinds,
             "start_gap_rad": found.start_loss,
             "gap_rad": found.loss,
+            "searched_episodes": chosen.iter().map(|&i| train[i]).collect::<Vec<_>>(),
+            "train_gap_rad": mean_gap(&trained),
             "validate_gap_rad": mean_gap(&validated),
             "evaluations": found.evaluations,
             "seconds": seconds,

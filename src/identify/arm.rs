@@ -11,7 +11,7 @@ use crate::actuator::bus_servo::ServoParams;
 use crate::actuator::{MotorSet, load_motor_file};
 use crate::error::Error;
 use crate::model::Model;
-use crate::replay::forward::{Drives, ForwardCase, follow};
+use crate::replay::forward::{Drives, FollowSetup, ForwardCase, gap_within};
 use std::path::Path;
 
 /// The servo parameters an arm's motion tells: the loop's gain and the motor's torque (k_t, the
@@ -19,6 +19,50 @@ use std::path::Path;
 /// command delay. The rest (the resistance beside k_t, the Stribeck shape, the goal-speed bound)
 /// trade off against these on an arm's slow motions and stay the motor file's.
 pub const ARM_KEYS: [&str; 9] = ["kt", "error_gain_ratio", "armature", "friction_base", "load_friction_base", "load_friction_motor", "load_friction_external", "friction_viscous", "command_delay"];
+
+/// How far from its start a scale of the servo (its motor constant, loop gain, rotor inertia,
+/// resistance, speed bound) is searched: a factor of 4 either way. An arm's slow motion trades the
+/// rotor's inertia against the links' and k_t against the error gain; the catalogue's bench fit
+/// pins their scale, and a rotor inertia far below it is no geared servo's (and stiffens the plant:
+/// every halving of it doubles the steps a run needs).
+const SCALE_RANGE: f64 = 4.0;
+
+/// `space`'s scales narrowed to within [`SCALE_RANGE`] of `start` (and BAM's bounds).
+fn around(space: &mut Space, start: &ServoParams) {
+    let point = space.point(start);
+    let starts = space.params_from(start, &point);
+    for d in &mut space.dimensions {
+        let value = match d.key {
+            "kt" => starts.kt,
+            "error_gain_ratio" => starts.error_gain_ratio,
+            "armature" => starts.armature,
+            "R" => starts.resistance,
+            "max_velocity" => starts.max_velocity,
+            _ => continue,
+        };
+        if value > 0.0 {
+            d.lower = d.lower.max(value / SCALE_RANGE);
+            d.upper = d.upper.min(value * SCALE_RANGE);
+            d.logarithmic = true;
+        }
+    }
+}
+
+/// Every parameter a servo of `family` with friction `model` can have fitted on an arm (ARM_KEYS'
+/// and the rest of BAM's but the bench's angle offset).
+pub fn fittable(motors: &MotorSet, fitted: &[usize]) -> Vec<&'static str> {
+    let mut keys: Vec<&'static str> = Vec::new();
+    for &j in fitted {
+        let Some(servo) = motors.joints[j].as_ref().and_then(|d| d.servo.as_ref()) else { continue };
+        let p = servo.params();
+        for d in Space::new(p.family, p.friction.model, true, true, true).dimensions {
+            if d.key != "q_offset" && !keys.contains(&d.key) {
+                keys.push(d.key);
+            }
+        }
+    }
+    keys
+}
 
 /// The loss of a candidate whose run diverged or failed, rad: worse than any follower's gap.
 const FAILED: f64 = 10.0;
@@ -33,17 +77,25 @@ pub struct ServoKind {
     pub space: Space,
 }
 
-/// What is searched: each kind's parameters, then the payload (kg, 0 to its bound) where fitted.
+/// The largest calibration offset searched, rad (9°: a mid-range pose set by eye is off by a few
+/// degrees; more is a wrong map, not an offset).
+pub const OFFSET_RANGE: f64 = 0.15;
+
+/// What is searched: each kind's parameters, then the payload (kg, 0 to its bound) where fitted,
+/// then a calibration offset per joint of `offsets` (model coordinates) where fitted.
 #[derive(Clone, Debug)]
 pub struct ArmSpace {
     pub kinds: Vec<ServoKind>,
     pub payload: Option<f64>,
+    pub offsets: Vec<usize>,
+    pub dof: usize,
 }
 
 impl ArmSpace {
-    /// The servo kinds of `motors` on the joints `fitted` (model coordinates), and the payload up to
-    /// `payload` kg where given.
-    pub fn new(motors: &MotorSet, fitted: &[usize], payload: Option<f64>) -> Self {
+    /// The servo kinds of `motors` on the joints `fitted` (model coordinates) with their parameters
+    /// `keys` (those their family has), the payload up to `payload` kg where given, and the fitted
+    /// joints' offsets where asked.
+    pub fn new(motors: &MotorSet, fitted: &[usize], keys: &[&str], payload: Option<f64>, offsets: bool) -> Self {
         let mut kinds: Vec<ServoKind> = Vec::new();
         for &j in fitted {
             let Some(servo) = motors.joints[j].as_ref().and_then(|d| d.servo.as_ref()) else { continue };
@@ -51,16 +103,17 @@ impl ArmSpace {
                 Some(kind) => kind.joints.push(j),
                 None => {
                     let start = servo.params();
-                    let space = Space::new(start.family, start.friction.model, false, false, true).only(&ARM_KEYS);
+                    let mut space = Space::new(start.family, start.friction.model, false, false, true).only(keys);
+                    around(&mut space, &start);
                     kinds.push(ServoKind { name: servo.name.clone(), joints: vec![j], start, space });
                 }
             }
         }
-        Self { kinds, payload }
+        Self { kinds, payload, offsets: if offsets { fitted.to_vec() } else { Vec::new() }, dof: motors.joints.len() }
     }
 
     pub fn len(&self) -> usize {
-        self.kinds.iter().map(|k| k.space.len()).sum::<usize>() + usize::from(self.payload.is_some())
+        self.kinds.iter().map(|k| k.space.len()).sum::<usize>() + usize::from(self.payload.is_some()) + self.offsets.len()
     }
 
     pub fn is_empty(&self) -> bool {
@@ -73,11 +126,12 @@ impl ArmSpace {
         if self.payload.is_some() {
             u.push(0.0);
         }
+        u.extend(self.offsets.iter().map(|_| 0.5));
         u
     }
 
-    /// Each kind's parameters and the payload at point `u`.
-    pub fn decode(&self, u: &[f64]) -> (Vec<ServoParams>, f64) {
+    /// Each kind's parameters, the payload and the offsets (per coordinate) at point `u`.
+    pub fn decode(&self, u: &[f64]) -> (Vec<ServoParams>, f64, Vec<f64>) {
         let mut at = 0;
         let params = self
             .kinds
@@ -89,7 +143,12 @@ impl ArmSpace {
             })
             .collect();
         let payload = self.payload.map_or(0.0, |most| most * u[at].clamp(0.0, 1.0));
-        (params, payload)
+        at += usize::from(self.payload.is_some());
+        let mut offsets = vec![0.0; self.dof];
+        for (k, &j) in self.offsets.iter().enumerate() {
+            offsets[j] = OFFSET_RANGE * (2.0 * u[at + k].clamp(0.0, 1.0) - 1.0);
+        }
+        (params, payload, offsets)
     }
 }
 
@@ -118,21 +177,33 @@ impl ArmObjective<'_> {
         Ok(set)
     }
 
-    /// The mean |simulated − real| over the training episodes' frames and fitted joints, rad.
-    pub fn loss(&self, u: &[f64]) -> f64 {
-        let (params, payload) = self.space.decode(u);
+    /// The frames × fitted joints the loss averages over.
+    fn samples(&self) -> usize {
+        self.cases.iter().map(|c| c.frames() * c.compared().iter().filter(|&&j| self.fitted[j]).count()).sum()
+    }
+
+    /// The mean |simulated − real| over the training episodes' frames and fitted joints, rad; a
+    /// candidate whose mean passes `cutoff` is stopped there, its loss then the part it had reached
+    /// (past the cutoff: a lower bound, enough to rank it last).
+    pub fn loss(&self, u: &[f64], cutoff: f64) -> f64 {
+        let (params, payload, offsets) = self.space.decode(u);
         let make = || self.motors(&params);
-        let (mut sum, mut count) = (0.0, 0usize);
+        let setup = FollowSetup { payload, tool: self.tool, offsets: (!self.space.offsets.is_empty()).then_some(offsets.as_slice()) };
+        let samples = self.samples().max(1) as f64;
+        let budget = if cutoff.is_finite() { cutoff * samples } else { f64::INFINITY };
+        let mut sum = 0.0;
         for case in self.cases {
-            let Ok(replay) = follow(self.model, case, &Drives::Made { file: self.motor_file, make: &make }, payload, self.tool, None) else { return FAILED };
-            for (g, &j) in replay.joints.iter().zip(case.compared()) {
-                if self.fitted[j] {
-                    sum += g.gap_mae * replay.time.len() as f64;
-                    count += replay.time.len();
+            match gap_within(self.model, case, &Drives::Made { file: self.motor_file, make: &make }, &setup, &self.fitted, budget - sum) {
+                Ok((part, stopped)) => {
+                    sum += part;
+                    if stopped {
+                        break;
+                    }
                 }
+                Err(_) => return FAILED,
             }
         }
-        if count == 0 || !sum.is_finite() { FAILED } else { sum / count as f64 }
+        if sum.is_finite() { sum / samples } else { FAILED }
     }
 }
 
@@ -160,6 +231,8 @@ pub struct ArmFit {
     pub point: Vec<f64>,
     pub params: Vec<ServoParams>,
     pub payload: f64,
+    /// Per coordinate (0 where not fitted), rad (m).
+    pub offsets: Vec<f64>,
     pub loss: f64,
     pub start_loss: f64,
     pub evaluations: usize,
@@ -170,7 +243,7 @@ pub fn fit_arm(objective: &ArmObjective, options: &ArmFitOptions, progress: &(dy
     use rayon::prelude::*;
     let pool = rayon::ThreadPoolBuilder::new().num_threads(options.jobs.max(1)).build().map_err(|e| Error::flag("--jobs", e.to_string()))?;
     let start = objective.space.start();
-    let start_loss = objective.loss(&start);
+    let start_loss = objective.loss(&start, f64::INFINITY);
     let (mut best, mut best_loss) = (start.clone(), start_loss);
     let jobs = options.jobs.max(1);
     let population = if options.population >= 2 { options.population } else { (4 + (3.0 * (start.len() as f64).ln()).floor() as usize).div_ceil(jobs) * jobs };
@@ -178,9 +251,11 @@ pub fn fit_arm(objective: &ArmObjective, options: &ArmFitOptions, progress: &(dy
     let mut evaluations = 1;
     for generation in 0..options.generations {
         let candidates = search.ask();
-        let losses: Vec<f64> = pool.install(|| candidates.points.par_iter().map(|u| objective.loss(u)).collect());
+        let cutoff = search.cutoff();
+        let losses: Vec<f64> = pool.install(|| candidates.points.par_iter().map(|u| objective.loss(u, cutoff)).collect());
         evaluations += losses.len();
         for (u, &l) in candidates.points.iter().zip(&losses) {
+            // a stopped candidate's loss is past the cutoff, never below the best
             if l < best_loss {
                 (best, best_loss) = (u.clone(), l);
             }
@@ -188,6 +263,6 @@ pub fn fit_arm(objective: &ArmObjective, options: &ArmFitOptions, progress: &(dy
         search.tell(candidates, &losses);
         progress(generation + 1, best_loss);
     }
-    let (params, payload) = objective.space.decode(&best);
-    Ok(ArmFit { point: best, params, payload, loss: best_loss, start_loss, evaluations })
+    let (params, payload, offsets) = objective.space.decode(&best);
+    Ok(ArmFit { point: best, params, payload, offsets, loss: best_loss, start_loss, evaluations })
 }

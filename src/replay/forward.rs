@@ -96,12 +96,14 @@ impl Latency {
 /// `observed`.
 pub fn forward(replayer: &Replayer, options: &ForwardOptions, commands: &Episode, observed: &Episode) -> Result<ForwardReplay, Error> {
     let case = ForwardCase::prepare(replayer, commands, observed, &options.schedule, options.latency.clone())?;
-    follow(&replayer.base_model, &case, &Drives::File(&options.motors), options.payload, options.tool.as_deref(), options.recordings.as_ref())
+    let setup = FollowSetup { payload: options.payload, tool: options.tool.as_deref(), offsets: None };
+    follow(&replayer.base_model, &case, &Drives::File(&options.motors), &setup, options.recordings.as_ref())
 }
 
 /// An episode made ready to be followed, as many times as asked (identification follows it once per
 /// candidate): its commands and the real follower in the model's coordinates, its command schedule
 /// written.
+#[derive(Clone)]
 pub struct ForwardCase {
     pub label: String,
     command: super::Motion,
@@ -147,6 +149,11 @@ impl ForwardCase {
         &self.mapped
     }
 
+    /// The episode's frames.
+    pub fn frames(&self) -> usize {
+        self.command.len()
+    }
+
     /// The episode's length, s.
     pub fn duration(&self) -> f64 {
         schedule::span(&self.command).0
@@ -160,36 +167,92 @@ pub enum Drives<'a> {
     Made { file: &'a Path, make: &'a (dyn Fn() -> Result<crate::actuator::MotorSet, Error> + Sync) },
 }
 
-/// Follow `case` on the simulated arm (`model`, with `payload` kg at `tool`) through `drives`, and
-/// compare with the real follower; the run's recordings where asked.
-pub fn follow(model: &crate::model::Model, case: &ForwardCase, drives: &Drives, payload: f64, tool: Option<&str>, recordings: Option<&super::recording::RecordingOutputs>) -> Result<ForwardReplay, Error> {
-    let (command, reality, n) = (&case.command, &case.reality, model.dof());
-    // the run starts at rest where the real follower starts (one whose first frame is far from its
-    // leader's catches up, as the real one did), its servos holding the goal at which they sag to
-    // that pose under the weight: the set-up sags the arm from the goal it is given, so the goal is
-    // the pose less the sag there
-    let length = case.duration();
-    let observed_start: Vec<f64> = reality.q.iter().map(|joint| joint[0]).collect();
+/// What a follower is run with beyond its drives: the payload (kg) at the tool, and per coordinate
+/// the offset of the recording's angles from the arm's (None: none) — the arm runs at the
+/// recording's poses plus their offset, and is compared with the recording less it.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct FollowSetup<'a> {
+    pub payload: f64,
+    pub tool: Option<&'a str>,
+    pub offsets: Option<&'a [f64]>,
+}
+
+impl FollowSetup<'_> {
+    fn offset(&self, j: usize) -> f64 {
+        self.offsets.map_or(0.0, |o| o[j])
+    }
+}
+
+/// The experiment that follows `case`: the run starts at rest where the real follower starts (one
+/// whose first frame is far from its leader's catches up, as the real one did), its servos holding
+/// the goal at which they sag to that pose under the weight — the set-up sags the arm from the goal
+/// it is given, so the goal is the pose less the sag there.
+fn follower_experiment(model: &crate::model::Model, case: &ForwardCase, drives: &Drives, setup: &FollowSetup) -> Result<Experiment, Error> {
+    let n = model.dof();
+    let within = |j: usize, q: f64| q.clamp(model.joints[j].lower.min(model.joints[j].upper), model.joints[j].upper.max(model.joints[j].lower));
+    let observed_start: Vec<f64> = case.reality.q.iter().enumerate().map(|(j, joint)| within(j, joint[0] + setup.offset(j))).collect();
     let motor_file = match drives {
         Drives::File(file) | Drives::Made { file, .. } => file.to_path_buf(),
     };
     let config_from = |start: &[f64]| RunConfig {
         urdf: model.source.clone(),
         motors: Some(motor_file.clone()),
-        payload,
-        tool: tool.map(str::to_string),
+        payload: setup.payload,
+        tool: setup.tool.map(str::to_string),
         trajectory: Some(case.schedule.clone()),
-        duration: length,
+        duration: case.duration(),
         q0: Some(start.iter().map(|q| format!("{q:?}")).collect::<Vec<_>>().join(",")),
         ..RunConfig::default()
     };
-    let experiment_from = |start: &[f64]| match drives {
-        Drives::File(_) => Experiment::with_model(config_from(start), model.clone()),
-        Drives::Made { make, .. } => Experiment::with_motors(config_from(start), model.clone(), Some(make()?)),
+    let experiment_from = |start: &[f64]| -> Result<Experiment, Error> {
+        let mut experiment = match drives {
+            Drives::File(_) => Experiment::with_model(config_from(start), model.clone())?,
+            Drives::Made { make, .. } => Experiment::with_motors(config_from(start), model.clone(), Some(make()?))?,
+        };
+        if let Some(offsets) = setup.offsets {
+            let inner = std::mem::replace(&mut experiment.trajectory, Box::new(crate::control::trajectory::Hold));
+            experiment.trajectory = Box::new(crate::control::trajectory::Shifted { inner, offsets: offsets.to_vec() });
+        }
+        Ok(experiment)
     };
     let sagged = experiment_from(&observed_start)?.initial_state().0;
-    let goal: Vec<f64> = (0..n).map(|j| (2.0 * observed_start[j] - sagged[j]).clamp(model.joints[j].lower.min(model.joints[j].upper), model.joints[j].upper.max(model.joints[j].lower))).collect();
-    let experiment = experiment_from(&goal)?;
+    let goal: Vec<f64> = (0..n).map(|j| within(j, 2.0 * observed_start[j] - sagged[j])).collect();
+    experiment_from(&goal)
+}
+
+/// The sum over the frames and the joints `fitted` of |simulated − real| of `case` followed, run only
+/// as far as it stays within `budget` (rad·frames): (the sum, false), or (a sum past the budget,
+/// true) once stopped there. What identification ranks a candidate by, at a fraction of a whole
+/// follow's cost for the candidates that cannot win.
+pub fn gap_within(model: &crate::model::Model, case: &ForwardCase, drives: &Drives, setup: &FollowSetup, fitted: &[bool], budget: f64) -> Result<(f64, bool), Error> {
+    let experiment = follower_experiment(model, case, drives, setup)?;
+    let dt = experiment.dt();
+    let t0 = case.command.time[0];
+    let joints: Vec<usize> = case.mapped.iter().copied().filter(|&j| fitted[j]).collect();
+    let stop = std::sync::atomic::AtomicBool::new(false);
+    let mut watch = GapWatch {
+        wanted: case.command.time.iter().map(|t| ((t - t0) / dt).round() as usize).collect(),
+        observed: joints.iter().map(|&j| case.reality.recorded[j].clone().unwrap_or_default()).collect(),
+        offsets: joints.iter().map(|&j| setup.offset(j)).collect(),
+        joints,
+        next: 0,
+        sum: 0.0,
+        budget,
+        stop: &stop,
+    };
+    let summary = crate::sim::simulate(&experiment, &mut [&mut watch], Some(&stop))?;
+    match summary.status {
+        crate::summary::RunStatus::Completed => Ok((watch.sum, false)),
+        crate::summary::RunStatus::Interrupted { .. } => Ok((watch.sum, true)),
+        other => Err(Error::Diverged(format!("{}: the forward replay did not complete: {other:?}", case.label))),
+    }
+}
+
+/// Follow `case` on the simulated arm (`model`) through `drives` with `setup`, and compare with the
+/// real follower; the run's recordings where asked.
+pub fn follow(model: &crate::model::Model, case: &ForwardCase, drives: &Drives, setup: &FollowSetup, recordings: Option<&super::recording::RecordingOutputs>) -> Result<ForwardReplay, Error> {
+    let (command, reality) = (&case.command, &case.reality);
+    let experiment = follower_experiment(model, case, drives, setup)?;
     let dt = experiment.dt();
     let t0 = command.time[0];
     let time: Vec<f64> = command.time.iter().map(|t| t - t0).collect();
@@ -209,7 +272,7 @@ pub fn follow(model: &crate::model::Model, case: &ForwardCase, drives: &Drives, 
     for &j in &case.mapped {
         let c: Vec<f64> = command.recorded[j].clone().unwrap_or_default();
         let o: Vec<f64> = reality.recorded[j].clone().unwrap_or_default();
-        let s: Vec<f64> = simulated_at.iter().map(|q| q[j]).collect();
+        let s: Vec<f64> = simulated_at.iter().map(|q| q[j] - setup.offset(j)).collect();
         joints.push(JointGap::of(&model.joints[j].name, &time, &c, &o, &s));
         commanded.push(c);
         observed.push(o);
@@ -302,6 +365,41 @@ impl Recorder for Capture {
         }
         self.last.clear();
         self.last.extend_from_slice(sample.q);
+        Ok(())
+    }
+    fn finish(&mut self, _run: &RunInfo, _summary: &Summary) -> Result<(), Error> {
+        Ok(())
+    }
+}
+
+/// The running gap of a follower at the episode's frames, stopping the run once it passes its budget.
+struct GapWatch<'a> {
+    /// Per frame, its control step (non-decreasing).
+    wanted: Vec<usize>,
+    joints: Vec<usize>,
+    /// Per watched joint and frame, the real follower; and the joint's offset.
+    observed: Vec<Vec<f64>>,
+    offsets: Vec<f64>,
+    next: usize,
+    sum: f64,
+    budget: f64,
+    stop: &'a std::sync::atomic::AtomicBool,
+}
+
+impl Recorder for GapWatch<'_> {
+    fn start(&mut self, _run: &RunInfo) -> Result<(), Error> {
+        Ok(())
+    }
+    fn record(&mut self, sample: &Sample) -> Result<(), Error> {
+        while self.next < self.wanted.len() && self.wanted[self.next] <= sample.k {
+            for (w, &j) in self.joints.iter().enumerate() {
+                self.sum += (sample.q[j] - self.offsets[w] - self.observed[w][self.next]).abs();
+            }
+            self.next += 1;
+        }
+        if self.sum > self.budget {
+            self.stop.store(true, std::sync::atomic::Ordering::Relaxed);
+        }
         Ok(())
     }
     fn finish(&mut self, _run: &RunInfo, _summary: &Summary) -> Result<(), Error> {

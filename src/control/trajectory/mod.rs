@@ -4,6 +4,7 @@ mod hold;
 mod joint_wave;
 mod ramp_in;
 mod schedule;
+mod shifted;
 mod step;
 mod wave;
 
@@ -11,6 +12,7 @@ pub use hold::Hold;
 pub use joint_wave::JointWave;
 pub use ramp_in::RampIn;
 pub use schedule::JointSchedule;
+pub use shifted::Shifted;
 pub use step::JointStep;
 pub use wave::Wave;
 
