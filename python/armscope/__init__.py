@@ -6,17 +6,79 @@ The same library as the ``armscope`` command, NumPy in and out::
     m = armscope.Model("so101.urdf")
     tau = m.rnea(q, v, a)            # one state: (nq,) arrays
     taus = m.rnea(Q, V, A)           # a trajectory: (N, nq) arrays, the GIL released
+    r = armscope.run(no_ff=True, duration=30)   # `armscope run --no-ff --duration 30`, as arrays
 
 Bad input raises :class:`ArmscopeError` (what armscope refused, in the command line's one line),
 ``ValueError`` (an array of the wrong shape) or ``TypeError``.
 """
 
+import json
+import os
 import sys
 
+from . import _armscope
 from ._armscope import ArmscopeError, Model
 from ._armscope import main as _main
 
-__all__ = ["ArmscopeError", "Model", "main"]
+__all__ = ["ArmscopeError", "Model", "Run", "main", "run"]
+
+
+class Run:
+    """One run's every control step as NumPy arrays, and its summary.
+
+    ``t`` (N,); per joint, (N, nq): ``q``, ``q_target``, ``qd``, ``qd_target``, ``tau`` (the torque
+    applied, after the motors' limits), ``tau_g`` (the force gravity applies, Drake's sign),
+    ``tau_limit`` (the limit in the direction asked, at that speed), ``saturated`` (bool);
+    ``tool_position`` (N, 3), m; where the joints have bus servos, their ``duty`` and ``current``
+    (None otherwise). ``summary`` is the dict ``--summary-json`` writes.
+    """
+
+    def __init__(self, arrays, summary):
+        self.t = arrays["t"]
+        self.q = arrays["q"]
+        self.q_target = arrays["q_target"]
+        self.qd = arrays["qd"]
+        self.qd_target = arrays["qd_target"]
+        self.tau = arrays["tau"]
+        self.tau_g = arrays["tau_g"]
+        self.tau_limit = arrays["tau_limit"]
+        self.saturated = arrays["saturated"]
+        self.tool_position = arrays["tool_position"]
+        self.duty = arrays.get("duty")
+        self.current = arrays.get("current")
+        self.summary = summary
+
+    def __repr__(self):
+        status = self.summary.get("summary", {}).get("status")
+        return f"armscope.Run({self.t.size} steps of {self.q.shape[1]} joints, {status!r})"
+
+
+def _argv(flags):
+    """``run``'s keyword arguments as its flags: ``no_ff=True`` → ``--no-ff``; False and None left
+    out; a list joined by commas; ``--flag=value`` so that a negative number reads as a value."""
+    argv = []
+    for key, value in flags.items():
+        flag = "--" + key.replace("_", "-")
+        if value is None or value is False:
+            continue
+        if value is True:
+            argv.append(flag)
+        elif isinstance(value, (list, tuple)):
+            argv.append(f"{flag}={','.join(str(x) for x in value)}")
+        else:
+            argv.append(f"{flag}={os.fspath(value) if isinstance(value, os.PathLike) else value}")
+    return argv
+
+
+def run(**flags) -> Run:
+    """``armscope run`` with ``flags`` (its flags by name, ``-`` as ``_``: ``run(urdf="arm.urdf",
+    motors="m.toml", duration=30, no_ff=True)``), its samples returned as a :class:`Run`. No file is
+    written unless asked (``rrd=``, ``mcap=``, ``trace=``, ``csv=``, ``summary_json=``). The run goes
+    on without the GIL; an unknown flag or a bad value raises ArmscopeError with the command line's
+    line."""
+    arrays = _armscope.run(_argv(flags))
+    summary = json.loads(arrays.pop("summary_json"))
+    return Run(arrays, summary)
 
 
 def main() -> None:

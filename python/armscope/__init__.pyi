@@ -1,5 +1,5 @@
 from os import PathLike
-from typing import Union
+from typing import Any, Optional, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -53,6 +53,26 @@ class Model:
         """The frame's pose in the world, a 4×4 homogeneous transform (Pinocchio's oMf); (4, 4) or (N, 4, 4)."""
     def jacobian(self, q: ArrayLike, frame: Frame) -> npt.NDArray[np.float64]:
         """The frame's Jacobian, LOCAL_WORLD_ALIGNED: rows 0–2 linear, 3–5 angular velocity; (6, nq) or (N, 6, nq)."""
+
+class Run:
+    """One run's every control step as NumPy arrays, and its summary (the dict --summary-json writes)."""
+
+    t: npt.NDArray[np.float64]
+    q: npt.NDArray[np.float64]
+    q_target: npt.NDArray[np.float64]
+    qd: npt.NDArray[np.float64]
+    qd_target: npt.NDArray[np.float64]
+    tau: npt.NDArray[np.float64]
+    tau_g: npt.NDArray[np.float64]
+    tau_limit: npt.NDArray[np.float64]
+    saturated: npt.NDArray[np.bool_]
+    tool_position: npt.NDArray[np.float64]
+    duty: Optional[npt.NDArray[np.float64]]
+    current: Optional[npt.NDArray[np.float64]]
+    summary: dict[str, Any]
+
+def run(**flags: Any) -> Run:
+    """``armscope run`` with its flags by name (``-`` as ``_``), its samples as a Run; files only where asked."""
 
 def main() -> None:
     """The ``armscope`` command."""

@@ -2,6 +2,7 @@
 //! NumPy in and out, and the command line. A thin layer: nothing of the physics is written here.
 
 mod model;
+mod run;
 
 use pyo3::prelude::*;
 
@@ -23,6 +24,7 @@ fn main(argv: Vec<String>) -> i32 {
 fn _armscope(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("ArmscopeError", m.py().get_type::<ArmscopeError>())?;
     m.add_function(wrap_pyfunction!(main, m)?)?;
+    m.add_function(wrap_pyfunction!(run::run, m)?)?;
     m.add_class::<model::Model>()?;
     Ok(())
 }

@@ -110,3 +110,29 @@ def test_the_command_is_installed_beside_the_package(tmp_path):
     assert (tmp_path / "s.json").exists()
     bad = subprocess.run(["armscope", "run", "--duration=-1"], cwd=tmp_path, capture_output=True, text=True)
     assert bad.returncode == 2 and bad.stderr.count("\n") == 1 and "--duration" in bad.stderr
+
+
+def test_run_gives_the_commands_summary_and_its_trace_as_arrays(tmp_path):
+    # armscope.run(no_ff=True) against `armscope run --no-ff --summary-json --trace`, the same run
+    r = armscope.run(no_ff=True, duration=0.5)
+    cli = subprocess.run(["armscope", "run", "--no-ff", "--duration=0.5", "--no-rrd", "--no-mcap", "--quiet", "--summary-json", "s.json", "--trace", "t.csv"], cwd=tmp_path, capture_output=True, text=True)
+    assert cli.returncode == 0, cli.stderr
+    import json
+    expected = json.loads((tmp_path / "s.json").read_text())
+    for doc in (expected, r.summary):
+        doc["summary"].pop("wall_time", None)
+    assert r.summary == expected
+    trace = np.loadtxt(tmp_path / "t.csv", delimiter=",", skiprows=1)
+    n = r.q.shape[1]
+    assert r.t.shape == (trace.shape[0],) and np.array_equal(r.t, trace[:, 0])
+    for k, name in enumerate(["q", "qd", "q_target", "qd_target", "tau", "tau_g"]):
+        assert np.array_equal(getattr(r, name), trace[:, 1 + k * n : 1 + (k + 1) * n]), name
+    assert np.array_equal(r.tool_position, trace[:, -3:])
+    assert r.saturated.dtype == bool and r.saturated.shape == r.q.shape and r.duty is None
+
+
+def test_run_refuses_an_unknown_flag_or_a_bad_value_in_one_line():
+    with pytest.raises(armscope.ArmscopeError, match="unexpected argument '--bogus"):
+        armscope.run(bogus=1)
+    with pytest.raises(armscope.ArmscopeError, match="--duration"):
+        armscope.run(duration=-1)

@@ -1,0 +1,135 @@
+//! `armscope.run(**flags)`: `armscope run` in this process — the same flags, parsed by the same
+//! command line — with every control step's sample kept as NumPy arrays beside the recordings asked
+//! for.
+
+use armscope::recorder::{Recorder, RunInfo};
+use armscope::runner::{Outputs, run_experiment};
+use armscope::sample::Sample;
+use armscope::summary::{RunStatus, Summary};
+use clap::Parser;
+use numpy::IntoPyArray;
+use numpy::ndarray::Array2;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use std::sync::{Arc, Mutex};
+
+/// `run`'s flags, as the command line parses them.
+#[derive(Parser)]
+#[command(name = "armscope.run", no_binary_name = true, disable_help_flag = true)]
+struct RunCall {
+    #[command(flatten)]
+    args: armscope::flags::RunArgs,
+}
+
+/// Every sample's series, row after row.
+#[derive(Default)]
+struct Series {
+    joints: usize,
+    servos: bool,
+    t: Vec<f64>,
+    q: Vec<f64>,
+    q_target: Vec<f64>,
+    qd: Vec<f64>,
+    qd_target: Vec<f64>,
+    tau: Vec<f64>,
+    tau_g: Vec<f64>,
+    tau_limit: Vec<f64>,
+    saturated: Vec<bool>,
+    tool_position: Vec<f64>,
+    duty: Vec<f64>,
+    current: Vec<f64>,
+}
+
+/// The recorder that keeps the series (shared with the call that reads them after the run).
+struct Keep(Arc<Mutex<Series>>);
+
+impl Recorder for Keep {
+    fn start(&mut self, run: &RunInfo) -> Result<(), armscope::Error> {
+        let mut s = self.0.lock().expect("one run at a time");
+        s.joints = run.experiment.model.dof();
+        s.servos = run.experiment.servos.is_some();
+        Ok(())
+    }
+
+    fn record(&mut self, sample: &Sample) -> Result<(), armscope::Error> {
+        let mut s = self.0.lock().expect("one run at a time");
+        s.t.push(sample.t);
+        s.q.extend_from_slice(sample.q);
+        s.q_target.extend_from_slice(sample.cmd);
+        s.qd.extend_from_slice(sample.v);
+        s.qd_target.extend_from_slice(sample.cmd_dot);
+        s.tau.extend_from_slice(sample.u);
+        s.tau_g.extend_from_slice(sample.tau_g);
+        s.tau_limit.extend_from_slice(sample.torque_limit);
+        s.saturated.extend_from_slice(sample.saturated);
+        s.tool_position.extend_from_slice(sample.tool_position.as_slice());
+        if s.servos {
+            s.duty.extend_from_slice(sample.duty);
+            s.current.extend_from_slice(sample.current);
+        }
+        Ok(())
+    }
+
+    fn finish(&mut self, _run: &RunInfo, _summary: &Summary) -> Result<(), armscope::Error> {
+        Ok(())
+    }
+}
+
+/// The first line of a command-line parse error, without clap's `error: `.
+fn parse_error(e: &clap::Error) -> String {
+    let text = e.to_string();
+    let line = text.lines().next().unwrap_or_default();
+    line.strip_prefix("error: ").unwrap_or(line).to_string()
+}
+
+/// `armscope run ARGV` with its samples kept: a dict of arrays (`t` (N,), per joint (N, nq), the
+/// tool's position (N, 3)) and `summary_json`, the text `--summary-json` writes.
+#[pyfunction]
+pub fn run<'py>(py: Python<'py>, argv: Vec<String>) -> PyResult<Bound<'py, PyDict>> {
+    let call = RunCall::try_parse_from(&argv).map_err(|e| crate::error(format!("run: {}", parse_error(&e))))?;
+    let args = call.args;
+    let experiment = armscope::experiment::Experiment::prepare(args.config()).map_err(crate::error)?;
+    let warnings = py.import("warnings")?;
+    for notice in &experiment.model.notices {
+        warnings.call_method1("warn", (format!("armscope: {notice}"),))?;
+    }
+    let scratch = tempfile::tempdir().map_err(crate::error)?;
+    let summary_path = scratch.path().join("summary.json");
+    let summary_file = summary_path.clone();
+    let series = Arc::new(Mutex::new(Series::default()));
+    let name = args.name.clone().unwrap_or_else(|| "python".to_string());
+    let keep = series.clone();
+    let make_outputs = move || Outputs {
+        name,
+        rrd: args.files.rrd.clone(),
+        mcap: args.files.mcap.clone(),
+        csv: args.csv.clone(),
+        trace: args.trace.clone(),
+        summary_json: Some(summary_file),
+        compress: args.compress,
+        mcap_encoding: args.mcap_encoding,
+        recorders: vec![Box::new(Keep(keep))],
+        ..Outputs::default()
+    };
+    let summary = py.detach(|| run_experiment(&experiment, make_outputs(), None)).map_err(crate::error)?;
+    if let RunStatus::Diverged { message, .. } = &summary.status {
+        return Err(crate::error(message));
+    }
+    let summary_json = std::fs::read_to_string(&summary_path).map_err(crate::error)?;
+    let s = std::mem::take(&mut *series.lock().map_err(|_| crate::error("the run's samples were lost"))?);
+    let rows = s.t.len();
+    let out = PyDict::new(py);
+    let table = |v: Vec<f64>, columns: usize| Array2::from_shape_vec((rows, columns), v).map_err(crate::error);
+    out.set_item("t", s.t.into_pyarray(py))?;
+    for (key, values) in [("q", s.q), ("q_target", s.q_target), ("qd", s.qd), ("qd_target", s.qd_target), ("tau", s.tau), ("tau_g", s.tau_g), ("tau_limit", s.tau_limit)] {
+        out.set_item(key, table(values, s.joints)?.into_pyarray(py))?;
+    }
+    out.set_item("saturated", Array2::from_shape_vec((rows, s.joints), s.saturated).map_err(crate::error)?.into_pyarray(py))?;
+    out.set_item("tool_position", table(s.tool_position, 3)?.into_pyarray(py))?;
+    if s.servos {
+        out.set_item("duty", table(s.duty, s.joints)?.into_pyarray(py))?;
+        out.set_item("current", table(s.current, s.joints)?.into_pyarray(py))?;
+    }
+    out.set_item("summary_json", summary_json)?;
+    Ok(out)
+}
