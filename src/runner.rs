@@ -37,6 +37,8 @@ pub struct Outputs {
     pub mcap_encoding: crate::recorder::McapEncoding,
     /// Further recorders, run after the others (a batch's comparison series).
     pub recorders: Vec<Box<dyn Recorder>>,
+    /// A torque law in place of the PD controller (Python's `armscope.simulate`).
+    pub law: Option<Box<dyn crate::control::law::TorqueLaw>>,
 }
 
 /// `text` with every character that is not ASCII alphanumeric or `-_.` made a `-`: usable as a
@@ -111,5 +113,8 @@ pub fn run_experiment(experiment: &Experiment, outputs: Outputs, stop: Option<&A
     }
     recorders.extend(outputs.recorders);
     let mut refs: Vec<&mut dyn Recorder> = recorders.iter_mut().map(|r| r.as_mut() as &mut dyn Recorder).collect();
-    simulate(experiment, &mut refs, stop)
+    match outputs.law {
+        Some(mut law) => crate::sim::simulate_with_law(experiment, &mut refs, stop, law.as_mut()),
+        None => simulate(experiment, &mut refs, stop),
+    }
 }

@@ -47,6 +47,17 @@ impl Observed {
 
 /// [`simulate`], recording `observed` (a real arm's positions) beside the simulated arm's.
 pub fn simulate_beside(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], stop: Option<&AtomicBool>, observed: Option<&Observed>) -> Result<Summary, Error> {
+    simulate_loop(experiment, recorders, stop, observed, None)
+}
+
+/// [`simulate`] with `law` asking the joints' torques in place of the PD controller (through the
+/// same motor limits, plant and recorders). A law's error stops the run at that step: the
+/// recorders are finished with what was run, then the error is returned.
+pub fn simulate_with_law(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], stop: Option<&AtomicBool>, law: &mut dyn crate::control::law::TorqueLaw) -> Result<Summary, Error> {
+    simulate_loop(experiment, recorders, stop, None, Some(law))
+}
+
+fn simulate_loop(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], stop: Option<&AtomicBool>, observed: Option<&Observed>, mut law: Option<&mut dyn crate::control::law::TorqueLaw>) -> Result<Summary, Error> {
     let model = &*experiment.model;
     let n = model.dof();
     let dt = experiment.dt();
@@ -93,6 +104,9 @@ pub fn simulate_beside(experiment: &Experiment, recorders: &mut [&mut dyn Record
         .with_servos(experiment.servo_duty_limits());
     let started = Instant::now();
     let mut status = RunStatus::Completed;
+    // a law's asked torques, and the error that stopped it
+    let mut asked = vec![0.0; n];
+    let mut law_error: Option<Error> = None;
     let mut audit = EnergyAudit::new(experiment);
     // the motors' windings, where their thermal data is known
     let mut heat = crate::actuator::thermal::RunHeat::new(&experiment.motor_heat(), dt);
@@ -105,7 +119,16 @@ pub fn simulate_beside(experiment: &Experiment, recorders: &mut [&mut dyn Record
         forward_kinematics(model, &mut data, &q);
         gravity_and_bias_from_kinematics(model, &mut data, &v);
         experiment.trajectory.sample(t, &mut cmd, &mut cmd_dot);
-        controller.compute(&q, &v, &cmd, &cmd_dot, &data.gravity, ControlOutput { u: &mut u, saturated: &mut saturated, limit: &mut torque_limit });
+        match law.as_deref_mut() {
+            Some(law) => {
+                let input = crate::control::law::LawInput { t, q: &q, v: &v, cmd: &cmd, cmd_dot: &cmd_dot, tau_g: &data.gravity };
+                if let Err(e) = law.torque(&input, &mut asked) {
+                    law_error = Some(e);
+                }
+                controller.apply(&asked, &q, &v, ControlOutput { u: &mut u, saturated: &mut saturated, limit: &mut torque_limit });
+            }
+            None => controller.compute(&q, &v, &cmd, &cmd_dot, &data.gravity, ControlOutput { u: &mut u, saturated: &mut saturated, limit: &mut torque_limit }),
+        }
         if let Some(s) = steppers.as_mut() {
             // no PD on a stepper joint: the driver steps to the command, the rotor follows as it can
             s.control_step(&cmd, &cmd_dot, dt, &q, &v, StepperOutput { u: &mut u, limit: &mut torque_limit, saturated: &mut saturated, load_angle: &mut load_angle, lost_steps: &mut lost_steps });
@@ -135,7 +158,7 @@ pub fn simulate_beside(experiment: &Experiment, recorders: &mut [&mut dyn Record
                 collided = state.colliding().next().map(|p| RunStatus::Collided { time: t, link1: model.frames[p.a].name.clone(), link2: c.name(model, p.b).to_string() });
             }
         }
-        let interrupted = stop.is_some_and(|s| s.load(Ordering::Relaxed));
+        let interrupted = stop.is_some_and(|s| s.load(Ordering::Relaxed)) || law_error.is_some();
         let sample = Sample {
             k,
             t,
@@ -263,7 +286,10 @@ pub fn simulate_beside(experiment: &Experiment, recorders: &mut [&mut dyn Record
     for r in recorders.iter_mut() {
         r.finish(&info, &summary)?;
     }
-    Ok(summary)
+    match law_error {
+        Some(e) => Err(e),
+        None => Ok(summary),
+    }
 }
 
 /// How close a pair must come to be measured exactly and reported (the near misses), m.

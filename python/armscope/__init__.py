@@ -20,7 +20,7 @@ from . import _armscope
 from ._armscope import ArmscopeError, Model
 from ._armscope import main as _main
 
-__all__ = ["ArmscopeError", "Model", "Run", "main", "run"]
+__all__ = ["ArmscopeError", "Model", "Run", "main", "run", "simulate"]
 
 
 class Run:
@@ -77,6 +77,21 @@ def run(**flags) -> Run:
     on without the GIL; an unknown flag or a bad value raises ArmscopeError with the command line's
     line."""
     arrays = _armscope.run(_argv(flags))
+    summary = json.loads(arrays.pop("summary_json"))
+    return Run(arrays, summary)
+
+
+def simulate(model, controller, **flags) -> Run:
+    """Run ``model`` (an armscope.Model or a URDF's path) with your own ``controller`` in the loop:
+    ``controller(t, q, qd) -> tau`` (NumPy in and out; or an object with ``__call__`` and ``reset``,
+    reset before the run) at every control step, t = k·dt. Its torque then goes through the motors,
+    their limits and the plant exactly as the PD's does in ``run``, and the recordings are run's.
+    ``flags`` are run's (``duration=``, ``motors=``, ``q0=``, ``rrd=``, ``mcap=``, …). A controller that
+    raises, or returns the wrong length or a value that is not finite, stops the run there (its
+    recordings end whole) and raises ArmscopeError with the step's time; what it raised is the
+    cause."""
+    urdf = model.urdf if isinstance(model, Model) else model
+    arrays = _armscope.run(_argv({"urdf": urdf, **flags}), controller)
     summary = json.loads(arrays.pop("summary_json"))
     return Run(arrays, summary)
 

@@ -1,5 +1,5 @@
 from os import PathLike
-from typing import Any, Optional, Union
+from typing import Any, Callable, Optional, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -18,6 +18,9 @@ class Model:
     ((N, nq) arrays), and returns arrays of the matching shape.
     """
 
+    @property
+    def urdf(self) -> str:
+        """The URDF it was loaded from."""
     def __init__(self, urdf: Union[str, PathLike[str]]) -> None:
         """Load the URDF at ``urdf``; armscope's notices come as warnings, a URDF it cannot use raises ArmscopeError."""
     @property
@@ -73,6 +76,9 @@ class Run:
 
 def run(**flags: Any) -> Run:
     """``armscope run`` with its flags by name (``-`` as ``_``), its samples as a Run; files only where asked."""
+
+def simulate(model: Union[Model, str, PathLike[str]], controller: Callable[[float, npt.NDArray[np.float64], npt.NDArray[np.float64]], ArrayLike], **flags: Any) -> Run:
+    """Run the model with ``controller(t, q, qd) -> tau`` in place of the PD, through the same motors, limits, plant and recordings."""
 
 def main() -> None:
     """The ``armscope`` command."""

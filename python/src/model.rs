@@ -160,6 +160,12 @@ impl Model {
         Ok(Self { model, data })
     }
 
+    /// The URDF it was loaded from.
+    #[getter]
+    fn urdf(&self) -> std::path::PathBuf {
+        self.model.source.clone()
+    }
+
     /// The number of position coordinates (one per revolute, continuous or prismatic joint).
     #[getter]
     fn nq(&self) -> usize {

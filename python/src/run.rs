@@ -7,7 +7,8 @@ use armscope::runner::{Outputs, run_experiment};
 use armscope::sample::Sample;
 use armscope::summary::{RunStatus, Summary};
 use clap::Parser;
-use numpy::IntoPyArray;
+use armscope::control::law::{LawInput, TorqueLaw};
+use numpy::{IntoPyArray, PyArray1, PyArrayMethods};
 use numpy::ndarray::Array2;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -82,10 +83,61 @@ fn parse_error(e: &clap::Error) -> String {
     line.strip_prefix("error: ").unwrap_or(line).to_string()
 }
 
-/// `armscope run ARGV` with its samples kept: a dict of arrays (`t` (N,), per joint (N, nq), the
-/// tool's position (N, 3)) and `summary_json`, the text `--summary-json` writes.
+/// A Python controller as the loop's torque law: `controller(t, q, qd) -> tau` at every control
+/// step (NumPy in and out). What it raises is kept for the caller and stops the run.
+struct PythonLaw {
+    controller: Py<PyAny>,
+    joints: usize,
+    raised: Arc<Mutex<Option<PyErr>>>,
+}
+
+impl PythonLaw {
+    fn refuse(&self, t: f64, message: String) -> armscope::Error {
+        armscope::Error::flag("controller", format!("at t = {t} s: {message}"))
+    }
+}
+
+impl TorqueLaw for PythonLaw {
+    fn torque(&mut self, input: &LawInput, u: &mut [f64]) -> Result<(), armscope::Error> {
+        Python::attach(|py| {
+            let q = PyArray1::from_slice(py, input.q);
+            let qd = PyArray1::from_slice(py, input.v);
+            let result = match self.controller.bind(py).call1((input.t, q, qd)) {
+                Ok(r) => r,
+                Err(e) => {
+                    let message = e.to_string();
+                    *self.raised.lock().expect("one run at a time") = Some(e);
+                    return Err(self.refuse(input.t, format!("it raised {message}")));
+                }
+            };
+            let tau = match result.cast::<PyArray1<f64>>() {
+                Ok(a) => a.clone(),
+                Err(_) => {
+                    let numpy = py.import("numpy").map_err(|e| self.refuse(input.t, e.to_string()))?;
+                    let a = numpy.call_method1("ascontiguousarray", (&result, "float64")).map_err(|_| self.refuse(input.t, format!("it returned {}, not an array of torques", result.get_type().name().map_or("something".into(), |n| n.to_string()))))?;
+                    a.cast_into::<PyArray1<f64>>().map_err(|_| self.refuse(input.t, "it returned an array that is not one torque per joint".into()))?
+                }
+            };
+            let read = tau.readonly();
+            let values = read.as_slice().map_err(|_| self.refuse(input.t, "it returned a non-contiguous array".into()))?;
+            if values.len() != self.joints {
+                return Err(self.refuse(input.t, format!("it returned {} torques, the model has {} joints", values.len(), self.joints)));
+            }
+            if let Some(i) = values.iter().position(|x| !x.is_finite()) {
+                return Err(self.refuse(input.t, format!("it returned a torque that is not a finite number for joint {}", i + 1)));
+            }
+            u.copy_from_slice(values);
+            Ok(())
+        })
+    }
+}
+
+/// `armscope run ARGV` with its samples kept (with `controller`, it in place of the PD): a dict of
+/// arrays (`t` (N,), per joint (N, nq), the tool's position (N, 3)) and `summary_json`, the text
+/// `--summary-json` writes.
 #[pyfunction]
-pub fn run<'py>(py: Python<'py>, argv: Vec<String>) -> PyResult<Bound<'py, PyDict>> {
+#[pyo3(signature = (argv, controller = None))]
+pub fn run<'py>(py: Python<'py>, argv: Vec<String>, controller: Option<Py<PyAny>>) -> PyResult<Bound<'py, PyDict>> {
     let call = RunCall::try_parse_from(&argv).map_err(|e| crate::error(format!("run: {}", parse_error(&e))))?;
     let args = call.args;
     let experiment = armscope::experiment::Experiment::prepare(args.config()).map_err(crate::error)?;
@@ -99,6 +151,17 @@ pub fn run<'py>(py: Python<'py>, argv: Vec<String>) -> PyResult<Bound<'py, PyDic
     let series = Arc::new(Mutex::new(Series::default()));
     let name = args.name.clone().unwrap_or_else(|| "python".to_string());
     let keep = series.clone();
+    let raised = Arc::new(Mutex::new(None));
+    let law: Option<Box<dyn TorqueLaw>> = match controller {
+        Some(controller) => {
+            // an object with reset() starts afresh
+            if controller.bind(py).hasattr("reset")? {
+                controller.bind(py).call_method0("reset")?;
+            }
+            Some(Box::new(PythonLaw { controller, joints: experiment.model.dof(), raised: raised.clone() }))
+        }
+        None => None,
+    };
     let make_outputs = move || Outputs {
         name,
         rrd: args.files.rrd.clone(),
@@ -109,9 +172,20 @@ pub fn run<'py>(py: Python<'py>, argv: Vec<String>) -> PyResult<Bound<'py, PyDic
         compress: args.compress,
         mcap_encoding: args.mcap_encoding,
         recorders: vec![Box::new(Keep(keep))],
+        law,
         ..Outputs::default()
     };
-    let summary = py.detach(|| run_experiment(&experiment, make_outputs(), None)).map_err(crate::error)?;
+    let summary = match py.detach(|| run_experiment(&experiment, make_outputs(), None)) {
+        Ok(summary) => summary,
+        Err(e) => {
+            let error = crate::error(e);
+            // the controller's own exception, as the cause
+            if let Some(cause) = raised.lock().ok().and_then(|mut r| r.take()) {
+                error.set_cause(py, Some(cause));
+            }
+            return Err(error);
+        }
+    };
     if let RunStatus::Diverged { message, .. } = &summary.status {
         return Err(crate::error(message));
     }

@@ -88,6 +88,7 @@ pub fn run(args: &RunArgs) -> Result<i32, Error> {
         mcap_encoding: args.mcap_encoding,
         notice: Some(|n| eprintln!("armscope: notice: {n}")),
         recorders: Vec::new(),
+        law: None,
     };
     install_interrupt_handler();
     INTERRUPTED.store(false, Ordering::SeqCst);

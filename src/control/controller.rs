@@ -83,28 +83,41 @@ impl PdGravityController {
     }
 
     #[allow(clippy::too_many_arguments)]
-    pub fn compute(&self, q: &[f64], v: &[f64], cmd: &[f64], cmd_dot: &[f64], tau_g: &[f64], out: ControlOutput) {
+    pub fn compute(&self, q: &[f64], v: &[f64], cmd: &[f64], cmd_dot: &[f64], tau_g: &[f64], mut out: ControlOutput) {
         for i in 0..q.len() {
-            if self.elsewhere[i] {
-                continue;
-            }
-            if !self.actuated[i] {
-                out.u[i] = 0.0;
-                out.saturated[i] = false;
-                out.limit[i] = 0.0;
-                continue;
-            }
             let mut u = self.kp[i] * (cmd[i] - q[i]) + self.kd[i] * (cmd_dot[i] - v[i]);
             if self.feed_forward {
                 u -= tau_g[i];
             }
-            if let Some(envelope) = &self.envelopes[i] {
-                u += envelope.detent_torque(q[i] - self.detent_origin[i]);
-            }
-            let (lowest, highest) = self.range(i, v[i]);
-            out.saturated[i] = (u > highest) | (u < lowest);
-            out.u[i] = u.clamp(lowest, highest);
-            out.limit[i] = if u >= 0.0 { highest } else { -lowest };
+            self.limit(i, u, q[i], v[i], &mut out);
         }
+    }
+
+    /// The torques `asked` (a user's law, in place of the PD) through the same limits.
+    pub fn apply(&self, asked: &[f64], q: &[f64], v: &[f64], mut out: ControlOutput) {
+        for i in 0..q.len() {
+            self.limit(i, asked[i], q[i], v[i], &mut out);
+        }
+    }
+
+    /// Joint i's torque `u` as asked, its stepper's detent added, clipped to what its motor gives
+    /// at its speed (none on an unactuated joint; a joint driven elsewhere left alone).
+    fn limit(&self, i: usize, mut u: f64, q: f64, v: f64, out: &mut ControlOutput) {
+        if self.elsewhere[i] {
+            return;
+        }
+        if !self.actuated[i] {
+            out.u[i] = 0.0;
+            out.saturated[i] = false;
+            out.limit[i] = 0.0;
+            return;
+        }
+        if let Some(envelope) = &self.envelopes[i] {
+            u += envelope.detent_torque(q - self.detent_origin[i]);
+        }
+        let (lowest, highest) = self.range(i, v);
+        out.saturated[i] = (u > highest) | (u < lowest);
+        out.u[i] = u.clamp(lowest, highest);
+        out.limit[i] = if u >= 0.0 { highest } else { -lowest };
     }
 }
