@@ -11,7 +11,6 @@ use serde_json::Value;
 use std::path::{Path, PathBuf};
 
 const FPS: f64 = 30.0;
-const SECONDS: f64 = 6.0;
 const FRAMES: usize = 181;
 
 fn so101() -> PathBuf {
