@@ -12,7 +12,11 @@ use numpy::{IntoPyArray, PyArray1, PyArrayMethods};
 use numpy::ndarray::Array2;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
+
+/// How often Python's main thread looks for Ctrl-C while a run goes on.
+const SIGNAL_CHECK: std::time::Duration = std::time::Duration::from_millis(20);
 
 /// `run`'s flags, as the command line parses them.
 #[derive(Parser)]
@@ -175,7 +179,39 @@ pub fn run<'py>(py: Python<'py>, argv: Vec<String>, controller: Option<Py<PyAny>
         law,
         ..Outputs::default()
     };
-    let summary = match py.detach(|| run_experiment(&experiment, make_outputs(), None)) {
+    // the run on a thread of its own; this one, Python's main, watches for Ctrl-C (Python runs its
+    // signal handlers there only): it stops the run, whose recordings then end whole
+    let stop = AtomicBool::new(false);
+    let mut interrupted: Option<PyErr> = None;
+    let result = std::thread::scope(|scope| {
+        let (done, finished) = std::sync::mpsc::channel::<()>();
+        let finished = Mutex::new(finished);
+        let (experiment, stop_flag) = (&experiment, &stop);
+        let worker = scope.spawn(move || {
+            let result = run_experiment(experiment, make_outputs(), Some(stop_flag));
+            let _ = done.send(());
+            result
+        });
+        loop {
+            match py.detach(|| finished.lock().map_or(Ok(()), |f| f.recv_timeout(SIGNAL_CHECK))) {
+                Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {
+                    if interrupted.is_none()
+                        && let Err(e) = py.check_signals()
+                    {
+                        interrupted = Some(e);
+                        stop.store(true, Ordering::Relaxed);
+                    }
+                }
+                _ => break,
+            }
+        }
+        py.detach(|| worker.join())
+    });
+    let result = result.map_err(|_| crate::error("the run's thread panicked"))?;
+    if let Some(e) = interrupted {
+        return Err(e);
+    }
+    let summary = match result {
         Ok(summary) => summary,
         Err(e) => {
             let error = crate::error(e);

@@ -80,3 +80,20 @@ def test_a_controller_that_fails_stops_the_run_with_one_clear_exception(tutorial
     # the recording ends whole at the failing step: MCAP's footer magic closes the file
     data = mcap.read_bytes()
     assert data[:8] == b"\x89MCAP0\r\n" and data[-8:] == b"\x89MCAP0\r\n"
+
+
+def test_ctrl_c_stops_a_long_run_and_its_recording_ends_whole(tmp_path):
+    import os
+    import signal
+    import threading
+    import time
+
+    mcap = tmp_path / "long.mcap"
+    threading.Timer(0.3, lambda: os.kill(os.getpid(), signal.SIGINT)).start()
+    started = time.monotonic()
+    with pytest.raises(KeyboardInterrupt):
+        armscope.run(duration=3000, mcap=mcap, no_rrd=True)
+    # stopped within a second of the signal (the whole run would take minutes)
+    assert time.monotonic() - started < 1.5
+    data = mcap.read_bytes()
+    assert data[:8] == b"\x89MCAP0\r\n" and data[-8:] == b"\x89MCAP0\r\n"
