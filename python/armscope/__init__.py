@@ -20,7 +20,7 @@ from . import _armscope
 from ._armscope import ArmscopeError, Model
 from ._armscope import main as _main
 
-__all__ = ["ArmscopeError", "Model", "Run", "main", "run", "simulate"]
+__all__ = ["ArmscopeError", "Episode", "Model", "Run", "main", "replay", "run", "simulate"]
 
 
 class Run:
@@ -94,6 +94,31 @@ def simulate(model, controller, **flags) -> Run:
     arrays = _armscope.run(_argv({"urdf": urdf, **flags}), controller)
     summary = json.loads(arrays.pop("summary_json"))
     return Run(arrays, summary)
+
+
+class Episode:
+    """One recorded episode replayed: ``episode`` (its index), ``t`` (N,), per joint (N, nq) the
+    smoothed motion ``q``, ``qd``, ``qdd``, the torque it needed ``tau`` and what the joint had in that
+    direction ``available``; ``verdicts``, per joint the dict ``replay --summary-json`` gives (peak and
+    RMS torque, time over the limit, a servo's duty and protection, …)."""
+
+    def __init__(self, d):
+        self.episode = d["episode"]
+        self.t, self.q, self.qd, self.qdd = d["t"], d["q"], d["qd"], d["qdd"]
+        self.tau, self.available = d["tau"], d["available"]
+        self.verdicts = json.loads(d["verdicts_json"])
+
+    def __repr__(self):
+        return f"armscope.Episode({self.episode}: {self.t.size} samples of {self.q.shape[1]} joints)"
+
+
+def replay(source, urdf, **options) -> list:
+    """``armscope replay SOURCE --urdf URDF``: every episode of a recorded motion (a LeRobot dataset, a
+    ROS 2 bag, a CSV), read as the command reads it, replayed into the torque each joint needed.
+    ``options``: ``motors``, ``payload``, ``tool``, ``episodes`` (a list), ``feature``, ``joint_map``,
+    ``units`` ("degrees" or "range"), ``calibration``. Returns a list of :class:`Episode`; what the
+    reading assumed comes as warnings."""
+    return [Episode(d) for d in _armscope.replay(os.fspath(source), os.fspath(urdf), **options)]
 
 
 def main() -> None:

@@ -80,5 +80,20 @@ def run(**flags: Any) -> Run:
 def simulate(model: Union[Model, str, PathLike[str]], controller: Callable[[float, npt.NDArray[np.float64], npt.NDArray[np.float64]], ArrayLike], **flags: Any) -> Run:
     """Run the model with ``controller(t, q, qd) -> tau`` in place of the PD, through the same motors, limits, plant and recordings."""
 
+class Episode:
+    """One recorded episode replayed: its smoothed motion, the torque it needed, what the joints had, the verdicts."""
+
+    episode: int
+    t: npt.NDArray[np.float64]
+    q: npt.NDArray[np.float64]
+    qd: npt.NDArray[np.float64]
+    qdd: npt.NDArray[np.float64]
+    tau: npt.NDArray[np.float64]
+    available: npt.NDArray[np.float64]
+    verdicts: list[dict[str, Any]]
+
+def replay(source: Union[str, PathLike[str]], urdf: Union[str, PathLike[str]], **options: Any) -> list[Episode]:
+    """``armscope replay``: every episode of a recorded motion replayed into the torque each joint needed."""
+
 def main() -> None:
     """The ``armscope`` command."""

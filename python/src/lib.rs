@@ -2,6 +2,7 @@
 //! NumPy in and out, and the command line. A thin layer: nothing of the physics is written here.
 
 mod model;
+mod replay;
 mod run;
 
 use pyo3::prelude::*;
@@ -25,6 +26,7 @@ fn _armscope(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("ArmscopeError", m.py().get_type::<ArmscopeError>())?;
     m.add_function(wrap_pyfunction!(main, m)?)?;
     m.add_function(wrap_pyfunction!(run::run, m)?)?;
+    m.add_function(wrap_pyfunction!(replay::replay, m)?)?;
     m.add_class::<model::Model>()?;
     Ok(())
 }

@@ -136,3 +136,22 @@ def test_run_refuses_an_unknown_flag_or_a_bad_value_in_one_line():
         armscope.run(bogus=1)
     with pytest.raises(armscope.ArmscopeError, match="--duration"):
         armscope.run(duration=-1)
+
+
+def test_replay_gives_each_episodes_motion_and_the_torque_it_needed(model, tmp_path):
+    # a table named by joint (SI units): the needed torque is the model's inverse dynamics along the
+    # smoothed motion the replay returns, to round-off
+    t = np.arange(0, 4, 1 / 30)
+    q = np.stack([0.3 * np.sin(1.3 * t + j) for j in range(model.nq)], axis=1)
+    csv = tmp_path / "motion.csv"
+    np.savetxt(csv, np.column_stack([t, q]), delimiter=",", header="t," + ",".join(model.joint_names), comments="")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        (ep,) = armscope.replay(csv, SO101)
+    assert ep.q.shape == (t.size, model.nq) and np.allclose(ep.t, t)
+    assert np.allclose(ep.tau, model.rnea(ep.q, ep.qd, ep.qdd), atol=1e-9, rtol=0)
+    assert [v["joint"] for v in ep.verdicts] == model.joint_names
+    peak = [v["peak_torque"] for v in ep.verdicts]
+    assert np.allclose(peak, np.abs(ep.tau).max(axis=0), atol=1e-12)
+    with pytest.raises(armscope.ArmscopeError, match="units: 'furlongs'"):
+        armscope.replay(csv, SO101, units="furlongs")
