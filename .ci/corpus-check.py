@@ -12,7 +12,7 @@ joint after the 2 s settling.
 Run by .ci/run in a venv with pin and example-robot-data installed:
     corpus-check.py ARMSCOPE_BINARY [--tolerance 1e-9]
 """
-from example_robots import robots_dir
+from example_robots import ROBOTS, robots_dir
 import argparse
 import json
 import os
@@ -23,25 +23,6 @@ import tempfile
 import numpy as np
 import pinocchio as pin
 
-ROBOTS = {
-    "ur3": "ur_description/urdf/ur3_robot.urdf",
-    "ur5": "ur_description/urdf/ur5_robot.urdf",
-    "ur10": "ur_description/urdf/ur10_robot.urdf",
-    "panda": "panda_description/urdf/panda.urdf",
-    "kinova": "kinova_description/robots/kinova.urdf",
-    "so100": "so_arm_description/urdf/so100.urdf",
-    "so101": "so_arm_description/urdf/so101.urdf",
-    "xarm7": "xarm_description/urdf/xarm7.urdf",
-    "z1": "z1_description/urdf/z1.urdf",
-    "double_pendulum": "double_pendulum_description/urdf/double_pendulum.urdf",
-    "asr_twodof": "asr_twodof_description/urdf/TwoDofs.urdf",
-    "finger_edu": "finger_edu_description/robots/finger_edu.urdf",
-    "talos_left_arm": "talos_data/robots/talos_left_arm.urdf",
-    "baxter": "baxter_description/urdf/baxter.urdf",
-    "allegro": "allegro_hand_description/urdf/allegro_right_hand.urdf",
-    "tiago": "tiago_description/robots/tiago.urdf",
-    "pr2": "pr2_description/urdf/pr2.urdf",
-}
 # robots armscope does not load yet, with a word of the reason its error gives
 KNOWN_UNSUPPORTED = {}
 

@@ -42,13 +42,19 @@ fn dataset(dir: &Path) -> PathBuf {
 }
 
 fn dataset_of(dir: &Path, name: &str, motion: &[Sines], payload: f64, motors: &Path) -> PathBuf {
+    let storage = so101_storage();
+    let root = dir.join(name);
+    Spec { fps: 30.0, frames: FRAMES, episodes: vec![motion.to_vec()], storage, observed: Some(vec![follower(dir, motion, payload, motors)]) }.write_v3(&root);
+    root
+}
+
+/// How LeRobot stores the SO-101: the body joints in quantized degrees, the gripper 0…100 over its limits.
+fn so101_storage() -> Vec<Storage> {
     let model = load_urdf(&so101()).unwrap();
     let gripper = &model.joints[model.joint_index("gripper").unwrap()];
     let mut storage: Vec<Storage> = (0..5).map(|_| Storage::Degrees { sign: 1.0, offset: 0.0 }).collect();
     storage.push(Storage::Range0To100 { lower: gripper.lower, upper: gripper.upper });
-    let root = dir.join(name);
-    Spec { fps: 30.0, frames: FRAMES, episodes: vec![motion.to_vec()], storage, observed: Some(vec![follower(dir, motion, payload, motors)]) }.write_v3(&root);
-    root
+    storage
 }
 
 fn replay_forward(root: &Path, dir: &Path, payload: f64) -> armscope::replay::forward::ForwardReplay {
@@ -171,10 +177,7 @@ fn a_datasets_episodes_are_replayed_forward_together_the_widest_gap_first_and_re
     // two episodes of the same commands: in episode 0 the follower carried the 0.2 kg the replay is
     // told of, in episode 1 it carried 0.5 kg — the model misses episode 1 by more
     let dir = tempfile::tempdir().unwrap();
-    let model = load_urdf(&so101()).unwrap();
-    let gripper = &model.joints[model.joint_index("gripper").unwrap()];
-    let mut storage: Vec<Storage> = (0..5).map(|_| Storage::Degrees { sign: 1.0, offset: 0.0 }).collect();
-    storage.push(Storage::Range0To100 { lower: gripper.lower, upper: gripper.upper });
+    let storage = so101_storage();
     let motion = common::follower::so101_commands();
     let root = dir.path().join("so101_two_loads");
     let observed = vec![follower(dir.path(), &motion, PAYLOAD, &motors()), follower(dir.path(), &motion, 0.5, &motors())];
@@ -203,10 +206,7 @@ fn a_follower_whose_commands_arrive_late_is_met_once_the_replay_is_told_the_late
     // the "real" follower's commands reach it 100 ms (3 frames) after their frame: the default one
     // frame's replay parts from it on a fast joint; --latency 0.1 meets it within the encoder's quantum
     let dir = tempfile::tempdir().unwrap();
-    let model = load_urdf(&so101()).unwrap();
-    let gripper = &model.joints[model.joint_index("gripper").unwrap()];
-    let mut storage: Vec<Storage> = (0..5).map(|_| Storage::Degrees { sign: 1.0, offset: 0.0 }).collect();
-    storage.push(Storage::Range0To100 { lower: gripper.lower, upper: gripper.upper });
+    let storage = so101_storage();
     let motion = common::follower::so101_commands();
     let root = dir.path().join("so101_late");
     let observed = vec![follower_after(dir.path(), &motion, PAYLOAD, &motors(), 0.1)];
