@@ -20,7 +20,7 @@ from . import _armscope
 from ._armscope import ArmscopeError, Model
 from ._armscope import main as _main
 
-__all__ = ["ArmscopeError", "Episode", "Model", "Run", "main", "replay", "run", "simulate"]
+__all__ = ["ArmscopeError", "Episode", "Model", "Run", "batch", "main", "replay", "run", "simulate", "size"]
 
 
 class Run:
@@ -119,6 +119,23 @@ def replay(source, urdf, **options) -> list:
     ``units`` ("degrees" or "range"), ``calibration``. Returns a list of :class:`Episode`; what the
     reading assumed comes as warnings."""
     return [Episode(d) for d in _armscope.replay(os.fspath(source), os.fspath(urdf), **options)]
+
+
+def size(**flags) -> dict:
+    """``armscope size`` with ``flags`` (its flags by name, ``-`` as ``_``): the dict its size.json
+    holds (per joint the candidates, the chosen motor and ratio, the checks). Its table is printed
+    as the command prints it; its files go to ``out=`` if given, else to a scratch folder removed
+    after."""
+    return json.loads(_armscope.size(_argv(flags)))
+
+
+def batch(manifest=None, **flags) -> dict:
+    """``armscope batch [MANIFEST]`` with ``flags``: the dict its summary.json holds (every
+    experiment's status, error and summary; a failed experiment is in it, not raised). Its table is
+    printed as the command prints it; its files go to ``out=`` if given, else to a scratch folder
+    removed after."""
+    argv = ([os.fspath(manifest)] if manifest is not None else []) + _argv(flags)
+    return json.loads(_armscope.batch(argv))
 
 
 def main() -> None:

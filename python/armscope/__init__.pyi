@@ -95,5 +95,11 @@ class Episode:
 def replay(source: Union[str, PathLike[str]], urdf: Union[str, PathLike[str]], **options: Any) -> list[Episode]:
     """``armscope replay``: every episode of a recorded motion replayed into the torque each joint needed."""
 
+def size(**flags: Any) -> dict[str, Any]:
+    """``armscope size`` with its flags by name: the dict its size.json holds."""
+
+def batch(manifest: Optional[Union[str, PathLike[str]]] = None, **flags: Any) -> dict[str, Any]:
+    """``armscope batch [MANIFEST]`` with its flags by name: the dict its summary.json holds."""
+
 def main() -> None:
     """The ``armscope`` command."""

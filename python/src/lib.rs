@@ -4,6 +4,7 @@
 mod model;
 mod replay;
 mod run;
+mod tables;
 
 use pyo3::prelude::*;
 
@@ -27,6 +28,8 @@ fn _armscope(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(main, m)?)?;
     m.add_function(wrap_pyfunction!(run::run, m)?)?;
     m.add_function(wrap_pyfunction!(replay::replay, m)?)?;
+    m.add_function(wrap_pyfunction!(tables::size, m)?)?;
+    m.add_function(wrap_pyfunction!(tables::batch, m)?)?;
     m.add_class::<model::Model>()?;
     Ok(())
 }

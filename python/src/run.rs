@@ -81,7 +81,7 @@ impl Recorder for Keep {
 }
 
 /// The first line of a command-line parse error, without clap's `error: `.
-fn parse_error(e: &clap::Error) -> String {
+pub(crate) fn parse_error(e: &clap::Error) -> String {
     let text = e.to_string();
     let line = text.lines().next().unwrap_or_default();
     line.strip_prefix("error: ").unwrap_or(line).to_string()
