@@ -215,14 +215,18 @@ pub fn open_mapped(path: &Path, topic: Option<&str>, episodes: Option<&[i64]>, f
             let first = source.read(episodes[0], feature)?;
             match JointMap::builtin(source.kind(), model, &first) {
                 Some(map) if source.kind() == SourceKind::LeRobot => {
-                    let (unit, why) = body_unit(&source, &episodes, feature, &map, reading.units, path)?;
+                    // the first episodes' values, read once: they tell the unit and a range's width
+                    let body: Vec<String> = map.entries.iter().filter(|e| e.unit != joint_map::Unit::Range0To100).map(|e| e.column.clone()).collect();
+                    let told = reading.units.is_none() || (reading.units == Some(BodyUnits::Range) && reading.calibration.is_none());
+                    let values = if told { column_values(&source, &episodes, &[feature, "action"], &body) } else { Vec::new() };
+                    let (unit, why) = body_unit(&values, reading.units, path)?;
                     let calibration = match reading.calibration {
                         Some(c) => Some((c, joint_map::read_calibration(c)?)),
                         None => None,
                     };
                     let mut map = map.with_body_unit(unit, calibration.as_ref().map(|(p, r)| (*p, r)))?;
                     let how = match (unit, reading.calibration) {
-                        (joint_map::Unit::RangeM100To100, None) => lattice_ranges(&source, &episodes, feature, &mut map, model)?,
+                        (joint_map::Unit::RangeM100To100, None) => lattice_ranges(&values, feature, &mut map, model),
                         (_, Some(c)) => format!("; angles from the middle of each motor's calibrated range in {}", c.display()),
                         _ => String::new(),
                     };
@@ -246,17 +250,15 @@ pub fn open_mapped(path: &Path, topic: Option<&str>, episodes: Option<&[i64]>, f
     Ok(Mapped::Ready(MappedRecording { source, episodes, map, notices }))
 }
 
-/// Without a calibration file, each body joint's calibrated range as the tick lattice of its values
-/// (`feature`'s: the follower's calibration turns its goals into ticks too) tells it
-/// ([`tick_lattice`]); a joint whose values do not tell it maps onto its URDF limits. What was
-/// done, as the tail of the unit's notice.
-fn lattice_ranges(source: &Source, episodes: &[i64], feature: &str, map: &mut JointMap, model: &crate::model::Model) -> Result<String, Error> {
-    let body: Vec<String> = map.entries.iter().filter(|e| e.unit == joint_map::Unit::RangeM100To100).map(|e| e.column.clone()).collect();
-    let values = column_values(source, episodes, &[feature], &body);
+/// Without a calibration file, each body joint's calibrated range as the tick lattice of its
+/// `feature` values tells it (the follower's calibration turns its goals into ticks too;
+/// [`tick_lattice`]); a joint whose values do not tell it maps onto its URDF limits. What was done,
+/// as the tail of the unit's notice.
+fn lattice_ranges(values: &[Series], feature: &str, map: &mut JointMap, model: &crate::model::Model) -> String {
     let (mut read, mut unread) = (Vec::new(), Vec::new());
     for entry in map.entries.iter_mut().filter(|e| e.unit == joint_map::Unit::RangeM100To100) {
         let name = &model.joints[entry.joint].name;
-        let all: Vec<f64> = values.iter().filter(|(c, _)| *c == entry.column).flat_map(|(_, v)| v.iter().copied()).collect();
+        let all: Vec<f64> = values.iter().filter(|s| s.group == feature && s.column == entry.column).flat_map(|s| s.values.iter().copied()).collect();
         match tick_lattice::range_width(&all) {
             Some(width) => {
                 entry.calibration = Some(joint_map::MotorCalibration { drive_mode: 0, homing_offset: 0, range_min: 0.0, range_max: f64::from(width) });
@@ -272,19 +274,26 @@ fn lattice_ranges(source: &Source, episodes: &[i64], feature: &str, map: &mut Jo
     if !unread.is_empty() {
         how += &format!("{} −100…100 mapped onto the URDF limits of {} (too few distinct values to tell the range): approximate", if read.is_empty() { "" } else { ";" }, unread.join(", "));
     }
-    Ok(how)
+    how
 }
 
-/// The values of `columns` in `groups` (a dataset's features) over the first episodes, per column
-/// and episode (a bounded read of a dataset of hundreds).
-fn column_values(source: &Source, episodes: &[i64], groups: &[&str], columns: &[String]) -> Vec<(String, Vec<f64>)> {
+/// One column's values in one feature of one episode.
+struct Series {
+    group: String,
+    column: String,
+    values: Vec<f64>,
+}
+
+/// The values of `columns` in `groups` (a dataset's features) over the first episodes, per feature,
+/// column and episode (a bounded read of a dataset of hundreds).
+fn column_values(source: &Source, episodes: &[i64], groups: &[&str], columns: &[String]) -> Vec<Series> {
     let mut series = Vec::new();
     for &index in episodes.iter().take(UNIT_EPISODES) {
         for group in groups {
             let Ok(episode) = source.read(index, group) else { continue };
             for column in columns {
                 if let Some(c) = episode.column(column) {
-                    series.push((column.clone(), c.values.clone()));
+                    series.push(Series { group: group.to_string(), column: column.clone(), values: c.values.clone() });
                 }
             }
         }
@@ -293,16 +302,14 @@ fn column_values(source: &Source, episodes: &[i64], groups: &[&str], columns: &[
 }
 
 /// The unit of a dataset's body joints: `units` where given (no reason to say), else what the
-/// values of its first episodes tell (and why), else one line asking for it.
-fn body_unit(source: &Source, episodes: &[i64], feature: &str, map: &JointMap, units: Option<BodyUnits>, path: &Path) -> Result<(joint_map::Unit, Option<String>), Error> {
+/// `values` of its first episodes tell (and why), else one line asking for it.
+fn body_unit(values: &[Series], units: Option<BodyUnits>, path: &Path) -> Result<(joint_map::Unit, Option<String>), Error> {
     match units {
         Some(BodyUnits::Degrees) => return Ok((joint_map::Unit::Deg, None)),
         Some(BodyUnits::Range) => return Ok((joint_map::Unit::RangeM100To100, None)),
         None => {}
     }
-    let body: Vec<String> = map.entries.iter().filter(|e| e.unit != joint_map::Unit::Range0To100).map(|e| e.column.clone()).collect();
-    let series = column_values(source, episodes, &[feature, "action"], &body);
-    let columns: Vec<(&str, &[f64])> = series.iter().map(|(n, v)| (n.as_str(), v.as_slice())).collect();
+    let columns: Vec<(&str, &[f64])> = values.iter().map(|s| (s.column.as_str(), s.values.as_slice())).collect();
     match joint_map::decide_body_unit(&columns) {
         Ok((unit, why)) => Ok((unit, Some(why))),
         Err(why) => Err(Error::flag(path.display().to_string(), format!("the body joints' unit cannot be told from the data: {why}; say which with --units degrees or --units range (or a joint map's unit)"))),
