@@ -112,6 +112,18 @@ fn mean(list: &[LogMae]) -> f64 {
     list.iter().map(|l| l.mae_rad).sum::<f64>() / list.len().max(1) as f64
 }
 
+/// The progress bar of a fit, counting `length` generations (hidden when `quiet`).
+pub(super) fn generations_bar(length: u64, quiet: bool) -> ProgressBar {
+    let bar = ProgressBar::new(length);
+    if quiet {
+        bar.set_draw_target(ProgressDrawTarget::hidden());
+    } else {
+        bar.set_style(ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:30} {pos}/{len} generations  {msg}").unwrap_or_else(|_| ProgressStyle::default_bar()));
+        bar.enable_steady_tick(std::time::Duration::from_millis(200));
+    }
+    bar
+}
+
 /// `armscope identify`.
 pub fn identify(args: &IdentifyArgs) -> Result<i32, Error> {
     if let Some(dataset) = &args.arm.from {
@@ -158,13 +170,7 @@ pub fn identify(args: &IdentifyArgs) -> Result<i32, Error> {
     let space = Space::new(family, args.friction_model, args.fit_supply_resistance, args.fit_motor_voltage_limit, !args.no_command_delay);
     let options = FitOptions { searches: args.searches, population: args.population, generations, refine_generations: args.refine_generations, seed: args.seed, start };
     let started = std::time::Instant::now();
-    let bar = ProgressBar::new(0);
-    if args.quiet {
-        bar.set_draw_target(ProgressDrawTarget::hidden());
-    } else {
-        bar.set_style(ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:30} {pos}/{len} generations  {msg}").unwrap_or_else(|_| ProgressStyle::default_bar()));
-        bar.enable_steady_tick(std::time::Duration::from_millis(200));
-    }
+    let bar = generations_bar(0, args.quiet);
     let progress = |p: Progress| {
         bar.set_length(p.generations as u64);
         bar.set_position(p.generation as u64);

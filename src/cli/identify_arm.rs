@@ -7,7 +7,6 @@ use crate::identify::arm::{ArmFitOptions, ArmObjective, ArmSpace, fit_arm};
 use crate::motion::{Mapped, open_mapped};
 use crate::replay::forward::{Drives, FollowSetup, ForwardCase, ForwardReplay, ForwardSummary, Latency, follow};
 use crate::replay::{ReplayOptions, Replayer};
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 /// The flags of `identify --from`.
 #[derive(Args, Debug)]
@@ -121,10 +120,8 @@ pub fn identify_arm(args: &IdentifyArgs, dataset: &Path) -> Result<i32, Error> {
     if !(arm.payload_max.is_finite() && arm.payload_max > 0.0) {
         return Err(Error::flag("--payload-max", "must be a positive mass, kg"));
     }
-    if let Some(l) = arm.latency
-        && !(0.0..=crate::replay::forward::MAX_LATENCY).contains(&l)
-    {
-        return Err(Error::flag("--latency", format!("must be a number of seconds between 0 and {}", crate::replay::forward::MAX_LATENCY)));
+    if let Some(latency) = arm.latency {
+        crate::replay::forward::check_latency(latency)?;
     }
     let generations = args.generations.unwrap_or(GENERATIONS);
     if generations == 0 {
@@ -260,13 +257,7 @@ pub fn identify_arm(args: &IdentifyArgs, dataset: &Path) -> Result<i32, Error> {
     let objective = ArmObjective { model: &model, motor_file: motors, tool: arm.tool.as_deref(), space: &space, cases: &search_cases, fitted: is_fitted.clone() };
     let jobs = arm.jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get())).max(1);
     let options = ArmFitOptions { population: args.population, generations, seed: args.seed, jobs, ..ArmFitOptions::default() };
-    let bar = ProgressBar::new(generations as u64);
-    if args.quiet {
-        bar.set_draw_target(ProgressDrawTarget::hidden());
-    } else {
-        bar.set_style(ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:30} {pos}/{len} generations  {msg}").unwrap_or_else(|_| ProgressStyle::default_bar()));
-        bar.enable_steady_tick(std::time::Duration::from_millis(200));
-    }
+    let bar = super::identify::generations_bar(generations as u64, args.quiet);
     let progress = |generation: usize, best: f64| {
         bar.set_position(generation as u64);
         bar.set_message(format!("best {:.2} mrad", 1e3 * best));
@@ -275,7 +266,7 @@ pub fn identify_arm(args: &IdentifyArgs, dataset: &Path) -> Result<i32, Error> {
     bar.finish_and_clear();
     let seconds = started.elapsed().as_secs_f64();
 
-    let servo_files = write_motor_file(&args.out, motors, &model, &start_set, &space, &found.params, dataset, &train, &found)?;
+    let servo_files = write_motor_file(&args.out, motors, &model, &start_set, &space, dataset, &train, &found)?;
     // the file as written, replayed: what `replay --forward --motors FILE` will give
     let payload = if arm.fit_payload { found.payload } else { arm.payload };
     let replay_with = |cases: &[ForwardCase]| -> Result<Vec<ForwardReplay>, Error> { cases.iter().map(|c| follow(&model, c, &Drives::File(&args.out), &FollowSetup { payload, tool: arm.tool.as_deref(), offsets: arm.fit_offsets.then_some(found.offsets.as_slice()) }, None)).collect() };
@@ -359,7 +350,7 @@ pub fn identify_arm(args: &IdentifyArgs, dataset: &Path) -> Result<i32, Error> {
 /// kind's parameters (`OUT_STEM.KIND.json`, beside it), the files it names made absolute so that it
 /// reads from anywhere. Returns the parameter files written.
 #[allow(clippy::too_many_arguments)]
-fn write_motor_file(out: &Path, motors: &Path, model: &crate::model::Model, set: &crate::actuator::MotorSet, space: &ArmSpace, params: &[crate::actuator::bus_servo::ServoParams], dataset: &Path, train: &[i64], found: &crate::identify::arm::ArmFit) -> Result<Vec<PathBuf>, Error> {
+fn write_motor_file(out: &Path, motors: &Path, model: &crate::model::Model, set: &crate::actuator::MotorSet, space: &ArmSpace, dataset: &Path, train: &[i64], found: &crate::identify::arm::ArmFit) -> Result<Vec<PathBuf>, Error> {
     use toml::Value;
     let fail = |m: String| Error::flag(motors.display().to_string(), m);
     let text = crate::builtin::read_to_string(motors).map_err(|e| fail(format!("cannot read: {e}")))?;
@@ -374,7 +365,7 @@ fn write_motor_file(out: &Path, motors: &Path, model: &crate::model::Model, set:
     let out_dir = out.parent().filter(|p| !p.as_os_str().is_empty()).map_or_else(|| PathBuf::from("."), Path::to_path_buf);
     let mut written = Vec::new();
     let mut file_of_kind = Vec::new();
-    for (kind, p) in space.kinds.iter().zip(params) {
+    for (kind, p) in space.kinds.iter().zip(&found.params) {
         let name = format!("{stem}.{}.json", crate::runner::file_safe(&kind.name));
         let path = out_dir.join(&name);
         std::fs::write(&path, serde_json::to_string_pretty(&p.to_json()).unwrap_or_default() + "\n").map_err(|e| Error::output(&path, e))?;

@@ -152,10 +152,8 @@ pub fn replay(args: &ReplayArgs) -> Result<i32, Error> {
 fn forward(args: &ReplayArgs, replayer: &Replayer, source: &crate::motion::Source, episodes: &[i64]) -> Result<i32, Error> {
     use crate::replay::forward::{ForwardOptions, Latency, forward, forward_episodes, schedule_path};
     let motors = args.motors.clone().ok_or_else(|| Error::flag("--forward", "needs --motors: the servos that follow the commands"))?;
-    if let Some(latency) = args.latency
-        && !(0.0..=crate::replay::forward::MAX_LATENCY).contains(&latency)
-    {
-        return Err(Error::flag("--latency", if latency.is_finite() { format!("{latency} s: a command latency is between 0 and {} s", crate::replay::forward::MAX_LATENCY) } else { format!("must be a number of seconds between 0 and {}", crate::replay::forward::MAX_LATENCY) }));
+    if let Some(latency) = args.latency {
+        crate::replay::forward::check_latency(latency)?;
     }
     // the command schedules go where the recordings go
     let dir = args.files.folder();

@@ -27,19 +27,14 @@ pub const ARM_KEYS: [&str; 9] = ["kt", "error_gain_ratio", "armature", "friction
 /// every halving of it doubles the steps a run needs).
 const SCALE_RANGE: f64 = 4.0;
 
+/// The parameters that are scales of the servo, searched within [`SCALE_RANGE`] of their start.
+const SCALES: [&str; 5] = ["kt", "error_gain_ratio", "armature", "R", "max_velocity"];
+
 /// `space`'s scales narrowed to within [`SCALE_RANGE`] of `start` (and BAM's bounds).
 fn around(space: &mut Space, start: &ServoParams) {
-    let point = space.point(start);
-    let starts = space.params_from(start, &point);
-    for d in &mut space.dimensions {
-        let value = match d.key {
-            "kt" => starts.kt,
-            "error_gain_ratio" => starts.error_gain_ratio,
-            "armature" => starts.armature,
-            "R" => starts.resistance,
-            "max_velocity" => starts.max_velocity,
-            _ => continue,
-        };
+    for d in space.dimensions.iter_mut().filter(|d| SCALES.contains(&d.key)) {
+        // the start as the space holds it: clamped into BAM's bounds
+        let value = d.value(d.coordinate(super::space::get(start, d.key)));
         if value > 0.0 {
             d.lower = d.lower.max(value / SCALE_RANGE);
             d.upper = d.upper.min(value * SCALE_RANGE);

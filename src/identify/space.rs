@@ -157,7 +157,8 @@ fn set(p: &mut ServoParams, key: &str, x: f64) {
     }
 }
 
-fn get(p: &ServoParams, key: &str) -> f64 {
+/// The parameter `key` (BAM's name) of `p`.
+pub(crate) fn get(p: &ServoParams, key: &str) -> f64 {
     match key {
         "kt" => p.kt,
         "R" => p.resistance,

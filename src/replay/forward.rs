@@ -78,6 +78,14 @@ pub struct ForwardOptions {
 /// The longest command latency accepted, s: a teleop loop slower than this is not one.
 pub const MAX_LATENCY: f64 = 1.0;
 
+/// `seconds` as a command latency, or the one line that refuses it (naming `--latency`).
+pub fn check_latency(seconds: f64) -> Result<(), Error> {
+    if (0.0..=MAX_LATENCY).contains(&seconds) {
+        return Ok(());
+    }
+    Err(Error::flag("--latency", if seconds.is_finite() { format!("{seconds} s: a command latency is between 0 and {MAX_LATENCY} s") } else { format!("must be a number of seconds between 0 and {MAX_LATENCY}") }))
+}
+
 /// The latency a forward replay models and where it came from.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct Latency {
