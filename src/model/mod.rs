@@ -57,6 +57,11 @@ impl Joint {
     pub fn has_limits(&self) -> bool {
         self.lower.is_finite() || self.upper.is_finite()
     }
+
+    /// Its limits as an interval (lowest, highest), whichever way round the URDF wrote them.
+    pub fn range(&self) -> (f64, f64) {
+        (self.lower.min(self.upper), self.upper.max(self.lower))
+    }
 }
 
 /// Every URDF link, as a frame rigidly attached to a body.

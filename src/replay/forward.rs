@@ -197,7 +197,10 @@ impl FollowSetup<'_> {
 /// it is given, so the goal is the pose less the sag there.
 fn follower_experiment(model: &crate::model::Model, case: &ForwardCase, drives: &Drives, setup: &FollowSetup) -> Result<Experiment, Error> {
     let n = model.dof();
-    let within = |j: usize, q: f64| q.clamp(model.joints[j].lower.min(model.joints[j].upper), model.joints[j].upper.max(model.joints[j].lower));
+    let within = |j: usize, q: f64| {
+        let (lowest, highest) = model.joints[j].range();
+        q.clamp(lowest, highest)
+    };
     let observed_start: Vec<f64> = case.reality.q.iter().enumerate().map(|(j, joint)| within(j, joint[0] + setup.offset(j))).collect();
     let motor_file = match drives {
         Drives::File(file) | Drives::Made { file, .. } => file.to_path_buf(),

@@ -66,8 +66,7 @@ const ROUND_OFF: f64 = 1e-9;
 
 /// A joint's range, [−∞, ∞] where the URDF gives none.
 fn range_of(model: &Model, j: usize) -> (f64, f64) {
-    let joint = &model.joints[j];
-    let (lower, upper) = (joint.lower.min(joint.upper), joint.upper.max(joint.lower));
+    let (lower, upper) = model.joints[j].range();
     if lower.is_finite() && upper.is_finite() { (lower, upper) } else { (f64::NEG_INFINITY, f64::INFINITY) }
 }
 

@@ -65,7 +65,10 @@ impl Replayer {
         let base_model = model.clone();
         let experiment = Experiment::with_model(config, model)?;
         let model = experiment.model.clone();
-        let hold = model.joints.iter().map(|j| 0.0_f64.clamp(j.lower.min(j.upper), j.upper.max(j.lower))).collect();
+        let hold = model.joints.iter().map(|j| {
+            let (lowest, highest) = j.range();
+            0.0_f64.clamp(lowest, highest)
+        }).collect();
         Ok(Self { model, base_model, motors: experiment.motors.clone(), map, hold, experiment })
     }
 
