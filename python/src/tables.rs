@@ -20,50 +20,41 @@ struct BatchCall {
     args: armscope::cli::BatchArgs,
 }
 
-/// `--out` when the caller gave none: a scratch folder, removed after its JSON is read.
-fn out_folder(given: bool, out: &mut PathBuf) -> PyResult<Option<tempfile::TempDir>> {
-    if given {
-        return Ok(None);
-    }
-    let scratch = tempfile::Builder::new().prefix("armscope-").tempdir().map_err(crate::error)?;
-    *out = scratch.path().to_path_buf();
-    Ok(Some(scratch))
+/// A scratch folder for the command's files, removed after its JSON is read.
+fn scratch() -> PyResult<tempfile::TempDir> {
+    tempfile::Builder::new().prefix("armscope-").tempdir().map_err(crate::error)
 }
 
-/// `armscope size ARGV`: the text of the size.json it writes.
+/// `armscope size ARGV`: the text of the size.json it writes (to `--out`, else to a scratch folder).
 #[pyfunction]
 pub fn size(py: Python<'_>, argv: Vec<String>) -> PyResult<String> {
+    // `--out` has a default: whether the caller gave one is in the arguments
     let given = argv.iter().any(|a| a == "--out" || a.starts_with("--out="));
     let mut call = SizeCall::try_parse_from(&argv).map_err(|e| crate::error(format!("size: {}", crate::run::parse_error(&e))))?;
-    let _scratch = out_folder(given, &mut call.args.out)?;
-    let out = call.args.out.clone();
+    let folder = if given { None } else { Some(scratch()?) };
+    if let Some(f) = &folder {
+        call.args.out = f.path().to_path_buf();
+    }
     py.detach(|| armscope::cli::size(&call.args)).map_err(crate::error)?;
-    std::fs::read_to_string(out.join("size.json")).map_err(crate::error)
+    std::fs::read_to_string(call.args.out.join("size.json")).map_err(crate::error)
 }
 
-/// `armscope batch ARGV`: the text of the summary.json it writes (failed experiments in it, with
-/// their errors).
+/// `armscope batch ARGV`: the text of the summary (or shard summary) JSON it writes, failed
+/// experiments in it with their errors (to `--out`, else to a scratch folder).
 #[pyfunction]
 pub fn batch(py: Python<'_>, argv: Vec<String>) -> PyResult<String> {
-    let given = argv.iter().any(|a| a == "--out" || a.starts_with("--out="));
     let mut call = BatchCall::try_parse_from(&argv).map_err(|e| crate::error(format!("batch: {}", crate::run::parse_error(&e))))?;
     if call.args.action.is_some() {
         return Err(crate::error("batch: merge is the command's (`armscope batch merge DIR…`)"));
     }
-    let scratch = out_folder(given, &mut PathBuf::new())?;
-    if let Some(s) = &scratch {
-        call.args.out = Some(s.path().to_path_buf());
-    }
-    let out = call.args.out.clone();
-    py.detach(|| armscope::cli::batch(&call.args)).map_err(crate::error)?;
-    let manifest_name = armscope::batch::load_manifest(&call.args.manifest).map_err(crate::error)?.name;
-    let folder = out.unwrap_or_else(|| PathBuf::from("recordings").join(manifest_name));
-    let file = match &call.args.shard {
-        Some(spec) => {
-            let (i, n) = armscope::batch::parse_shard(spec).map_err(crate::error)?;
-            folder.join(format!("summary.shard-{i}-of-{n}.json"))
-        }
-        None => folder.join("summary.json"),
+    let folder = if call.args.out.is_none() { Some(scratch()?) } else { None };
+    let out: PathBuf = match &folder {
+        Some(f) => f.path().to_path_buf(),
+        None => call.args.out.clone().unwrap_or_default(),
     };
+    call.args.out = Some(out.clone());
+    py.detach(|| armscope::cli::batch(&call.args)).map_err(crate::error)?;
+    let shard = call.args.shard.as_deref().map(armscope::batch::parse_shard).transpose().map_err(crate::error)?;
+    let file = out.join(format!("{}.json", armscope::batch::table_stem(shard.map(|(i, n)| [i, n]))));
     std::fs::read_to_string(&file).map_err(crate::error)
 }

@@ -11,4 +11,4 @@ pub use compare::{ComparedRun, build_comparison};
 pub use manifest::{Manifest, PlannedExperiment, load_manifest, parse_shard, shard};
 pub use outcome::ExperimentOutcome;
 pub use runner::{BatchOptions, run_args, run_batch, write_comparison};
-pub use table::{BatchSummary, merge_summaries, write_tables};
+pub use table::{BatchSummary, merge_summaries, table_stem, write_tables};

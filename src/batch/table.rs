@@ -127,9 +127,9 @@ pub fn csv(summary: &BatchSummary) -> String {
     out
 }
 
-/// The file stem of the tables: `summary`, or `summary.shard-I-of-N` for a shard.
-pub fn table_stem(summary: &BatchSummary) -> String {
-    match summary.shard {
+/// The file stem of the tables: `summary`, or `summary.shard-I-of-N` for shard I of N.
+pub fn table_stem(shard: Option<[usize; 2]>) -> String {
+    match shard {
         Some([i, n]) => format!("summary.shard-{i}-of-{n}"),
         None => "summary".into(),
     }
@@ -137,7 +137,7 @@ pub fn table_stem(summary: &BatchSummary) -> String {
 
 /// Writes DIR/STEM.md, .csv and .json; returns the paths.
 pub fn write_tables(dir: &Path, summary: &BatchSummary) -> Result<Vec<PathBuf>, Error> {
-    let stem = table_stem(summary);
+    let stem = table_stem(summary.shard);
     let files = [
         (dir.join(format!("{stem}.md")), markdown(summary)),
         (dir.join(format!("{stem}.csv")), csv(summary)),
