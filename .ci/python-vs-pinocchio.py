@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """armscope's Python package against Pinocchio's Python API on the fixed-base robots of
-example-robot-data: at random states, by joint and frame name, rnea, aba, the mass matrix, the
-generalized gravity, every link frame's pose and its LOCAL_WORLD_ALIGNED Jacobian, each within
---tolerance of its scale. Then the speed side by side: one rnea call from Python, and rnea over a
+example-robot-data: at random states, by joint and frame name, rnea (one state at a time and all at
+once, as a trajectory), aba, the mass matrix, the generalized gravity, every link frame's pose and its
+LOCAL_WORLD_ALIGNED Jacobian, each within --tolerance of its scale. Then the speed side by side: one rnea call from Python, and rnea over a
 10 000-state trajectory against a Python loop of pin.rnea.
 
 Run by .ci/run in the corpus venv (pin, example-robot-data) with the armscope wheel installed:
@@ -45,7 +45,7 @@ def rel(a, b):
     return float(np.abs(np.asarray(a) - np.asarray(b)).max()) / scale if np.size(b) else 0.0
 
 
-def compare(urdf, rng, states=5):
+def compare(urdf, rng, states=9):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         ours = armscope.Model(urdf)
@@ -59,6 +59,7 @@ def compare(urdf, rng, states=5):
     links = [f for f in ours.frame_names if model.existFrame(f, pin.FrameType.BODY)]
     mimic = model.nvExtended != model.nv
     worst = dict.fromkeys(["rnea", "aba", "M", "g", "poses", "J"], 0.0)
+    trajectory, expected = ([], [], []), []  # the states at once: rnea's SIMD lanes
     for _ in range(states):
         q = np.where(finite, rng.uniform(np.where(finite, lo, -np.pi), np.where(finite, hi, np.pi)), rng.uniform(-np.pi, np.pi, ours.nq))
         v, a, tau = (rng.uniform(-1, 1, ours.nv) for _ in range(3))
@@ -74,6 +75,9 @@ def compare(urdf, rng, states=5):
         else:
             rnea, aba = pin.rnea(model, data, pq, pv, pa).copy(), pin.aba(model, data, pq, pv, ptau).copy()
         worst["rnea"] = max(worst["rnea"], rel(ours.rnea(q, v, a), P(rnea)))
+        for rows, x in zip(trajectory, (q, v, a)):
+            rows.append(x)
+        expected.append(P(rnea))
         worst["aba"] = max(worst["aba"], rel(ours.aba(q, v, tau), P(aba)))
         worst["M"] = max(worst["M"], rel(ours.mass_matrix(q), M[np.ix_(v_idx, v_idx)]))
         worst["g"] = max(worst["g"], rel(ours.gravity_torque(q), P(pin.computeGeneralizedGravity(model, data, pq))))
@@ -84,12 +88,16 @@ def compare(urdf, rng, states=5):
             worst["poses"] = max(worst["poses"], rel(ours.frame_pose(q, link), data.oMf[fid].homogeneous))
             J = pin.getFrameJacobian(model, data, fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
             worst["J"] = max(worst["J"], rel(ours.jacobian(q, link), J[:, v_idx]))
+    many = ours.rnea(*(np.array(rows) for rows in trajectory))
+    worst["rnea"] = max([worst["rnea"]] + [rel(got, want) for got, want in zip(many, expected)])
     return ours, model, worst, len(links)
 
 
-def speed(urdf):
+def speed(urdf, rounds=7):
     """One rnea call from Python, armscope's and Pinocchio's; a 10 000-state trajectory at once
-    against a Python loop of pin.rnea."""
+    against a Python loop of pin.rnea. The two are timed in turn, round after round (this machine's
+    speed drifts by tens of percent within a minute): each round's ratio, of the best of a few calls
+    each; the rounds' median and range."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         ours = armscope.Model(urdf)
@@ -97,18 +105,22 @@ def speed(urdf):
     data = model.createData()
     rng = np.random.default_rng(1)
     q, v, a = (rng.uniform(-1, 1, model.nv) for _ in range(3))
-    n = 20000
-    one_ours = min(timeit.repeat(lambda: ours.rnea(q, v, a), number=n, repeat=5)) / n
-    one_pin = min(timeit.repeat(lambda: pin.rnea(model, data, q, v, a), number=n, repeat=5)) / n
     Q, V, A = (rng.uniform(-1, 1, (10000, model.nv)) for _ in range(3))
-    traj_ours = min(timeit.repeat(lambda: ours.rnea(Q, V, A), number=3, repeat=5)) / 3
 
     def loop():
         for k in range(10000):
             pin.rnea(model, data, Q[k], V[k], A[k])
 
-    traj_pin = min(timeit.repeat(loop, number=1, repeat=5))
-    return one_ours, one_pin, traj_ours, traj_pin
+    one, trajectory = [], []
+    n = 20000
+    for _ in range(rounds):
+        one_ours = min(timeit.repeat(lambda: ours.rnea(q, v, a), number=n, repeat=3)) / n
+        one_pin = min(timeit.repeat(lambda: pin.rnea(model, data, q, v, a), number=n, repeat=3)) / n
+        traj_ours = min(timeit.repeat(lambda: ours.rnea(Q, V, A), number=3, repeat=3)) / 3
+        traj_pin = min(timeit.repeat(loop, number=1, repeat=2))
+        one.append((one_pin / one_ours, one_ours, one_pin))
+        trajectory.append((traj_pin / traj_ours, traj_ours, traj_pin))
+    return sorted(one), sorted(trajectory)
 
 
 def main():
@@ -130,9 +142,11 @@ def main():
         bad = [k for k, w in worst.items() if not w <= a.tolerance]
         failures += [f"{name}: {k} differs by {worst[k]:.1e}" for k in bad]
         print(f"| {name} | {ours.nq} | {links} | " + " | ".join(f"{worst[k]:.1e}" for k in ["rnea", "aba", "M", "g", "poses", "J"]) + " |")
-    one_ours, one_pin, traj_ours, traj_pin = speed(os.path.join(root, ROBOTS["ur5"]))
-    print(f"\nUR5 rnea from Python: armscope {1e6 * one_ours:.2f} µs a call, pin.rnea {1e6 * one_pin:.2f} µs ({one_pin / one_ours:.2f}×); "
-          f"10 000 states at once {1e3 * traj_ours:.2f} ms against a Python loop of pin.rnea {1e3 * traj_pin:.2f} ms ({traj_pin / traj_ours:.1f}×)")
+    one, trajectory = speed(os.path.join(root, ROBOTS["ur5"]))
+    (ratio, ours_s, pin_s), (traj_ratio, traj_ours, traj_pin) = one[len(one) // 2], trajectory[len(trajectory) // 2]
+    print(f"\nUR5 rnea from Python, {len(one)} rounds in turn, medians: armscope {1e6 * ours_s:.2f} µs a call, pin.rnea {1e6 * pin_s:.2f} µs "
+          f"({ratio:.2f}×; rounds {one[0][0]:.2f}–{one[-1][0]:.2f}×); 10 000 states at once {1e3 * traj_ours:.2f} ms against a Python loop of "
+          f"pin.rnea {1e3 * traj_pin:.2f} ms ({traj_ratio:.1f}×; rounds {trajectory[0][0]:.1f}–{trajectory[-1][0]:.1f}×)")
     if failures:
         sys.exit("python-vs-pinocchio: " + "; ".join(failures))
     print(f"python-vs-pinocchio: {len(ROBOTS)} robots within {a.tolerance:g} of Pinocchio {pin.__version__}")

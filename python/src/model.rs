@@ -45,8 +45,10 @@ struct States<'py> {
 
 /// The most inputs an algorithm takes (q, v, a).
 const MOST_INPUTS: usize = 3;
-/// Trajectories of at least this many states are split over the cores.
+/// Trajectories of at least this many states are split over the cores,
 const PARALLEL_FROM: usize = 512;
+/// in blocks of this many states (a block's cost, tens of microseconds, far above a task's).
+const BLOCK: usize = 128;
 
 impl Model {
     fn dof(&self) -> usize {
@@ -91,7 +93,34 @@ impl Model {
     fn over<'py>(&self, py: Python<'py>, states: States<'py>, per_state: &[usize], each: impl Fn(&armscope::model::Model, &mut Data, &[&[f64]], &mut [f64]) + Send + Sync) -> PyResult<Bound<'py, PyAny>> {
         let n = self.dof();
         let size: usize = per_state.iter().product::<usize>().max(1);
-        let mut shape = if states.single { Vec::new() } else { vec![states.rows] };
+        if states.single {
+            let mut data = self.data.lock().map_err(|_| PyValueError::new_err("the model's workspace was poisoned by a failed call"))?;
+            // SAFETY: a new array, written here only; the inputs stay alive (owned here) for the call
+            let out = unsafe { PyArrayDyn::<f64>::new(py, IxDyn(per_state), false) };
+            let inputs: Vec<&[f64]> = states.arrays.iter().map(|a| unsafe { a.as_slice() }.unwrap_or_default()).collect();
+            let written = unsafe { out.as_slice_mut() }.map_err(|e| PyValueError::new_err(e.to_string()))?;
+            each(&self.model, &mut data, &inputs, written);
+            return Ok(out.into_any());
+        }
+        self.over_blocks(py, states, per_state, Data::new, |model, data, inputs, out| {
+            let mut row: [&[f64]; MOST_INPUTS] = [&[]; MOST_INPUTS];
+            for (k, chunk) in out.chunks_mut(size).enumerate() {
+                for (slot, x) in row.iter_mut().zip(inputs) {
+                    *slot = &x[k * n..(k + 1) * n];
+                }
+                each(model, data, &row[..inputs.len()], chunk);
+            }
+        })
+    }
+
+    /// `each` (the model, a workspace `init` made, a block of consecutive states' inputs, where
+    /// their results go) over every state of a trajectory, a block at a time: the result per state
+    /// has shape `per_state`. It runs without the GIL, in blocks of [`BLOCK`] states split over the
+    /// cores when long, each core with a workspace of its own.
+    fn over_blocks<'py, W>(&self, py: Python<'py>, states: States<'py>, per_state: &[usize], init: impl Fn(&armscope::model::Model) -> W + Send + Sync, each: impl Fn(&armscope::model::Model, &mut W, &[&[f64]], &mut [f64]) + Send + Sync) -> PyResult<Bound<'py, PyAny>> {
+        let n = self.dof();
+        let size: usize = per_state.iter().product::<usize>().max(1);
+        let mut shape = vec![states.rows];
         shape.extend_from_slice(per_state);
         // SAFETY: a new array, written here only
         let out = unsafe { PyArrayDyn::<f64>::new(py, IxDyn(&shape), false) };
@@ -100,31 +129,25 @@ impl Model {
         // GIL-free functions do
         let inputs: Vec<&[f64]> = states.arrays.iter().map(|a| unsafe { a.as_slice() }.unwrap_or_default()).collect();
         let written = unsafe { out.as_slice_mut() }.map_err(|e| PyValueError::new_err(e.to_string()))?;
-        let row_of = |k: usize| -> [&[f64]; MOST_INPUTS] {
-            let mut row: [&[f64]; MOST_INPUTS] = [&[]; MOST_INPUTS];
-            for (slot, x) in row.iter_mut().zip(&inputs) {
-                *slot = &x[k * n..(k + 1) * n];
+        let block_of = |first: usize, rows: usize| -> [&[f64]; MOST_INPUTS] {
+            let mut block: [&[f64]; MOST_INPUTS] = [&[]; MOST_INPUTS];
+            for (slot, x) in block.iter_mut().zip(&inputs) {
+                *slot = &x[first * n..(first + rows) * n];
             }
-            row
+            block
         };
         let k_inputs = inputs.len();
-        if states.single {
-            let mut data = self.data.lock().map_err(|_| PyValueError::new_err("the model's workspace was poisoned by a failed call"))?;
-            each(&self.model, &mut data, &row_of(0)[..k_inputs], written);
-        } else {
-            let model = &self.model;
-            py.detach(|| {
+        let model = &self.model;
+        py.detach(|| {
+            if states.rows >= PARALLEL_FROM {
                 use rayon::prelude::*;
-                if states.rows >= PARALLEL_FROM {
-                    written.par_chunks_mut(size).enumerate().for_each_init(|| Data::new(model), |data, (k, chunk)| each(model, data, &row_of(k)[..k_inputs], chunk));
-                } else {
-                    let mut data = Data::new(model);
-                    for (k, chunk) in written.chunks_mut(size).enumerate() {
-                        each(model, &mut data, &row_of(k)[..k_inputs], chunk);
-                    }
-                }
-            });
-        }
+                written.par_chunks_mut(size * BLOCK).enumerate().for_each_init(|| init(model), |workspace, (b, chunk)| {
+                    each(model, workspace, &block_of(b * BLOCK, chunk.len() / size)[..k_inputs], chunk)
+                });
+            } else {
+                each(model, &mut init(model), &block_of(0, states.rows)[..k_inputs], written);
+            }
+        });
         Ok(out.into_any())
     }
 
@@ -212,7 +235,11 @@ impl Model {
     /// accelerations `a` at positions `q` and velocities `v`.
     fn rnea<'py>(&self, py: Python<'py>, q: &Bound<'py, PyAny>, v: &Bound<'py, PyAny>, a: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
         let states = self.states(&[("q", q), ("v", v), ("a", a)])?;
-        self.over(py, states, &[self.dof()], |model, data, x, out| out.copy_from_slice(dynamics::rnea(model, data, x[0], x[1], x[2])))
+        if states.single {
+            return self.over(py, states, &[self.dof()], |model, data, x, out| out.copy_from_slice(dynamics::rnea(model, data, x[0], x[1], x[2])));
+        }
+        // a trajectory: four states at a time in SIMD lanes
+        self.over_blocks(py, states, &[self.dof()], dynamics::RneaManyData::new, |model, data, x, out| dynamics::rnea_many(model, data, x[0], x[1], x[2], out))
     }
 
     /// Forward dynamics (ABA): the accelerations the torques `tau` give at positions `q` and

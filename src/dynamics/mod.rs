@@ -17,6 +17,7 @@ mod kinematics;
 mod ldlt;
 mod ltdl;
 mod rnea;
+mod rnea_many;
 mod solvable;
 
 pub use aba::{aba, aba_from_kinematics};
@@ -29,5 +30,6 @@ pub use jacobian::frame_jacobian;
 pub use ldlt::{ldlt_in_place, ldlt_in_place_slice, ldlt_solve_in_place, ldlt_solve_slice};
 pub use ltdl::{ltdl_in_place, ltdl_solve_in_place};
 pub use kinematics::{body_poses, forward_kinematics, frame_pose, frame_pose_in};
+pub use rnea_many::{LANES, RneaManyData, rnea_many};
 pub use solvable::check_solvable;
 pub use rnea::{bias_forces, gravity_and_bias_from_kinematics, gravity_forces, gravity_from_kinematics, rnea, rnea_from_kinematics};

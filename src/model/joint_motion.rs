@@ -9,14 +9,14 @@ use nalgebra::{Matrix3, Vector3};
 #[derive(Clone, Copy, Debug)]
 pub struct JointMotion {
     /// R_pl·a·aᵀ for a revolute joint, R_pl for a prismatic one.
-    fixed: Matrix3<f64>,
-    cosine: Matrix3<f64>,
-    sine: Matrix3<f64>,
+    pub(crate) fixed: Matrix3<f64>,
+    pub(crate) cosine: Matrix3<f64>,
+    pub(crate) sine: Matrix3<f64>,
     /// The axis in the parent body's frame, R_pl·a.
     pub axis: Vector3<f64>,
     /// The joint frame's origin in the parent body's frame.
-    origin: Vector3<f64>,
-    prismatic: bool,
+    pub(crate) origin: Vector3<f64>,
+    pub(crate) prismatic: bool,
 }
 
 impl JointMotion {
