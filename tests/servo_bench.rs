@@ -323,3 +323,25 @@ fn testbench_replays_a_catalogue_servo_by_name() {
     assert_eq!(catalogue.variant_of("STS3215-C018-BAM12V"), Some("STS3215-C018"));
     assert_eq!(catalogue.servo_params("STS3215-C018-BAM12V").unwrap().unwrap().friction.model, FrictionModel::M1);
 }
+
+#[test]
+fn identify_fits_the_motor_voltage_cap_of_a_servo_run_above_its_vendors_highest_supply() {
+    // the XL330 allows at most 6.0 V: on logs at 7.4 V (BAM's bench) the cap is fitted by default,
+    // said in one notice, and written; at 5.0 V, or with --no-motor-voltage-limit, it is not
+    let dir = tempfile::tempdir().unwrap();
+    let truth = known_servo(FrictionModel::M1);
+    let fitted = |vin: f64, extra: &[&str]| {
+        let log = write_log(dir.path(), &record(&truth, &Bench { vin, duration: 1.0, ..Default::default() }, Trajectory::SinSin, &ReplayOptions::default()));
+        let out = dir.path().join(format!("fit-{vin}-{}.json", extra.len()));
+        let mut args = vec!["identify", log.to_str().unwrap(), "--actuator", "xl330", "--friction-model", "m1", "--generations", "2", "--refine-generations", "1", "--searches", "1", "--out", out.to_str().unwrap(), "--quiet"];
+        args.extend_from_slice(extra);
+        let (code, _, stderr) = run(&args);
+        assert_eq!(code, 0, "{stderr}");
+        let params: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+        (params.get("motor_voltage_limit").is_some(), stderr.matches("above the 6.0 V its vendor allows the xl330").count())
+    };
+    assert_eq!(fitted(7.4, &[]), (true, 1));
+    assert_eq!(fitted(5.0, &[]), (false, 0));
+    assert_eq!(fitted(7.4, &["--no-motor-voltage-limit"]), (false, 0));
+    assert_eq!(fitted(5.0, &["--fit-motor-voltage-limit"]), (true, 0));
+}

@@ -22,6 +22,9 @@ pub struct Family {
     pub default_kp: f64,
     /// The supply the vendor rates it at, V.
     pub nominal_supply: f64,
+    /// The highest supply the vendor allows, V, where a source gives it (None: not found). Run above
+    /// it, a servo does not put the whole supply across its motor (`identify` then fits that cap).
+    pub max_supply: Option<f64>,
     /// Whether the firmware walks an internal target towards the goal at a bounded speed (Feetech).
     pub goal_speed_limiter: bool,
     /// That speed out of the box, rad/s.
@@ -43,12 +46,14 @@ pub const XL330: Family = Family {
     max_duty: 1.0,
     default_kp: 400.0,
     nominal_supply: 5.0,
+    max_supply: Some(6.0),
     goal_speed_limiter: false,
     default_max_velocity: f64::INFINITY,
     protection: Protection::NONE,
     source: "e_g = (4096/2π)/(256·885): Rhoban/bam bam/dynamixel/actuator.py at 1b5a1ce (the 256 divisor measured by BAM; \
              the Dynamixel manual says 128); 885 = 100 % is the PWM Limit(36) default and Position P Gain(84) defaults to 400 \
-             (ROBOTIS e-manual docs/en/dxl/x/xl330-m288.md); 5.0 V: the e-manual's rated voltage (catalogue-sources.md §2)",
+             (ROBOTIS e-manual docs/en/dxl/x/xl330-m288.md); 5.0 V: the e-manual's rated voltage, 6.0 V the top of its 3.7–6.0 V \
+             supply range (catalogue-sources.md §2)",
 };
 
 pub const XL320: Family = Family {
@@ -57,6 +62,7 @@ pub const XL320: Family = Family {
     max_duty: 1.0,
     default_kp: 32.0,
     nominal_supply: 7.5,
+    max_supply: None,
     goal_speed_limiter: false,
     default_max_velocity: f64::INFINITY,
     protection: Protection::NONE,
@@ -69,6 +75,7 @@ pub const MX64: Family = Family {
     max_duty: 0.9625,
     default_kp: 32.0,
     nominal_supply: 15.0,
+    max_supply: None,
     goal_speed_limiter: false,
     default_max_velocity: f64::INFINITY,
     protection: Protection::NONE,
@@ -83,6 +90,8 @@ pub const STS3215: Family = Family {
     max_duty: 0.97,
     default_kp: 32.0,
     nominal_supply: 7.4,
+    // the family covers the 7.4 V and the 12 V servos: no one limit
+    max_supply: None,
     goal_speed_limiter: true,
     default_max_velocity: 3400.0 * std::f64::consts::TAU / 4096.0,
     protection: protection::FEETECH_FACTORY,
