@@ -116,7 +116,9 @@ def speed(urdf, rounds=7):
     for _ in range(rounds):
         one_ours = min(timeit.repeat(lambda: ours.rnea(q, v, a), number=n, repeat=3)) / n
         one_pin = min(timeit.repeat(lambda: pin.rnea(model, data, q, v, a), number=n, repeat=3)) / n
-        traj_ours = min(timeit.repeat(lambda: ours.rnea(Q, V, A), number=3, repeat=3)) / 3
+        # warm: the cores woken (the loop before left one idle), as in a notebook's repeated calls
+        ours.rnea(Q, V, A)
+        traj_ours = min(timeit.repeat(lambda: ours.rnea(Q, V, A), number=10, repeat=3)) / 10
         traj_pin = min(timeit.repeat(loop, number=1, repeat=2))
         one.append((one_pin / one_ours, one_ours, one_pin))
         trajectory.append((traj_pin / traj_ours, traj_ours, traj_pin))
