@@ -57,6 +57,10 @@ pub struct ArmArgs {
     /// URDF's, within ±0.15 rad).
     #[arg(long, requires = "from")]
     pub fit_offsets: bool,
+    /// With --from: each fitted joint's servo its own parameters (by default the servos of one kind
+    /// share theirs): more parameters, searched longer.
+    #[arg(long, requires = "from")]
+    pub per_joint: bool,
     /// With --from: the link whose origin is the tool.
     #[arg(long, value_name = "LINK", requires = "from")]
     pub tool: Option<String>,
@@ -232,7 +236,8 @@ pub fn identify_arm(args: &IdentifyArgs, dataset: &Path) -> Result<i32, Error> {
         }
         None => crate::identify::arm::ARM_KEYS.to_vec(),
     };
-    let space = ArmSpace::new(&start_set, &fitted, &keys, arm.fit_payload.then_some(arm.payload_max), arm.fit_offsets);
+    let joint_names: Vec<String> = model.joints.iter().map(|j| j.name.clone()).collect();
+    let space = ArmSpace::new(&start_set, &fitted, &keys, arm.fit_payload.then_some(arm.payload_max), arm.fit_offsets, arm.per_joint.then_some(joint_names.as_slice()));
     if space.is_empty() {
         return Err(Error::flag("--fit-params", "nothing left to fit"));
     }
@@ -379,7 +384,8 @@ fn write_motor_file(out: &Path, motors: &Path, model: &crate::model::Model, set:
     for (key, entry) in joints.iter_mut() {
         let Value::Table(entry) = entry else { continue };
         let servo = model.joint_index(key).and_then(|j| set.joints[j].as_ref()).and_then(|d| d.servo.as_ref());
-        match servo.and_then(|s| space.kinds.iter().position(|k| k.name == s.name)) {
+        let joint = model.joint_index(key);
+        match servo.zip(joint).and_then(|(s, j)| space.kinds.iter().position(|k| k.drives(j, &s.name))) {
             Some(k) => {
                 entry.insert("servo_params".into(), Value::String(file_of_kind[k].clone()));
             }

@@ -70,6 +70,16 @@ pub struct ServoKind {
     pub joints: Vec<usize>,
     pub start: ServoParams,
     pub space: Space,
+    /// The parameters of this one joint's servo (`--per-joint`), not of every servo of the name.
+    pub one_joint: bool,
+}
+
+impl ServoKind {
+    /// Whether the drive of joint `joint`, a servo named `servo`, takes this kind's parameters: the
+    /// kind's own joint, or every servo of its name (those left out of the fit too: the same part).
+    pub fn drives(&self, joint: usize, servo: &str) -> bool {
+        if self.one_joint { self.joints == [joint] } else { self.name == servo }
+    }
 }
 
 /// The largest calibration offset searched, rad (9°: a mid-range pose set by eye is off by a few
@@ -90,17 +100,20 @@ impl ArmSpace {
     /// The servo kinds of `motors` on the joints `fitted` (model coordinates) with their parameters
     /// `keys` (those their family has), the payload up to `payload` kg where given, and the fitted
     /// joints' offsets where asked.
-    pub fn new(motors: &MotorSet, fitted: &[usize], keys: &[&str], payload: Option<f64>, offsets: bool) -> Self {
+    /// With `per_joint` each fitted joint's servo is a kind of its own, named "SERVO JOINT"
+    /// (`joint_names` by coordinate).
+    pub fn new(motors: &MotorSet, fitted: &[usize], keys: &[&str], payload: Option<f64>, offsets: bool, per_joint: Option<&[String]>) -> Self {
         let mut kinds: Vec<ServoKind> = Vec::new();
         for &j in fitted {
             let Some(servo) = motors.joints[j].as_ref().and_then(|d| d.servo.as_ref()) else { continue };
-            match kinds.iter_mut().find(|k| k.name == servo.name) {
+            match kinds.iter_mut().find(|k| per_joint.is_none() && k.name == servo.name) {
                 Some(kind) => kind.joints.push(j),
                 None => {
                     let start = servo.params();
                     let mut space = Space::new(start.family, start.friction.model, false, false, true).only(keys);
                     around(&mut space, &start);
-                    kinds.push(ServoKind { name: servo.name.clone(), joints: vec![j], start, space });
+                    let name = per_joint.map_or_else(|| servo.name.clone(), |names| format!("{} {}", servo.name, names[j]));
+                    kinds.push(ServoKind { name, joints: vec![j], start, space, one_joint: per_joint.is_some() });
                 }
             }
         }
@@ -163,8 +176,8 @@ impl ArmObjective<'_> {
     pub fn motors(&self, params: &[ServoParams]) -> Result<MotorSet, Error> {
         let mut set = load_motor_file(self.motor_file, self.model)?;
         for (kind, p) in self.space.kinds.iter().zip(params) {
-            for d in set.joints.iter_mut().flatten() {
-                if let Some(servo) = d.servo.as_mut().filter(|s| s.name == kind.name) {
+            for (j, d) in set.joints.iter_mut().enumerate() {
+                if let Some(servo) = d.as_mut().and_then(|d| d.servo.as_mut()).filter(|s| kind.drives(j, &s.name)) {
                     servo.set_params(p);
                 }
             }
