@@ -1,11 +1,12 @@
 //! Inverse dynamics over many states at once (a trajectory's torques): the same recursions as
 //! [`rnea`](super::rnea) — world-frame kinematics, then the forward and backward passes — run on
 //! [`LANES`] states side by side, each number of the scalar algorithm a short array of one value per
-//! state. The arrays' arithmetic is written lane by lane and compiled twice: for any x86-64, and with
-//! AVX2 for the processors that have it (chosen when called), where each of its operations is one
-//! 256-bit instruction. A trajectory's states do not depend on each other, so this is the scalar
-//! algorithm's arithmetic with a quarter of the instructions; only the joints' sines and cosines are
-//! computed here (by polynomial, in the lanes) instead of by the library, one number at a time.
+//! state. A trajectory's states do not depend on each other, so each operation of the scalar
+//! algorithm becomes one 256-bit instruction for four states. The lanes' arithmetic is written lane
+//! by lane with fused multiply-adds and compiled for AVX2 and FMA, chosen when called (an x86-64
+//! without them takes the scalar algorithm; elsewhere the lanes are the target's own vectors); the
+//! joints' sines and cosines are computed here, by polynomial in the lanes, instead of by the
+//! library one number at a time.
 
 use super::{Data, rnea};
 use crate::model::{JointKind, Model};
@@ -257,8 +258,8 @@ impl RneaManyData {
 }
 
 /// Inverse dynamics of every state of a trajectory: row k of `q`, `v`, `a` (each states × dof,
-/// row-major) gives row k of `tau`, τ = M(q)·q̈ + C(q, q̇)·q̇ − τ_g(q) as [`rnea`] gives it, to
-/// the rounding of the same operations.
+/// row-major) gives row k of `tau`, τ = M(q)·q̈ + C(q, q̇)·q̇ − τ_g(q) as [`rnea`] gives it, within a
+/// few roundings (fused multiply-adds round once where the scalar algorithm rounds twice).
 pub fn rnea_many(model: &Model, data: &mut RneaManyData, q: &[f64], v: &[f64], a: &[f64], tau: &mut [f64]) {
     let n = model.dof();
     assert!(q.len() == tau.len() && v.len() == tau.len() && a.len() == tau.len() && (n == 0 || tau.len() % n == 0), "rnea_many: rows of {n} values each");
