@@ -151,6 +151,14 @@ impl RigidInertia {
         Self { mass: 0.0, com: Vector3::zeros(), inertia_com: Matrix3::zeros() }
     }
 
+    /// Whether its central inertia is diagonal (the body's frame on its principal axes, as most
+    /// URDFs' links are): rotating it then only scales the rotation's columns.
+    #[inline]
+    pub fn on_principal_axes(&self) -> bool {
+        let i = &self.inertia_com;
+        i[(0, 1)] == 0.0 && i[(0, 2)] == 0.0 && i[(1, 2)] == 0.0 && i[(1, 0)] == 0.0 && i[(2, 0)] == 0.0 && i[(2, 1)] == 0.0
+    }
+
     /// The same body seen from another frame: `pose` is this body's frame in the other frame.
     pub fn transformed(&self, pose: &Pose) -> RigidInertia {
         RigidInertia {

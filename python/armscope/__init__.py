@@ -76,9 +76,7 @@ def run(**flags) -> Run:
     written unless asked (``rrd=``, ``mcap=``, ``trace=``, ``csv=``, ``summary_json=``). The run goes
     on without the GIL; an unknown flag or a bad value raises ArmscopeError with the command line's
     line."""
-    arrays = _armscope.run(_argv(flags))
-    summary = json.loads(arrays.pop("summary_json"))
-    return Run(arrays, summary)
+    return _run(_argv(flags))
 
 
 def simulate(model, controller, **flags) -> Run:
@@ -91,9 +89,13 @@ def simulate(model, controller, **flags) -> Run:
     recordings end whole) and raises ArmscopeError with the step's time; what it raised is the
     cause."""
     urdf = model.urdf if isinstance(model, Model) else model
-    arrays = _armscope.run(_argv({"urdf": urdf, **flags}), controller)
-    summary = json.loads(arrays.pop("summary_json"))
-    return Run(arrays, summary)
+    return _run(_argv({"urdf": urdf, **flags}), controller)
+
+
+def _run(argv, controller=None) -> Run:
+    """The binding's run of ``argv`` (with ``controller`` in the PD's place where given) as a Run."""
+    arrays = _armscope.run(argv, controller)
+    return Run(arrays, json.loads(arrays.pop("summary_json")))
 
 
 class Episode:

@@ -12,9 +12,9 @@ use pyo3::types::PyDict;
 use std::path::PathBuf;
 
 /// Per coordinate, per sample → (samples, coordinates).
-fn table(per_joint: &[Vec<f64>]) -> PyResult<Array2<f64>> {
+fn table(per_joint: &[Vec<f64>]) -> Array2<f64> {
     let rows = per_joint.first().map_or(0, Vec::len);
-    Ok(Array2::from_shape_fn((rows, per_joint.len()), |(k, j)| per_joint[j][k]))
+    Array2::from_shape_fn((rows, per_joint.len()), |(k, j)| per_joint[j][k])
 }
 
 /// Every episode of `source` (or `episodes`) replayed on `urdf`: a list of dicts, one an episode.
@@ -63,11 +63,11 @@ pub fn replay<'py>(
         let d = PyDict::new(py);
         d.set_item("episode", index)?;
         d.set_item("t", m.time.clone().into_pyarray(py))?;
-        d.set_item("q", table(&m.q)?.into_pyarray(py))?;
-        d.set_item("qd", table(&m.qd)?.into_pyarray(py))?;
-        d.set_item("qdd", table(&m.qdd)?.into_pyarray(py))?;
-        d.set_item("tau", table(&m.needed)?.into_pyarray(py))?;
-        d.set_item("available", table(&replayed.available)?.into_pyarray(py))?;
+        d.set_item("q", table(&m.q).into_pyarray(py))?;
+        d.set_item("qd", table(&m.qd).into_pyarray(py))?;
+        d.set_item("qdd", table(&m.qdd).into_pyarray(py))?;
+        d.set_item("tau", table(&m.needed).into_pyarray(py))?;
+        d.set_item("available", table(&replayed.available).into_pyarray(py))?;
         d.set_item("verdicts_json", serde_json::to_string(&replayed.verdicts).map_err(crate::error)?)?;
         out.push(d);
     }

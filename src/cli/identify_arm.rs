@@ -383,9 +383,11 @@ fn write_motor_file(out: &Path, motors: &Path, model: &crate::model::Model, set:
     };
     for (key, entry) in joints.iter_mut() {
         let Value::Table(entry) = entry else { continue };
-        let servo = model.joint_index(key).and_then(|j| set.joints[j].as_ref()).and_then(|d| d.servo.as_ref());
-        let joint = model.joint_index(key);
-        match servo.zip(joint).and_then(|(s, j)| space.kinds.iter().position(|k| k.drives(j, &s.name))) {
+        let kind = model.joint_index(key).and_then(|j| {
+            let servo = set.joints[j].as_ref().and_then(|d| d.servo.as_ref())?;
+            space.kinds.iter().position(|k| k.drives(j, &servo.name))
+        });
+        match kind {
             Some(k) => {
                 entry.insert("servo_params".into(), Value::String(file_of_kind[k].clone()));
             }

@@ -30,6 +30,6 @@ pub use jacobian::frame_jacobian;
 pub use ldlt::{ldlt_in_place, ldlt_in_place_slice, ldlt_solve_in_place, ldlt_solve_slice};
 pub use ltdl::{ltdl_in_place, ltdl_solve_in_place};
 pub use kinematics::{body_poses, forward_kinematics, frame_pose, frame_pose_in};
-pub use rnea_many::{LANES, RneaManyData, rnea_many};
+pub use rnea_many::{RneaManyData, rnea_many};
 pub use solvable::check_solvable;
 pub use rnea::{bias_forces, gravity_and_bias_from_kinematics, gravity_forces, gravity_from_kinematics, rnea, rnea_from_kinematics};

@@ -14,7 +14,7 @@ use nalgebra::{Matrix3, Vector3};
 use std::ops::{Add, Mul, Neg, Sub};
 
 /// States computed side by side: four f64 fill one AVX2 register.
-pub const LANES: usize = 4;
+const LANES: usize = 4;
 
 /// One number of the algorithm, for each of the [`LANES`] states.
 #[derive(Clone, Copy, Debug, Default)]
@@ -358,7 +358,7 @@ fn body_inertia(body: &crate::spatial::RigidInertia, rotation: &M3, translation:
     // a central inertia on its principal axes (most URDFs' links) only scales R's columns, as in
     // the scalar algorithm
     let i = &body.inertia_com;
-    let ri = if i[(0, 1)] == 0.0 && i[(0, 2)] == 0.0 && i[(1, 2)] == 0.0 && i[(1, 0)] == 0.0 && i[(2, 0)] == 0.0 && i[(2, 1)] == 0.0 {
+    let ri = if body.on_principal_axes() {
         let d = [Lanes::splat(i[(0, 0)]), Lanes::splat(i[(1, 1)]), Lanes::splat(i[(2, 2)])];
         let row = |r: usize| [rotation[r][0] * d[0], rotation[r][1] * d[1], rotation[r][2] * d[2]];
         [row(0), row(1), row(2)]

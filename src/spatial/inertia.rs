@@ -46,7 +46,7 @@ impl SpatialInertia {
         // principal axes (most URDFs' links) only scales R's columns — the same numbers, as the
         // full product's other terms are exact zeros
         let i = &body.inertia_com;
-        let ri = if i[(0, 1)] == 0.0 && i[(0, 2)] == 0.0 && i[(1, 2)] == 0.0 && i[(1, 0)] == 0.0 && i[(2, 0)] == 0.0 && i[(2, 1)] == 0.0 {
+        let ri = if body.on_principal_axes() {
             Matrix3::from_columns(&[r.column(0) * i[(0, 0)], r.column(1) * i[(1, 1)], r.column(2) * i[(2, 2)]])
         } else {
             r * i
