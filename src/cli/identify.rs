@@ -9,10 +9,12 @@ use crate::testbench::{BenchLog, ReplayOptions, Step, Supply, mae};
 #[derive(Args, Debug)]
 pub struct IdentifyArgs {
     /// Training logs (BAM's JSON, processed or raw).
-    #[arg(required_unless_present = "from", conflicts_with = "from", value_name = "LOG.json")]
+    // (no `conflicts_with = "from"` here or on --actuator: clap waives an arg's `requires = "from"`
+    // once something present conflicts with --from; `identify` refuses the mix itself)
+    #[arg(required_unless_present = "from", value_name = "LOG.json")]
     pub logs: Vec<PathBuf>,
     /// The servo: xl330, xl320, mx64, mx106, sts3215.
-    #[arg(long, value_name = "NAME", required_unless_present = "from", conflicts_with = "from")]
+    #[arg(long, value_name = "NAME", required_unless_present = "from")]
     pub actuator: Option<String>,
     #[command(flatten)]
     pub arm: super::identify_arm::ArmArgs,
@@ -150,6 +152,12 @@ fn above_max_supply(family: &firmware::Family, logs: &[BenchLog], supply: Supply
 /// `armscope identify`.
 pub fn identify(args: &IdentifyArgs) -> Result<i32, Error> {
     if let Some(dataset) = &args.arm.from {
+        if let Some(log) = args.logs.first() {
+            return Err(Error::flag("--from", format!("identifies an arm from its episodes, not a servo from bench logs ({} given)", log.display())));
+        }
+        if args.actuator.is_some() {
+            return Err(Error::flag("--from", "identifies an arm from its episodes: --actuator is for a servo's bench logs"));
+        }
         return super::identify_arm::identify_arm(args, dataset);
     }
     let actuator = args.actuator.as_deref().unwrap_or_default();
