@@ -80,11 +80,9 @@ impl Recorder for Keep {
     }
 }
 
-/// The first line of a command-line parse error, without clap's `error: `.
+/// A command-line parse error as the command says it, in one line.
 pub(crate) fn parse_error(e: &clap::Error) -> String {
-    let text = e.to_string();
-    let line = text.lines().next().unwrap_or_default();
-    line.strip_prefix("error: ").unwrap_or(line).to_string()
+    armscope::cli::parse_error_line(e)
 }
 
 /// A Python controller as the loop's torque law: `controller(t, q, qd) -> tau` at every control

@@ -97,9 +97,7 @@ where
                 let _ = e.print();
                 return if e.kind() == ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand { 2 } else { 0 };
             }
-            let rendered = e.render().to_string();
-            let first = rendered.lines().find(|l| !l.trim().is_empty()).unwrap_or("invalid arguments");
-            eprintln!("armscope: {}", first.trim_start_matches("error: "));
+            eprintln!("armscope: {}", parse_error_line(&e));
             return 2;
         }
     };
@@ -110,6 +108,15 @@ where
             e.exit_code()
         }
     }
+}
+
+/// A command-line parse error as one line, without clap's `error: `: its message and the lines
+/// that complete it (the arguments a "not provided" names), not the usage and help after them.
+pub fn parse_error_line(e: &clap::Error) -> String {
+    let rendered = e.render().to_string();
+    let message: Vec<&str> = rendered.lines().skip_while(|l| l.trim().is_empty()).take_while(|l| !l.trim().is_empty()).map(str::trim).collect();
+    let line = if message.is_empty() { "invalid arguments".to_string() } else { message.join(" ") };
+    line.strip_prefix("error: ").map(str::to_string).unwrap_or(line)
 }
 
 fn run_command(command: Command) -> Result<i32, Error> {
