@@ -1,15 +1,17 @@
-//! Inverse dynamics over many states at once (a trajectory's torques): the same recursions as
-//! [`rnea`](super::rnea) — world-frame kinematics, then the forward and backward passes — run on
-//! [`LANES`] states side by side, each number of the scalar algorithm a short array of one value per
-//! state. A trajectory's states do not depend on each other, so each operation of the scalar
-//! algorithm becomes one 256-bit instruction for four states. The lanes' arithmetic is written lane
+//! Inverse dynamics over many states at once (a trajectory's torques): the recursions of
+//! [`rnea`](super::rnea) — out from the root for the bodies' motion and the forces it needs, back in
+//! for the joints' torques — written in each body's own frame, where its inertia is constant (the
+//! scalar algorithm's world frame rotates every inertia at every state), and run on
+//! [`LANES`] states side by side, each number a short array of one value per state. A trajectory's
+//! states do not depend on each other, so each operation becomes one 256-bit instruction for four
+//! states. The lanes' arithmetic is written lane
 //! by lane with fused multiply-adds and compiled for AVX2 and FMA, chosen when called (an x86-64
 //! without them takes the scalar algorithm; elsewhere the lanes are the target's own vectors); the
 //! joints' sines and cosines are computed here, by polynomial in the lanes, instead of by the
 //! library one number at a time.
 
 use super::{Data, rnea};
-use crate::model::{JointKind, Model};
+use crate::model::Model;
 use nalgebra::{Matrix3, Vector3};
 use std::ops::{Add, Mul, Neg, Sub};
 
@@ -113,12 +115,6 @@ fn mat_vec(m: &M3, v: V3) -> V3 {
     [dot(m[0], v), dot(m[1], v), dot(m[2], v)]
 }
 
-#[inline(always)]
-fn mat_mat(a: &M3, b: &M3) -> M3 {
-    let entry = |r: usize, c: usize| a[r][2].mul_add(b[2][c], a[r][1].mul_add(b[1][c], a[r][0] * b[0][c]));
-    [[entry(0, 0), entry(0, 1), entry(0, 2)], [entry(1, 0), entry(1, 1), entry(1, 2)], [entry(2, 0), entry(2, 1), entry(2, 2)]]
-}
-
 /// Beyond this many radians a lane's sine and cosine are the library's (the reduction below keeps its
 /// accuracy to about 1e8 rad; a joint is nowhere near either).
 const REDUCED_UP_TO: f64 = 1e6;
@@ -169,7 +165,7 @@ fn sin_cos(x: Lanes) -> (Lanes, Lanes) {
     (sin, cos)
 }
 
-/// A motion or force vector: angular part, linear part (world coordinates, about the origin).
+/// A motion or force vector: angular part, linear part (in a body's frame, about its origin).
 #[derive(Clone, Copy, Default)]
 struct Spatial {
     angular: V3,
@@ -182,22 +178,6 @@ impl Spatial {
         Self { angular: add(self.angular, other.angular), linear: add(self.linear, other.linear) }
     }
 
-    #[inline(always)]
-    fn times(self, s: Lanes) -> Self {
-        Self { angular: scale(self.angular, s), linear: scale(self.linear, s) }
-    }
-
-    #[inline(always)]
-    fn dot(self, other: Self) -> Lanes {
-        dot(self.angular, other.angular) + dot(self.linear, other.linear)
-    }
-
-    /// v ×ₘ m.
-    #[inline(always)]
-    fn cross_motion(self, m: Self) -> Self {
-        Self { angular: cross(self.angular, m.angular), linear: add(cross(self.angular, m.linear), cross(self.linear, m.angular)) }
-    }
-
     /// v ×* f.
     #[inline(always)]
     fn cross_force(self, f: Self) -> Self {
@@ -205,7 +185,8 @@ impl Spatial {
     }
 }
 
-/// A body's spatial inertia about the world origin (as [`SpatialInertia`](crate::spatial::SpatialInertia)).
+/// A body's spatial inertia about its own frame's origin, in its frame (as
+/// [`SpatialInertia`](crate::spatial::SpatialInertia)): constant, so made once per call.
 #[derive(Clone, Copy, Default)]
 struct Inertia {
     mass: Lanes,
@@ -215,6 +196,12 @@ struct Inertia {
 }
 
 impl Inertia {
+    /// The rigid body's inertia about its own frame's origin (SpatialInertia's numbers, in lanes).
+    fn of_body(body: &crate::spatial::RigidInertia) -> Self {
+        let about_origin = crate::spatial::SpatialInertia::of_body(body, &crate::spatial::Pose::identity());
+        Self { mass: Lanes::splat(about_origin.mass), first_moment: v3(&about_origin.first_moment), rotational: about_origin.rotational.map(Lanes::splat) }
+    }
+
     #[inline(always)]
     fn mul_motion(&self, m: Spatial) -> Spatial {
         let [xx, yy, zz, xy, xz, yz] = self.rotational;
@@ -224,14 +211,20 @@ impl Inertia {
     }
 }
 
-/// The workspace of [`rnea_many`]: per body, its lanes' world pose, motion subspace, inertia,
-/// velocity, acceleration and force. Sized once for a model.
+/// The workspace of [`rnea_many`]: per body, its lanes' pose in its parent's frame and its
+/// velocity, acceleration and force in its own frame; the bodies' inertias. Sized once for a model.
 #[derive(Clone)]
 pub struct RneaManyData {
+    /// The body frame's axes in its parent's frame (columns), E.
     rotation: Vec<M3>,
+    /// The body frame's origin in its parent's frame, r.
     translation: Vec<V3>,
-    subspace: Vec<Spatial>,
     inertia: Vec<Inertia>,
+    /// The joint's axis in the body's frame (the same as in the joint's: the joint moves along
+    /// it), times its coupling's multiplier.
+    axis: Vec<Vector3<f64>>,
+    /// The states' positions, velocities and accelerations, a coordinate at a time.
+    inputs: [Vec<Lanes>; 3],
     velocity: Vec<Spatial>,
     acceleration: Vec<Spatial>,
     force: Vec<Spatial>,
@@ -246,8 +239,9 @@ impl RneaManyData {
         Self {
             rotation: vec![M3::default(); bodies],
             translation: vec![V3::default(); bodies],
-            subspace: vec![Spatial::default(); bodies],
-            inertia: vec![Inertia::default(); bodies],
+            inertia: model.bodies.iter().map(|body| Inertia::of_body(&body.inertia)).collect(),
+            axis: model.bodies.iter().zip(&model.couplings).map(|(body, coupling)| body.axis * coupling.multiplier).collect(),
+            inputs: std::array::from_fn(|_| vec![Lanes::default(); model.dof()]),
             velocity: vec![Spatial::default(); bodies],
             acceleration: vec![Spatial::default(); bodies],
             force: vec![Spatial::default(); bodies],
@@ -259,10 +253,12 @@ impl RneaManyData {
 
 /// Inverse dynamics of every state of a trajectory: row k of `q`, `v`, `a` (each states × dof,
 /// row-major) gives row k of `tau`, τ = M(q)·q̈ + C(q, q̇)·q̇ − τ_g(q) as [`rnea`] gives it, within a
-/// few roundings (fused multiply-adds round once where the scalar algorithm rounds twice).
+/// few roundings (it works in each body's frame where [`rnea`] works in the world's, and fused
+/// multiply-adds round once where the scalar algorithm rounds twice).
 pub fn rnea_many(model: &Model, data: &mut RneaManyData, q: &[f64], v: &[f64], a: &[f64], tau: &mut [f64]) {
     let n = model.dof();
     assert!(q.len() == tau.len() && v.len() == tau.len() && a.len() == tau.len() && (n == 0 || tau.len() % n == 0), "rnea_many: rows of {n} values each");
+    assert!(data.inertia.len() == model.bodies.len(), "rnea_many: a workspace made for another model");
     if n == 0 {
         return;
     }
@@ -296,121 +292,112 @@ fn lanes_avx2(model: &Model, data: &mut RneaManyData, q: &[f64], v: &[f64], a: &
 #[inline(always)]
 fn lanes_portable(model: &Model, data: &mut RneaManyData, q: &[f64], v: &[f64], a: &[f64], tau: &mut [f64], whole: usize) {
     let n = model.dof();
-    for first in (0..whole).step_by(LANES) {
-        let at = |x: &[f64], coordinate: usize| {
-            let mut lanes = Lanes::default();
-            for k in 0..LANES {
-                lanes.0[k] = x[(first + k) * n + coordinate];
+    let group = LANES * n;
+    for (first, out) in (0..whole).step_by(LANES).zip(tau[..whole * n].chunks_exact_mut(group)) {
+        let rows = first * n..first * n + group;
+        for (lanes, x) in data.inputs.iter_mut().zip([&q[rows.clone()], &v[rows.clone()], &a[rows]]) {
+            for (k, row) in x.chunks_exact(n).enumerate() {
+                for (coordinate, value) in lanes.iter_mut().zip(row) {
+                    coordinate.0[k] = *value;
+                }
             }
-            lanes
-        };
-        forward_kinematics(model, data, |c| at(q, c));
-        passes(model, data, |c| at(v, c), |c| at(a, c));
-        for (c, t) in data.tau.iter().enumerate() {
-            for k in 0..LANES {
-                tau[(first + k) * n + c] = t.0[k];
+        }
+        forward_pass(model, data);
+        backward_pass(model, data);
+        for (k, row) in out.chunks_exact_mut(n).enumerate() {
+            for (value, coordinate) in row.iter_mut().zip(&data.tau) {
+                *value = coordinate.0[k];
             }
         }
     }
 }
 
-/// [`forward_kinematics`](super::forward_kinematics) on the lanes: world poses, motion subspaces
-/// and inertias.
+/// Eᵀ·x: a vector of the parent's frame in the body's.
 #[inline(always)]
-fn forward_kinematics(model: &Model, data: &mut RneaManyData, q: impl Fn(usize) -> Lanes) {
+fn to_body(e: &M3, x: V3) -> V3 {
+    let column = |c: usize| e[2][c].mul_add(x[2], e[1][c].mul_add(x[1], e[0][c] * x[0]));
+    [column(0), column(1), column(2)]
+}
+
+/// A motion of the parent's frame (about its origin) in the body's frame (about the body's origin
+/// r): ω' = Eᵀ·ω, v' = Eᵀ·(v + ω × r).
+#[inline(always)]
+fn motion_to_body(e: &M3, r: V3, m: Spatial) -> Spatial {
+    Spatial { angular: to_body(e, m.angular), linear: to_body(e, add(m.linear, cross(m.angular, r))) }
+}
+
+/// A force of the body's frame in its parent's: F = E·f, N = E·n + r × F.
+#[inline(always)]
+fn force_to_parent(e: &M3, r: V3, f: Spatial) -> Spatial {
+    let linear = mat_vec(e, f.linear);
+    Spatial { angular: add(mat_vec(e, f.angular), cross(r, linear)), linear }
+}
+
+/// The recursion from the root out: each body's pose in its parent, and its velocity,
+/// acceleration (gravity as the world's upward acceleration) and the force its motion needs, all
+/// in its own frame.
+#[inline(always)]
+fn forward_pass(model: &Model, data: &mut RneaManyData) {
+    let [q, v, a] = &data.inputs;
+    let gravity = Spatial { angular: V3::default(), linear: v3(&-model.gravity) };
     for i in 0..model.bodies.len() {
         let (joint, coupling, motion) = (&model.bodies[i], &model.couplings[i], &model.motions[i]);
-        let coordinate = q(coupling.coordinate);
-        let position = Lanes::splat(coupling.multiplier) * coordinate + Lanes::splat(coupling.offset);
-        let (local_rotation, local_translation) = if motion.prismatic {
+        let position = Lanes::splat(coupling.multiplier).mul_add(q[coupling.coordinate], Lanes::splat(coupling.offset));
+        let (rotation, translation) = if motion.prismatic {
             (m3(&motion.fixed), add(v3(&motion.origin), scale(v3(&motion.axis), position)))
         } else {
             let (sin, cos) = sin_cos(position);
             let (fixed, cosine, sine) = (m3(&motion.fixed), m3(&motion.cosine), m3(&motion.sine));
             let entry = |r: usize, c: usize| sine[r][c].mul_add(sin, cosine[r][c].mul_add(cos, fixed[r][c]));
-            let rotation = [[entry(0, 0), entry(0, 1), entry(0, 2)], [entry(1, 0), entry(1, 1), entry(1, 2)], [entry(2, 0), entry(2, 1), entry(2, 2)]];
-            (rotation, v3(&motion.origin))
+            ([[entry(0, 0), entry(0, 1), entry(0, 2)], [entry(1, 0), entry(1, 1), entry(1, 2)], [entry(2, 0), entry(2, 1), entry(2, 2)]], v3(&motion.origin))
         };
-        let (rotation, translation, axis) = match joint.parent {
-            Some(p) => {
-                let parent = &data.rotation[p];
-                (mat_mat(parent, &local_rotation), add(data.translation[p], mat_vec(parent, local_translation)), mat_vec(parent, v3(&motion.axis)))
-            }
-            None => (local_rotation, local_translation, v3(&motion.axis)),
+        let (v_parent, a_parent) = match joint.parent {
+            Some(p) => (motion_to_body(&rotation, translation, data.velocity[p]), motion_to_body(&rotation, translation, data.acceleration[p])),
+            None => (Spatial::default(), motion_to_body(&rotation, translation, gravity)),
         };
-        let subspace = match joint.kind {
-            JointKind::Revolute | JointKind::Continuous => Spatial { angular: axis, linear: cross(translation, axis) },
-            JointKind::Prismatic => Spatial { angular: V3::default(), linear: axis },
+        let axis = v3(&data.axis[i]);
+        let (vc, ac) = (v[coupling.coordinate], a[coupling.coordinate]);
+        let (velocity, acceleration) = if motion.prismatic {
+            let joint_velocity = scale(axis, vc);
+            let velocity = Spatial { angular: v_parent.angular, linear: add(v_parent.linear, joint_velocity) };
+            // v ×ₘ (0, s·q̇) = (0, ω × s·q̇)
+            let linear = add(add(a_parent.linear, scale(axis, ac)), cross(velocity.angular, joint_velocity));
+            (velocity, Spatial { angular: a_parent.angular, linear })
+        } else {
+            let joint_velocity = scale(axis, vc);
+            let velocity = Spatial { angular: add(v_parent.angular, joint_velocity), linear: v_parent.linear };
+            // v ×ₘ (s·q̇, 0) = (ω × s·q̇, v × s·q̇)
+            let angular = add(add(a_parent.angular, scale(axis, ac)), cross(velocity.angular, joint_velocity));
+            let linear = add(a_parent.linear, cross(velocity.linear, joint_velocity));
+            (velocity, Spatial { angular, linear })
         };
-        data.subspace[i] = subspace.times(Lanes::splat(coupling.multiplier));
-        data.inertia[i] = body_inertia(&joint.inertia, &rotation, translation);
+        let inertia = &data.inertia[i];
+        data.force[i] = inertia.mul_motion(acceleration).plus(velocity.cross_force(inertia.mul_motion(velocity)));
+        data.velocity[i] = velocity;
+        data.acceleration[i] = acceleration;
         data.rotation[i] = rotation;
         data.translation[i] = translation;
     }
 }
 
-/// [`SpatialInertia::of_body`](crate::spatial::SpatialInertia::of_body) on the lanes.
+/// The recursion from the leaves in: each joint's torque, the body's force carried to its parent;
+/// then the motors' rotors (J_r·N²·q̈), into `data.tau`.
 #[inline(always)]
-fn body_inertia(body: &crate::spatial::RigidInertia, rotation: &M3, translation: V3) -> Inertia {
-    let m = Lanes::splat(body.mass);
-    let c = add(mat_vec(rotation, v3(&body.com)), translation);
-    let h = scale(c, m);
-    // a central inertia on its principal axes (most URDFs' links) only scales R's columns, as in
-    // the scalar algorithm
-    let i = &body.inertia_com;
-    let ri = if body.on_principal_axes() {
-        let d = [Lanes::splat(i[(0, 0)]), Lanes::splat(i[(1, 1)]), Lanes::splat(i[(2, 2)])];
-        let row = |r: usize| [rotation[r][0] * d[0], rotation[r][1] * d[1], rotation[r][2] * d[2]];
-        [row(0), row(1), row(2)]
-    } else {
-        mat_mat(rotation, &m3(i))
-    };
-    let entry = |a: usize, b: usize| dot(ri[a], rotation[b]);
-    Inertia {
-        mass: m,
-        first_moment: h,
-        rotational: [
-            entry(0, 0) + (h[1] * c[1] + h[2] * c[2]),
-            entry(1, 1) + (h[0] * c[0] + h[2] * c[2]),
-            entry(2, 2) + (h[0] * c[0] + h[1] * c[1]),
-            entry(0, 1) - h[0] * c[1],
-            entry(0, 2) - h[0] * c[2],
-            entry(1, 2) - h[1] * c[2],
-        ],
-    }
-}
-
-/// [`rnea_from_kinematics`](super::rnea_from_kinematics) on the lanes, into `data.tau`.
-#[inline(always)]
-fn passes(model: &Model, data: &mut RneaManyData, v: impl Fn(usize) -> Lanes, a: impl Fn(usize) -> Lanes) {
-    let gravity = Spatial { angular: V3::default(), linear: v3(&-model.gravity) };
-    for i in 0..model.bodies.len() {
-        let (joint, coupling) = (&model.bodies[i], &model.couplings[i]);
-        let s = data.subspace[i];
-        let (v_parent, a_parent) = match joint.parent {
-            Some(p) => (data.velocity[p], data.acceleration[p]),
-            None => (Spatial::default(), gravity),
-        };
-        let (vc, ac) = (v(coupling.coordinate), a(coupling.coordinate));
-        let joint_velocity = s.times(vc);
-        let velocity = v_parent.plus(joint_velocity);
-        let acceleration = a_parent.plus(s.times(ac)).plus(velocity.cross_motion(joint_velocity));
-        let inertia = &data.inertia[i];
-        data.force[i] = inertia.mul_motion(acceleration).plus(velocity.cross_force(inertia.mul_motion(velocity)));
-        data.velocity[i] = velocity;
-        data.acceleration[i] = acceleration;
-    }
+fn backward_pass(model: &Model, data: &mut RneaManyData) {
     data.tau.fill(Lanes::default());
     for i in (0..model.bodies.len()).rev() {
-        let (joint, coupling) = (&model.bodies[i], &model.couplings[i]);
+        let (joint, coupling, motion) = (&model.bodies[i], &model.couplings[i], &model.motions[i]);
         let c = coupling.coordinate;
-        data.tau[c] = data.tau[c] + data.subspace[i].dot(data.force[i]);
+        let axis = v3(&data.axis[i]);
+        let force = data.force[i];
+        let along = if motion.prismatic { force.linear } else { force.angular };
+        data.tau[c] = data.tau[c] + dot(axis, along);
         if let Some(p) = joint.parent {
-            data.force[p] = data.force[p].plus(data.force[i]);
+            data.force[p] = data.force[p].plus(force_to_parent(&data.rotation[i], data.translation[i], force));
         }
     }
     for (c, armature) in model.armature.iter().enumerate() {
-        data.tau[c] = data.tau[c] + Lanes::splat(*armature) * a(c);
+        data.tau[c] = data.tau[c] + Lanes::splat(*armature) * data.inputs[2][c];
     }
 }
 
@@ -447,8 +434,8 @@ mod tests {
         assert!(worst <= 4.5e-16, "largest difference from the library's: {worst:e}");
     }
 
-    /// Every state's torques are the scalar RNEA's: the same operations on the same numbers, so
-    /// within a few roundings (1e-12 of the largest torque), on a 6-joint chain, a branched tree
+    /// Every state's torques are the scalar RNEA's: the same dynamics in the bodies' frames instead
+    /// of the world's, so within a few roundings (1e-12 of the largest torque), on a 6-joint chain, a branched tree
     /// with prismatic joints (Tiago) and one with mimic joints (Baxter), over a count of states that
     /// leaves a remainder for the scalar path.
     #[test]

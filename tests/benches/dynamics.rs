@@ -33,35 +33,38 @@ fn algorithms(c: &mut Criterion) {
     c.bench_function("aba", |b| b.iter(|| black_box(aba(&model, &mut data, black_box(&q), black_box(&v), black_box(&tau))[0])));
 }
 
-/// A trajectory's inverse dynamics, 1000 states of the box model: `rnea_many` (four states in SIMD
-/// lanes) against a loop of `rnea`.
+/// A trajectory's inverse dynamics, 1000 states of the box model and of the SO-101 (six joints):
+/// `rnea_many` (four states in SIMD lanes) against a loop of `rnea`.
 fn trajectory(c: &mut Criterion) {
-    let model = load_urdf(&urdf()).unwrap();
-    let n = model.dof();
-    let states = 1000;
-    let wave = |i: usize, f: f64| (i as f64 * f).sin();
-    let q: Vec<f64> = (0..states * n).map(|i| wave(i, 0.37)).collect();
-    let v: Vec<f64> = (0..states * n).map(|i| 2.0 * wave(i, 0.71)).collect();
-    let a: Vec<f64> = (0..states * n).map(|i| 5.0 * wave(i, 1.13)).collect();
-    let mut tau = vec![0.0; states * n];
+    let so101 = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/robots/so101.urdf");
     let mut group = c.benchmark_group("trajectory_1000_states");
-    let mut many = RneaManyData::new(&model);
-    group.bench_function("rnea_many", |b| {
-        b.iter(|| {
-            rnea_many(&model, &mut many, black_box(&q), black_box(&v), black_box(&a), &mut tau);
-            black_box(tau[0])
-        })
-    });
-    let mut data = Data::new(&model);
-    group.bench_function("rnea_loop", |b| {
-        b.iter(|| {
-            for k in 0..states {
-                let row = k * n..(k + 1) * n;
-                tau[row.clone()].copy_from_slice(rnea(&model, &mut data, black_box(&q[row.clone()]), black_box(&v[row.clone()]), black_box(&a[row])));
-            }
-            black_box(tau[0])
-        })
-    });
+    for (robot, path) in [("box", urdf()), ("so101", so101)] {
+        let model = load_urdf(&path).unwrap();
+        let n = model.dof();
+        let states = 1000;
+        let wave = |i: usize, f: f64| (i as f64 * f).sin();
+        let q: Vec<f64> = (0..states * n).map(|i| wave(i, 0.37)).collect();
+        let v: Vec<f64> = (0..states * n).map(|i| 2.0 * wave(i, 0.71)).collect();
+        let a: Vec<f64> = (0..states * n).map(|i| 5.0 * wave(i, 1.13)).collect();
+        let mut tau = vec![0.0; states * n];
+        let mut many = RneaManyData::new(&model);
+        group.bench_function(format!("rnea_many/{robot}"), |b| {
+            b.iter(|| {
+                rnea_many(&model, &mut many, black_box(&q), black_box(&v), black_box(&a), &mut tau);
+                black_box(tau[0])
+            })
+        });
+        let mut data = Data::new(&model);
+        group.bench_function(format!("rnea_loop/{robot}"), |b| {
+            b.iter(|| {
+                for k in 0..states {
+                    let row = k * n..(k + 1) * n;
+                    tau[row.clone()].copy_from_slice(rnea(&model, &mut data, black_box(&q[row.clone()]), black_box(&v[row.clone()]), black_box(&a[row])));
+                }
+                black_box(tau[0])
+            })
+        });
+    }
     group.finish();
 }
 
