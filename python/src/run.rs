@@ -80,11 +80,6 @@ impl Recorder for Keep {
     }
 }
 
-/// A command-line parse error as the command says it, in one line.
-pub(crate) fn parse_error(e: &clap::Error) -> String {
-    armscope::cli::parse_error_line(e)
-}
-
 /// A Python controller as the loop's torque law: `controller(t, q, qd) -> tau` at every control
 /// step (NumPy in and out). What it raises is kept for the caller and stops the run.
 struct PythonLaw {
@@ -140,7 +135,7 @@ impl TorqueLaw for PythonLaw {
 #[pyfunction]
 #[pyo3(signature = (argv, controller = None))]
 pub fn run<'py>(py: Python<'py>, argv: Vec<String>, controller: Option<Py<PyAny>>) -> PyResult<Bound<'py, PyDict>> {
-    let call = RunCall::try_parse_from(&argv).map_err(|e| crate::error(format!("run: {}", parse_error(&e))))?;
+    let call = RunCall::try_parse_from(&argv).map_err(|e| crate::error(format!("run: {}", armscope::cli::parse_error_line(&e))))?;
     let args = call.args;
     let experiment = armscope::experiment::Experiment::prepare(args.config()).map_err(crate::error)?;
     let warnings = py.import("warnings")?;

@@ -30,7 +30,7 @@ fn scratch() -> PyResult<tempfile::TempDir> {
 pub fn size(py: Python<'_>, argv: Vec<String>) -> PyResult<String> {
     // `--out` has a default: whether the caller gave one is in the arguments
     let given = argv.iter().any(|a| a == "--out" || a.starts_with("--out="));
-    let mut call = SizeCall::try_parse_from(&argv).map_err(|e| crate::error(format!("size: {}", crate::run::parse_error(&e))))?;
+    let mut call = SizeCall::try_parse_from(&argv).map_err(|e| crate::error(format!("size: {}", armscope::cli::parse_error_line(&e))))?;
     let folder = if given { None } else { Some(scratch()?) };
     if let Some(f) = &folder {
         call.args.out = f.path().to_path_buf();
@@ -43,7 +43,7 @@ pub fn size(py: Python<'_>, argv: Vec<String>) -> PyResult<String> {
 /// experiments in it with their errors (to `--out`, else to a scratch folder).
 #[pyfunction]
 pub fn batch(py: Python<'_>, argv: Vec<String>) -> PyResult<String> {
-    let mut call = BatchCall::try_parse_from(&argv).map_err(|e| crate::error(format!("batch: {}", crate::run::parse_error(&e))))?;
+    let mut call = BatchCall::try_parse_from(&argv).map_err(|e| crate::error(format!("batch: {}", armscope::cli::parse_error_line(&e))))?;
     if call.args.action.is_some() {
         return Err(crate::error("batch: merge is the command's (`armscope batch merge DIR…`)"));
     }

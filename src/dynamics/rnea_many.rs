@@ -186,7 +186,7 @@ impl Spatial {
 }
 
 /// A body's spatial inertia about its own frame's origin, in its frame (as
-/// [`SpatialInertia`](crate::spatial::SpatialInertia)): constant, so made once per call.
+/// [`SpatialInertia`](crate::spatial::SpatialInertia)): constant, so made once with the workspace.
 #[derive(Clone, Copy, Default)]
 struct Inertia {
     mass: Lanes,
@@ -357,14 +357,13 @@ fn forward_pass(model: &Model, data: &mut RneaManyData) {
         };
         let axis = v3(&data.axis[i]);
         let (vc, ac) = (v[coupling.coordinate], a[coupling.coordinate]);
+        let joint_velocity = scale(axis, vc);
         let (velocity, acceleration) = if motion.prismatic {
-            let joint_velocity = scale(axis, vc);
             let velocity = Spatial { angular: v_parent.angular, linear: add(v_parent.linear, joint_velocity) };
             // v ×ₘ (0, s·q̇) = (0, ω × s·q̇)
             let linear = add(add(a_parent.linear, scale(axis, ac)), cross(velocity.angular, joint_velocity));
             (velocity, Spatial { angular: a_parent.angular, linear })
         } else {
-            let joint_velocity = scale(axis, vc);
             let velocity = Spatial { angular: add(v_parent.angular, joint_velocity), linear: v_parent.linear };
             // v ×ₘ (s·q̇, 0) = (ω × s·q̇, v × s·q̇)
             let angular = add(add(a_parent.angular, scale(axis, ac)), cross(velocity.angular, joint_velocity));
