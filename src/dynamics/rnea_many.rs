@@ -11,7 +11,7 @@
 //! library one number at a time.
 
 use super::{Data, rnea};
-use crate::model::Model;
+use crate::model::{JointMotion, Model};
 use nalgebra::{Matrix3, Vector3};
 use std::ops::{Add, Mul, Neg, Sub};
 
@@ -27,6 +27,16 @@ impl Lanes {
     #[inline(always)]
     fn splat(x: f64) -> Self {
         Self([x; LANES])
+    }
+
+    /// c − self·b, rounded once (one FMA instruction on all lanes).
+    #[inline(always)]
+    fn neg_mul_add(self, b: Self, c: Self) -> Self {
+        let mut out = [0.0; LANES];
+        for k in 0..LANES {
+            out[k] = (-self.0[k]).mul_add(b.0[k], c.0[k]);
+        }
+        Self(out)
     }
 
     /// self·b + c, rounded once (one FMA instruction on all lanes).
@@ -91,11 +101,6 @@ fn add(a: V3, b: V3) -> V3 {
 }
 
 #[inline(always)]
-fn sub(a: V3, b: V3) -> V3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-#[inline(always)]
 fn scale(a: V3, s: Lanes) -> V3 {
     [a[0] * s, a[1] * s, a[2] * s]
 }
@@ -103,6 +108,20 @@ fn scale(a: V3, s: Lanes) -> V3 {
 #[inline(always)]
 fn cross(a: V3, b: V3) -> V3 {
     [a[1].mul_add(b[2], -(a[2] * b[1])), a[2].mul_add(b[0], -(a[0] * b[2])), a[0].mul_add(b[1], -(a[1] * b[0]))]
+}
+
+/// base + a × b, each component two fused multiply-adds (the sums of this algorithm are folded
+/// into its products so: fewer instructions and fewer numbers waiting in registers).
+#[inline(always)]
+fn cross_add(a: V3, b: V3, base: V3) -> V3 {
+    [a[1].mul_add(b[2], a[2].neg_mul_add(b[1], base[0])), a[2].mul_add(b[0], a[0].neg_mul_add(b[2], base[1])), a[0].mul_add(b[1], a[1].neg_mul_add(b[0], base[2]))]
+}
+
+/// base + m·v.
+#[inline(always)]
+fn mat_vec_add(m: &M3, v: V3, base: V3) -> V3 {
+    let row = |r: usize| m[r][2].mul_add(v[2], m[r][1].mul_add(v[1], m[r][0].mul_add(v[0], base[r])));
+    [row(0), row(1), row(2)]
 }
 
 #[inline(always)]
@@ -173,15 +192,10 @@ struct Spatial {
 }
 
 impl Spatial {
+    /// base + v ×* f (v = self, a motion; f a force).
     #[inline(always)]
-    fn plus(self, other: Self) -> Self {
-        Self { angular: add(self.angular, other.angular), linear: add(self.linear, other.linear) }
-    }
-
-    /// v ×* f.
-    #[inline(always)]
-    fn cross_force(self, f: Self) -> Self {
-        Self { angular: add(cross(self.angular, f.angular), cross(self.linear, f.linear)), linear: cross(self.angular, f.linear) }
+    fn cross_force_add(self, f: Self, base: Self) -> Self {
+        Self { angular: cross_add(self.linear, f.linear, cross_add(self.angular, f.angular, base.angular)), linear: cross_add(self.angular, f.linear, base.linear) }
     }
 }
 
@@ -207,46 +221,224 @@ impl Inertia {
         let [xx, yy, zz, xy, xz, yz] = self.rotational;
         let w = m.angular;
         let rotational = [dot([xx, xy, xz], w), dot([xy, yy, yz], w), dot([xz, yz, zz], w)];
-        Spatial { angular: add(rotational, cross(self.first_moment, m.linear)), linear: sub(scale(m.linear, self.mass), cross(self.first_moment, w)) }
+        // (I_o·ω + c × v, m·v − c × ω)
+        Spatial { angular: cross_add(self.first_moment, m.linear, rotational), linear: cross_add(w, self.first_moment, scale(m.linear, self.mass)) }
     }
 }
 
-/// The workspace of [`rnea_many`]: per body, its lanes' pose in its parent's frame and its
-/// velocity, acceleration and force in its own frame; the bodies' inertias. Sized once for a model.
+/// How a joint's axis enters the recursions, chosen per body when the workspace is made: most
+/// URDFs' joints turn about an axis of their own frame (x, y or z, either sign), whose products
+/// with the axis are a single lane each and whose pose keeps one column fixed; the rest take the
+/// general form.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum JointAxisKind {
+    /// A revolute joint about its frame's axis `index` (the body's `axis` is zero off it).
+    Coordinate { index: usize },
+    /// A revolute joint about any other axis.
+    General,
+    Prismatic,
+}
+
+impl JointAxisKind {
+    /// The kind of the joint moving along `axis` (in its body's frame, times its coupling's
+    /// multiplier) as `motion`: a coordinate axis only where the numbers say so exactly (the
+    /// axis's other components zero, the pose's fixed part zero off that column and its cosine and
+    /// sine parts zero on it), so that the shortened products are the general ones.
+    fn of(axis: &Vector3<f64>, motion: &JointMotion) -> Self {
+        if motion.prismatic {
+            return Self::Prismatic;
+        }
+        let along = |k: usize| {
+            (0..3).all(|j| j == k || axis[j] == 0.0)
+                && axis[k] != 0.0
+                && (0..3).all(|r| motion.cosine[(r, k)] == 0.0 && motion.sine[(r, k)] == 0.0 && (0..3).all(|c| c == k || motion.fixed[(r, c)] == 0.0))
+        };
+        match (0..3).find(|&k| along(k)) {
+            Some(index) => Self::Coordinate { index },
+            None => Self::General,
+        }
+    }
+}
+
+/// One body's constants, each number as lanes (so the arithmetic reads them straight from
+/// memory), made once with the workspace.
+#[derive(Clone, Copy)]
+struct BodyLanes {
+    parent: Option<usize>,
+    /// The coordinate moving the joint: its position is multiplier·q + offset.
+    coordinate: usize,
+    multiplier: Lanes,
+    offset: Lanes,
+    kind: JointAxisKind,
+    /// The joint's axis in the body's frame (the same as in the joint's: the joint moves along
+    /// it), times its coupling's multiplier.
+    axis: V3,
+    /// The body frame's axes in its parent's, E = fixed + cos·C + sin·S (a prismatic joint's:
+    /// fixed).
+    fixed: M3,
+    cosine: M3,
+    sine: M3,
+    /// The joint frame's origin in the parent's frame, and a prismatic joint's direction there:
+    /// the body frame's origin is origin + slide·position.
+    origin: V3,
+    slide: V3,
+    inertia: Inertia,
+}
+
+impl BodyLanes {
+    fn new(model: &Model, i: usize) -> Self {
+        let (body, coupling, motion) = (&model.bodies[i], &model.couplings[i], &model.motions[i]);
+        let axis = body.axis * coupling.multiplier;
+        Self {
+            parent: body.parent,
+            coordinate: coupling.coordinate,
+            multiplier: Lanes::splat(coupling.multiplier),
+            offset: Lanes::splat(coupling.offset),
+            kind: JointAxisKind::of(&axis, motion),
+            axis: v3(&axis),
+            fixed: m3(&motion.fixed),
+            cosine: m3(&motion.cosine),
+            sine: m3(&motion.sine),
+            origin: v3(&motion.origin),
+            slide: v3(&motion.axis),
+            inertia: Inertia::of_body(&body.inertia),
+        }
+    }
+}
+
+/// A revolute joint's axis in the lanes' arithmetic: its products with a joint rate, and the
+/// part of the joint's pose its angle turns.
+trait JointAxis: Copy {
+    /// The axis times a joint rate, in the form the products below take.
+    type Along: Copy;
+    fn along(self, rate: Lanes) -> Self::Along;
+    /// base + along.
+    fn plus(self, base: V3, along: Self::Along) -> V3;
+    /// base + w × along.
+    fn plus_cross(self, base: V3, w: V3, along: Self::Along) -> V3;
+    /// The entries of E = fixed + cos·C + sin·S that the angle changes (the others were set
+    /// with the workspace).
+    fn turn(body: &BodyLanes, sin: Lanes, cos: Lanes, rotation: &mut M3);
+}
+
+/// A revolute joint about its frame's axis `K` (0, 1, 2: x, y, z), times `scale`.
+#[derive(Clone, Copy)]
+struct CoordinateAxis<const K: usize> {
+    scale: Lanes,
+}
+
+impl<const K: usize> JointAxis for CoordinateAxis<K> {
+    type Along = Lanes;
+
+    #[inline(always)]
+    fn along(self, rate: Lanes) -> Lanes {
+        self.scale * rate
+    }
+
+    #[inline(always)]
+    fn plus(self, mut base: V3, along: Lanes) -> V3 {
+        base[K] = base[K] + along;
+        base
+    }
+
+    /// w × e_K·x = (w_j·x, −w_i·x) on the other two axes (i, j, K in cyclic order), 0 on K.
+    #[inline(always)]
+    fn plus_cross(self, mut base: V3, w: V3, along: Lanes) -> V3 {
+        let (i, j) = ((K + 1) % 3, (K + 2) % 3);
+        base[i] = w[j].mul_add(along, base[i]);
+        base[j] = w[i].neg_mul_add(along, base[j]);
+        base
+    }
+
+    /// All but column K (the fixed part's alone: see [`JointAxisKind::of`]).
+    #[inline(always)]
+    fn turn(body: &BodyLanes, sin: Lanes, cos: Lanes, rotation: &mut M3) {
+        for r in 0..3 {
+            for c in [(K + 1) % 3, (K + 2) % 3] {
+                rotation[r][c] = body.sine[r][c].mul_add(sin, body.cosine[r][c] * cos);
+            }
+        }
+    }
+}
+
+/// A revolute joint about any axis (in its body's frame, times its coupling's multiplier).
+#[derive(Clone, Copy)]
+struct GeneralAxis(V3);
+
+impl JointAxis for GeneralAxis {
+    type Along = V3;
+
+    #[inline(always)]
+    fn along(self, rate: Lanes) -> V3 {
+        scale(self.0, rate)
+    }
+
+    #[inline(always)]
+    fn plus(self, base: V3, along: V3) -> V3 {
+        add(base, along)
+    }
+
+    #[inline(always)]
+    fn plus_cross(self, base: V3, w: V3, along: V3) -> V3 {
+        add(base, cross(w, along))
+    }
+
+    #[inline(always)]
+    fn turn(body: &BodyLanes, sin: Lanes, cos: Lanes, rotation: &mut M3) {
+        for r in 0..3 {
+            for c in 0..3 {
+                rotation[r][c] = body.sine[r][c].mul_add(sin, body.cosine[r][c].mul_add(cos, body.fixed[r][c]));
+            }
+        }
+    }
+}
+
+/// The workspace of [`rnea_many`]: the bodies' constants in lanes; per body, its lanes' pose in
+/// its parent's frame and its velocity, acceleration and force in its own frame. Sized once for a
+/// model.
 #[derive(Clone)]
 pub struct RneaManyData {
+    bodies: Vec<BodyLanes>,
     /// The body frame's axes in its parent's frame (columns), E.
     rotation: Vec<M3>,
     /// The body frame's origin in its parent's frame, r.
     translation: Vec<V3>,
-    inertia: Vec<Inertia>,
-    /// The joint's axis in the body's frame (the same as in the joint's: the joint moves along
-    /// it), times its coupling's multiplier.
-    axis: Vec<Vector3<f64>>,
     /// The states' positions, velocities and accelerations, a coordinate at a time.
     inputs: [Vec<Lanes>; 3],
     velocity: Vec<Spatial>,
     acceleration: Vec<Spatial>,
     force: Vec<Spatial>,
+    /// Per coordinate, its motor's rotor inertia seen at the joint, J_r·N².
+    armature: Vec<Lanes>,
     tau: Vec<Lanes>,
     /// The states left over when the count is not a multiple of [`LANES`], one at a time.
     scalar: Data,
+    /// The world's acceleration upward (the negated gravity), in the world's frame.
+    lift: Spatial,
 }
 
 impl RneaManyData {
     pub fn new(model: &Model) -> Self {
-        let bodies = model.bodies.len();
+        let bodies: Vec<BodyLanes> = (0..model.bodies.len()).map(|i| BodyLanes::new(model, i)).collect();
+        // what the angles never change: a coordinate joint's fixed column, a prismatic joint's
+        // rotation and a revolute joint's origin
+        let rotation = bodies.iter().map(|body| match body.kind {
+            JointAxisKind::Coordinate { index } => std::array::from_fn(|r| std::array::from_fn(|c| if c == index { body.fixed[r][c] } else { Lanes::default() })),
+            JointAxisKind::General => M3::default(),
+            JointAxisKind::Prismatic => body.fixed,
+        });
         Self {
-            rotation: vec![M3::default(); bodies],
-            translation: vec![V3::default(); bodies],
-            inertia: model.bodies.iter().map(|body| Inertia::of_body(&body.inertia)).collect(),
-            axis: model.bodies.iter().zip(&model.couplings).map(|(body, coupling)| body.axis * coupling.multiplier).collect(),
+            rotation: rotation.collect(),
+            translation: bodies.iter().map(|body| body.origin).collect(),
+            bodies,
             inputs: std::array::from_fn(|_| vec![Lanes::default(); model.dof()]),
-            velocity: vec![Spatial::default(); bodies],
-            acceleration: vec![Spatial::default(); bodies],
-            force: vec![Spatial::default(); bodies],
+            velocity: vec![Spatial::default(); model.bodies.len()],
+            acceleration: vec![Spatial::default(); model.bodies.len()],
+            force: vec![Spatial::default(); model.bodies.len()],
+            armature: model.armature.iter().map(|&j| Lanes::splat(j)).collect(),
             tau: vec![Lanes::default(); model.dof()],
             scalar: Data::new(model),
+            lift: Spatial { angular: V3::default(), linear: v3(&-model.gravity) },
         }
     }
 }
@@ -258,7 +450,7 @@ impl RneaManyData {
 pub fn rnea_many(model: &Model, data: &mut RneaManyData, q: &[f64], v: &[f64], a: &[f64], tau: &mut [f64]) {
     let n = model.dof();
     assert!(q.len() == tau.len() && v.len() == tau.len() && a.len() == tau.len() && (n == 0 || tau.len() % n == 0), "rnea_many: rows of {n} values each");
-    assert!(data.inertia.len() == model.bodies.len(), "rnea_many: a workspace made for another model");
+    assert!(data.bodies.len() == model.bodies.len() && data.tau.len() == n, "rnea_many: a workspace made for another model");
     if n == 0 {
         return;
     }
@@ -269,13 +461,13 @@ pub fn rnea_many(model: &Model, data: &mut RneaManyData, q: &[f64], v: &[f64], a
     #[cfg(target_arch = "x86_64")]
     let whole = if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
         // SAFETY: the processor has AVX2 and FMA (checked just above)
-        unsafe { lanes_avx2(model, data, q, v, a, tau, whole) };
+        unsafe { lanes_avx2(data, q, v, a, tau, whole) };
         whole
     } else {
         0
     };
     #[cfg(not(target_arch = "x86_64"))]
-    lanes_portable(model, data, q, v, a, tau, whole);
+    lanes_portable(data, q, v, a, tau, whole);
     for k in whole..states {
         let row = k * n..(k + 1) * n;
         tau[row.clone()].copy_from_slice(rnea(model, &mut data.scalar, &q[row.clone()], &v[row.clone()], &a[row]));
@@ -284,29 +476,33 @@ pub fn rnea_many(model: &Model, data: &mut RneaManyData, q: &[f64], v: &[f64], a
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-fn lanes_avx2(model: &Model, data: &mut RneaManyData, q: &[f64], v: &[f64], a: &[f64], tau: &mut [f64], whole: usize) {
-    lanes_portable(model, data, q, v, a, tau, whole);
+fn lanes_avx2(data: &mut RneaManyData, q: &[f64], v: &[f64], a: &[f64], tau: &mut [f64], whole: usize) {
+    lanes_portable(data, q, v, a, tau, whole);
 }
 
-/// The first `whole` states (a multiple of [`LANES`]), [`LANES`] at a time.
+/// The first `whole` states (a multiple of [`LANES`]), [`LANES`] at a time: the bodies' poses,
+/// then their motion out from the root, the forces it needs, and the torques back in, each pass a
+/// loop of its own (each loop's numbers fit the registers better than one loop doing all).
 #[inline(always)]
-fn lanes_portable(model: &Model, data: &mut RneaManyData, q: &[f64], v: &[f64], a: &[f64], tau: &mut [f64], whole: usize) {
-    let n = model.dof();
+fn lanes_portable(data: &mut RneaManyData, q: &[f64], v: &[f64], a: &[f64], tau: &mut [f64], whole: usize) {
+    let RneaManyData { bodies, rotation, translation, inputs, velocity, acceleration, force, armature, tau: torque, lift, .. } = data;
+    let n = torque.len();
     let group = LANES * n;
     for (first, out) in (0..whole).step_by(LANES).zip(tau[..whole * n].chunks_exact_mut(group)) {
         let rows = first * n..first * n + group;
-        for (lanes, x) in data.inputs.iter_mut().zip([&q[rows.clone()], &v[rows.clone()], &a[rows]]) {
-            for (k, row) in x.chunks_exact(n).enumerate() {
-                for (coordinate, value) in lanes.iter_mut().zip(row) {
-                    coordinate.0[k] = *value;
-                }
+        // the group's rows into lanes, a coordinate at a time: one register from four rows
+        for (lanes, x) in inputs.iter_mut().zip([&q[rows.clone()], &v[rows.clone()], &a[rows]]) {
+            for (c, coordinate) in lanes.iter_mut().enumerate() {
+                *coordinate = Lanes(std::array::from_fn(|k| x[k * n + c]));
             }
         }
-        forward_pass(model, data);
-        backward_pass(model, data);
-        for (k, row) in out.chunks_exact_mut(n).enumerate() {
-            for (value, coordinate) in row.iter_mut().zip(&data.tau) {
-                *value = coordinate.0[k];
+        let [positions, rates, accelerations] = &*inputs;
+        poses(bodies, positions, rotation, translation);
+        motions(bodies, rates, accelerations, rotation, translation, lift, velocity, acceleration, force);
+        torques(bodies, rotation, translation, accelerations, armature, force, torque);
+        for (c, coordinate) in torque.iter().enumerate() {
+            for (k, value) in coordinate.0.iter().enumerate() {
+                out[k * n + c] = *value;
             }
         }
     }
@@ -323,80 +519,97 @@ fn to_body(e: &M3, x: V3) -> V3 {
 /// r): ω' = Eᵀ·ω, v' = Eᵀ·(v + ω × r).
 #[inline(always)]
 fn motion_to_body(e: &M3, r: V3, m: Spatial) -> Spatial {
-    Spatial { angular: to_body(e, m.angular), linear: to_body(e, add(m.linear, cross(m.angular, r))) }
+    Spatial { angular: to_body(e, m.angular), linear: to_body(e, cross_add(m.angular, r, m.linear)) }
 }
 
-/// A force of the body's frame in its parent's: F = E·f, N = E·n + r × F.
+/// A force of the body's frame added to one of its parent's: F = E·f, N = E·n + r × F.
 #[inline(always)]
-fn force_to_parent(e: &M3, r: V3, f: Spatial) -> Spatial {
+fn add_force_to_parent(e: &M3, r: V3, f: Spatial, parent: Spatial) -> Spatial {
     let linear = mat_vec(e, f.linear);
-    Spatial { angular: add(mat_vec(e, f.angular), cross(r, linear)), linear }
+    Spatial { angular: cross_add(r, linear, mat_vec_add(e, f.angular, parent.angular)), linear: add(parent.linear, linear) }
 }
 
-/// The recursion from the root out: each body's pose in its parent, and its velocity,
-/// acceleration (gravity as the world's upward acceleration) and the force its motion needs, all
-/// in its own frame.
+/// Each body's pose in its parent's frame at `positions`: the entries of its rotation the joint
+/// turns, a prismatic joint's translation.
 #[inline(always)]
-fn forward_pass(model: &Model, data: &mut RneaManyData) {
-    let [q, v, a] = &data.inputs;
-    let gravity = Spatial { angular: V3::default(), linear: v3(&-model.gravity) };
-    for i in 0..model.bodies.len() {
-        let (joint, coupling, motion) = (&model.bodies[i], &model.couplings[i], &model.motions[i]);
-        let position = Lanes::splat(coupling.multiplier).mul_add(q[coupling.coordinate], Lanes::splat(coupling.offset));
-        let (rotation, translation) = if motion.prismatic {
-            (m3(&motion.fixed), add(v3(&motion.origin), scale(v3(&motion.axis), position)))
-        } else {
-            let (sin, cos) = sin_cos(position);
-            let (fixed, cosine, sine) = (m3(&motion.fixed), m3(&motion.cosine), m3(&motion.sine));
-            let entry = |r: usize, c: usize| sine[r][c].mul_add(sin, cosine[r][c].mul_add(cos, fixed[r][c]));
-            ([[entry(0, 0), entry(0, 1), entry(0, 2)], [entry(1, 0), entry(1, 1), entry(1, 2)], [entry(2, 0), entry(2, 1), entry(2, 2)]], v3(&motion.origin))
-        };
-        let (v_parent, a_parent) = match joint.parent {
-            Some(p) => (motion_to_body(&rotation, translation, data.velocity[p]), motion_to_body(&rotation, translation, data.acceleration[p])),
-            None => (Spatial::default(), motion_to_body(&rotation, translation, gravity)),
-        };
-        let axis = v3(&data.axis[i]);
-        let (vc, ac) = (v[coupling.coordinate], a[coupling.coordinate]);
-        let joint_velocity = scale(axis, vc);
-        let (velocity, acceleration) = if motion.prismatic {
-            let velocity = Spatial { angular: v_parent.angular, linear: add(v_parent.linear, joint_velocity) };
-            // v ×ₘ (0, s·q̇) = (0, ω × s·q̇)
-            let linear = add(add(a_parent.linear, scale(axis, ac)), cross(velocity.angular, joint_velocity));
-            (velocity, Spatial { angular: a_parent.angular, linear })
-        } else {
-            let velocity = Spatial { angular: add(v_parent.angular, joint_velocity), linear: v_parent.linear };
-            // v ×ₘ (s·q̇, 0) = (ω × s·q̇, v × s·q̇)
-            let angular = add(add(a_parent.angular, scale(axis, ac)), cross(velocity.angular, joint_velocity));
-            let linear = add(a_parent.linear, cross(velocity.linear, joint_velocity));
-            (velocity, Spatial { angular, linear })
-        };
-        let inertia = &data.inertia[i];
-        data.force[i] = inertia.mul_motion(acceleration).plus(velocity.cross_force(inertia.mul_motion(velocity)));
-        data.velocity[i] = velocity;
-        data.acceleration[i] = acceleration;
-        data.rotation[i] = rotation;
-        data.translation[i] = translation;
+fn poses(bodies: &[BodyLanes], positions: &[Lanes], rotation: &mut [M3], translation: &mut [V3]) {
+    for ((body, e), r) in bodies.iter().zip(rotation.iter_mut()).zip(translation.iter_mut()) {
+        let position = body.multiplier.mul_add(positions[body.coordinate], body.offset);
+        if body.kind == JointAxisKind::Prismatic {
+            *r = add(body.origin, scale(body.slide, position));
+            continue;
+        }
+        let (sin, cos) = sin_cos(position);
+        match body.kind {
+            JointAxisKind::Coordinate { index: 0 } => CoordinateAxis::<0>::turn(body, sin, cos, e),
+            JointAxisKind::Coordinate { index: 1 } => CoordinateAxis::<1>::turn(body, sin, cos, e),
+            JointAxisKind::Coordinate { .. } => CoordinateAxis::<2>::turn(body, sin, cos, e),
+            _ => GeneralAxis::turn(body, sin, cos, e),
+        }
     }
+}
+
+/// The recursion from the root out: each body's velocity and acceleration in its own frame, the
+/// world's acceleration `lift` (upward, against gravity) standing in for gravity, and the force
+/// its motion needs, f = I·a + v ×* I·v (in the same loop: a loop of the forces alone, each body's
+/// independent of the others', is vectorized by the compiler across bodies, lane by lane).
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn motions(bodies: &[BodyLanes], rates: &[Lanes], accelerations: &[Lanes], rotation: &[M3], translation: &[V3], lift: &Spatial, velocity: &mut [Spatial], acceleration: &mut [Spatial], force: &mut [Spatial]) {
+    for (i, body) in bodies.iter().enumerate() {
+        let (e, r) = (&rotation[i], translation[i]);
+        let (v_parent, a_parent) = match body.parent {
+            Some(p) => (motion_to_body(e, r, velocity[p]), motion_to_body(e, r, acceleration[p])),
+            None => (Spatial::default(), motion_to_body(e, r, *lift)),
+        };
+        let (rate, joint_acceleration) = (rates[body.coordinate], accelerations[body.coordinate]);
+        (velocity[i], acceleration[i]) = match body.kind {
+            JointAxisKind::Coordinate { index: 0 } => revolute_motion(CoordinateAxis::<0> { scale: body.axis[0] }, v_parent, a_parent, rate, joint_acceleration),
+            JointAxisKind::Coordinate { index: 1 } => revolute_motion(CoordinateAxis::<1> { scale: body.axis[1] }, v_parent, a_parent, rate, joint_acceleration),
+            JointAxisKind::Coordinate { .. } => revolute_motion(CoordinateAxis::<2> { scale: body.axis[2] }, v_parent, a_parent, rate, joint_acceleration),
+            JointAxisKind::General => revolute_motion(GeneralAxis(body.axis), v_parent, a_parent, rate, joint_acceleration),
+            JointAxisKind::Prismatic => {
+                let joint_velocity = scale(body.axis, rate);
+                let velocity = Spatial { angular: v_parent.angular, linear: add(v_parent.linear, joint_velocity) };
+                // v ×ₘ (0, s·q̇) = (0, ω × s·q̇)
+                let linear = add(add(a_parent.linear, scale(body.axis, joint_acceleration)), cross(velocity.angular, joint_velocity));
+                (velocity, Spatial { angular: a_parent.angular, linear })
+            }
+        };
+        let (v, a) = (velocity[i], acceleration[i]);
+        force[i] = v.cross_force_add(body.inertia.mul_motion(v), body.inertia.mul_motion(a));
+    }
+}
+
+/// A revolute joint's body's velocity and acceleration from its parent's (in the body's frame).
+#[inline(always)]
+fn revolute_motion<A: JointAxis>(axis: A, v_parent: Spatial, a_parent: Spatial, rate: Lanes, joint_acceleration: Lanes) -> (Spatial, Spatial) {
+    let joint_velocity = axis.along(rate);
+    let velocity = Spatial { angular: axis.plus(v_parent.angular, joint_velocity), linear: v_parent.linear };
+    // v ×ₘ (s·q̇, 0) = (ω × s·q̇, v × s·q̇)
+    let angular = axis.plus_cross(axis.plus(a_parent.angular, axis.along(joint_acceleration)), velocity.angular, joint_velocity);
+    let linear = axis.plus_cross(a_parent.linear, velocity.linear, joint_velocity);
+    (velocity, Spatial { angular, linear })
 }
 
 /// The recursion from the leaves in: each joint's torque, the body's force carried to its parent;
-/// then the motors' rotors (J_r·N²·q̈), into `data.tau`.
+/// then the motors' rotors (J_r·N²·q̈).
 #[inline(always)]
-fn backward_pass(model: &Model, data: &mut RneaManyData) {
-    data.tau.fill(Lanes::default());
-    for i in (0..model.bodies.len()).rev() {
-        let (joint, coupling, motion) = (&model.bodies[i], &model.couplings[i], &model.motions[i]);
-        let c = coupling.coordinate;
-        let axis = v3(&data.axis[i]);
-        let force = data.force[i];
-        let along = if motion.prismatic { force.linear } else { force.angular };
-        data.tau[c] = data.tau[c] + dot(axis, along);
-        if let Some(p) = joint.parent {
-            data.force[p] = data.force[p].plus(force_to_parent(&data.rotation[i], data.translation[i], force));
-        }
+fn torques(bodies: &[BodyLanes], rotation: &[M3], translation: &[V3], accelerations: &[Lanes], armature: &[Lanes], force: &mut [Spatial], torque: &mut [Lanes]) {
+    for ((t, j), q̈) in torque.iter_mut().zip(armature).zip(accelerations) {
+        *t = *j * *q̈;
     }
-    for (c, armature) in model.armature.iter().enumerate() {
-        data.tau[c] = data.tau[c] + Lanes::splat(*armature) * data.inputs[2][c];
+    for (i, body) in bodies.iter().enumerate().rev() {
+        let f = force[i];
+        let along = match body.kind {
+            JointAxisKind::Coordinate { index } => body.axis[index] * f.angular[index],
+            JointAxisKind::General => dot(body.axis, f.angular),
+            JointAxisKind::Prismatic => dot(body.axis, f.linear),
+        };
+        torque[body.coordinate] = torque[body.coordinate] + along;
+        if let Some(p) = body.parent {
+            force[p] = add_force_to_parent(&rotation[i], translation[i], f, force[p]);
+        }
     }
 }
 
@@ -433,14 +646,48 @@ mod tests {
         assert!(worst <= 4.5e-16, "largest difference from the library's: {worst:e}");
     }
 
+    /// A chain with a joint of every kind the lanes tell apart: about x, −y and z of its frame
+    /// (turned by its origin's rpy), about a skew axis, prismatic, and a mimic joint about −z at
+    /// −1.5 times its leader; a link frame's inertia off its axes.
+    fn every_joint_kind() -> Model {
+        let link = |name: &str| format!(r#"<link name="{name}"><inertial><origin xyz="0.02 -0.01 0.05" rpy="0.3 0.1 -0.2"/><mass value="0.7"/><inertia ixx="0.003" iyy="0.002" izz="0.001" ixy="0.0001" ixz="-0.0002" iyz="0.00005"/></inertial></link>"#);
+        let joint = |name: &str, kind: &str, parent: &str, child: &str, rpy: &str, axis: &str, extra: &str| {
+            format!(r#"<joint name="{name}" type="{kind}"><parent link="{parent}"/><child link="{child}"/><origin xyz="0.01 0.02 0.1" rpy="{rpy}"/><axis xyz="{axis}"/><limit lower="-3" upper="3" effort="10" velocity="3"/>{extra}</joint>"#)
+        };
+        let links: String = ["base", "a", "b", "c", "d", "e", "f"].iter().map(|n| link(n)).collect();
+        let joints = [
+            joint("about_x", "revolute", "base", "a", "0.2 0.1 0", "1 0 0", ""),
+            joint("about_minus_y", "revolute", "a", "b", "0 1.5708 0", "0 -1 0", ""),
+            joint("about_z", "revolute", "b", "c", "-0.4 0 0.7", "0 0 1", ""),
+            joint("about_skew", "revolute", "c", "d", "0 0 0", "0.6 0 0.8", ""),
+            joint("slide", "prismatic", "d", "e", "0.1 0.2 0.3", "0 0 1", ""),
+            joint("mimic", "revolute", "c", "f", "0.5 0 0", "0 0 -1", r#"<mimic joint="about_z" multiplier="-1.5" offset="0.2"/>"#),
+        ]
+        .concat();
+        let urdf = format!(r#"<robot name="kinds">{links}{joints}</robot>"#);
+        crate::model::load_urdf_str(&urdf, std::path::Path::new("kinds.urdf")).expect("the chain loads")
+    }
+
+    /// The kinds are told from the numbers: each coordinate axis (with its sign, or a mimic's
+    /// multiplier) as such, a skew axis and a prismatic joint as the general forms.
+    #[test]
+    fn joint_axis_kinds_are_read_from_the_model() {
+        let model = every_joint_kind();
+        let kinds: Vec<JointAxisKind> = RneaManyData::new(&model).bodies.iter().map(|b| b.kind).collect();
+        use JointAxisKind::*;
+        assert_eq!(kinds, [Coordinate { index: 0 }, Coordinate { index: 1 }, Coordinate { index: 2 }, General, Prismatic, Coordinate { index: 2 }]);
+        let so101 = robot("so101.urdf");
+        assert!(RneaManyData::new(&so101).bodies.iter().all(|b| matches!(b.kind, Coordinate { .. })), "the SO-101's joints all turn about an axis of their frames");
+    }
+
     /// Every state's torques are the scalar RNEA's: the same dynamics in the bodies' frames instead
-    /// of the world's, so within a few roundings (1e-12 of the largest torque), on a 6-joint chain, a branched tree
-    /// with prismatic joints (Tiago) and one with mimic joints (Baxter), over a count of states that
-    /// leaves a remainder for the scalar path.
+    /// of the world's, so within a few roundings (1e-12 of the largest torque), on a 6-joint chain, a
+    /// branched tree with prismatic joints (Tiago), one with mimic joints (Baxter) and a chain with
+    /// a joint of every kind, over a count of states that leaves a remainder for the scalar path.
     #[test]
     fn many_states_give_the_scalar_rneas_torques() {
-        for name in ["so101.urdf", "tiago.urdf", "baxter.urdf"] {
-            let model = robot(name);
+        for name in ["so101.urdf", "tiago.urdf", "baxter.urdf", "every joint kind"] {
+            let model = if name == "every joint kind" { every_joint_kind() } else { robot(name) };
             let n = model.dof();
             let states = 4 * LANES + 3;
             let wave = |k: usize, c: usize, f: f64| ((k * n + c) as f64 * f).sin();
