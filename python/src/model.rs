@@ -249,7 +249,7 @@ impl Model {
         if states.single {
             return self.over(py, states, &[self.dof()], |model, data, x, out| out.copy_from_slice(dynamics::rnea(model, data, x[0], x[1], x[2])));
         }
-        // a trajectory: four states at a time in SIMD lanes
+        // a trajectory: eight states at a time in SIMD lanes (AVX-512), or four (AVX2)
         self.over_blocks(py, states, &[self.dof()], dynamics::RneaManyData::new, |model, data, x, out| dynamics::rnea_many(model, data, x[0], x[1], x[2], out))
     }
 

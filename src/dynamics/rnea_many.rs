@@ -1,39 +1,45 @@
 //! Inverse dynamics over many states at once (a trajectory's torques): the recursions of
 //! [`rnea`](super::rnea) — out from the root for the bodies' motion and the forces it needs, back in
 //! for the joints' torques — written in each body's own frame, where its inertia is constant (the
-//! scalar algorithm's world frame rotates every inertia at every state), and run on
-//! [`LANES`] states side by side, each number a short array of one value per state. A trajectory's
-//! states do not depend on each other, so each operation becomes one 256-bit instruction for four
-//! states. The lanes' arithmetic is written lane
-//! by lane with fused multiply-adds and compiled for AVX2 and FMA, chosen when called (an x86-64
-//! without them takes the scalar algorithm; elsewhere the lanes are the target's own vectors); the
-//! joints' sines and cosines are computed here, by polynomial in the lanes, instead of by the
-//! library one number at a time.
+//! scalar algorithm's world frame rotates every inertia at every state), and run on several states
+//! side by side, each number a short array of one value per state ("lanes"). A trajectory's states
+//! do not depend on each other, so each operation becomes one instruction for all of them: eight
+//! states in an AVX-512 register where the processor has it, else four in an AVX2 one. The lanes'
+//! arithmetic is written lane by lane with fused multiply-adds and compiled for those instruction
+//! sets, chosen when the workspace is made and checked when called (an x86-64 without AVX2 and FMA
+//! takes the scalar algorithm; elsewhere four lanes are the target's own vectors); the joints' sines
+//! and cosines are computed here, by polynomial in the lanes, instead of by the library one number
+//! at a time.
 
 use super::{Data, rnea};
 use crate::model::{JointMotion, Model};
 use nalgebra::{Matrix3, Vector3};
 use std::ops::{Add, Mul, Neg, Sub};
 
-/// States computed side by side: four f64 fill one AVX2 register.
-const LANES: usize = 4;
+/// One number of the algorithm, for each of `N` states side by side (four fill an AVX2 register,
+/// eight an AVX-512 one; aligned to a cache line for both: an eight split across two lines loads
+/// ~15 % slower, and four lose nothing measurable to the padding).
+#[derive(Clone, Copy, Debug)]
+#[repr(align(64))]
+struct Lanes<const N: usize>([f64; N]);
 
-/// One number of the algorithm, for each of the [`LANES`] states.
-#[derive(Clone, Copy, Debug, Default)]
-#[repr(align(32))]
-struct Lanes([f64; LANES]);
+impl<const N: usize> Default for Lanes<N> {
+    fn default() -> Self {
+        Self([0.0; N])
+    }
+}
 
-impl Lanes {
+impl<const N: usize> Lanes<N> {
     #[inline(always)]
     fn splat(x: f64) -> Self {
-        Self([x; LANES])
+        Self([x; N])
     }
 
     /// c − self·b, rounded once (one FMA instruction on all lanes).
     #[inline(always)]
     fn neg_mul_add(self, b: Self, c: Self) -> Self {
-        let mut out = [0.0; LANES];
-        for k in 0..LANES {
+        let mut out = [0.0; N];
+        for k in 0..N {
             out[k] = (-self.0[k]).mul_add(b.0[k], c.0[k]);
         }
         Self(out)
@@ -42,8 +48,8 @@ impl Lanes {
     /// self·b + c, rounded once (one FMA instruction on all lanes).
     #[inline(always)]
     fn mul_add(self, b: Self, c: Self) -> Self {
-        let mut out = [0.0; LANES];
-        for k in 0..LANES {
+        let mut out = [0.0; N];
+        for k in 0..N {
             out[k] = self.0[k].mul_add(b.0[k], c.0[k]);
         }
         Self(out)
@@ -52,12 +58,12 @@ impl Lanes {
 
 macro_rules! lane_op {
     ($trait:ident, $method:ident, $op:tt) => {
-        impl $trait for Lanes {
+        impl<const N: usize> $trait for Lanes<N> {
             type Output = Self;
             #[inline(always)]
             fn $method(self, other: Self) -> Self {
-                let mut out = [0.0; LANES];
-                for k in 0..LANES {
+                let mut out = [0.0; N];
+                for k in 0..N {
                     out[k] = self.0[k] $op other.0[k];
                 }
                 Self(out)
@@ -69,7 +75,7 @@ lane_op!(Add, add, +);
 lane_op!(Sub, sub, -);
 lane_op!(Mul, mul, *);
 
-impl Neg for Lanes {
+impl<const N: usize> Neg for Lanes<N> {
     type Output = Self;
     #[inline(always)]
     fn neg(self) -> Self {
@@ -78,59 +84,59 @@ impl Neg for Lanes {
 }
 
 /// A 3-vector of lanes.
-type V3 = [Lanes; 3];
+type V3<const N: usize> = [Lanes<N>; 3];
 /// A 3×3 matrix of lanes, row by row.
-type M3 = [V3; 3];
+type M3<const N: usize> = [V3<N>; 3];
 
 #[inline(always)]
-fn v3(x: &Vector3<f64>) -> V3 {
+fn v3<const N: usize>(x: &Vector3<f64>) -> V3<N> {
     [Lanes::splat(x.x), Lanes::splat(x.y), Lanes::splat(x.z)]
 }
 
 // (written out: std::array::from_fn's closures are not always inlined, and a call that is not
 // runs without AVX2)
 #[inline(always)]
-fn m3(m: &Matrix3<f64>) -> M3 {
+fn m3<const N: usize>(m: &Matrix3<f64>) -> M3<N> {
     let row = |r: usize| [Lanes::splat(m[(r, 0)]), Lanes::splat(m[(r, 1)]), Lanes::splat(m[(r, 2)])];
     [row(0), row(1), row(2)]
 }
 
 #[inline(always)]
-fn add(a: V3, b: V3) -> V3 {
+fn add<const N: usize>(a: V3<N>, b: V3<N>) -> V3<N> {
     [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
 }
 
 #[inline(always)]
-fn scale(a: V3, s: Lanes) -> V3 {
+fn scale<const N: usize>(a: V3<N>, s: Lanes<N>) -> V3<N> {
     [a[0] * s, a[1] * s, a[2] * s]
 }
 
 #[inline(always)]
-fn cross(a: V3, b: V3) -> V3 {
+fn cross<const N: usize>(a: V3<N>, b: V3<N>) -> V3<N> {
     [a[1].mul_add(b[2], -(a[2] * b[1])), a[2].mul_add(b[0], -(a[0] * b[2])), a[0].mul_add(b[1], -(a[1] * b[0]))]
 }
 
 /// base + a × b, each component two fused multiply-adds (the sums of this algorithm are folded
 /// into its products so: fewer instructions and fewer numbers waiting in registers).
 #[inline(always)]
-fn cross_add(a: V3, b: V3, base: V3) -> V3 {
+fn cross_add<const N: usize>(a: V3<N>, b: V3<N>, base: V3<N>) -> V3<N> {
     [a[1].mul_add(b[2], a[2].neg_mul_add(b[1], base[0])), a[2].mul_add(b[0], a[0].neg_mul_add(b[2], base[1])), a[0].mul_add(b[1], a[1].neg_mul_add(b[0], base[2]))]
 }
 
 /// base + m·v.
 #[inline(always)]
-fn mat_vec_add(m: &M3, v: V3, base: V3) -> V3 {
+fn mat_vec_add<const N: usize>(m: &M3<N>, v: V3<N>, base: V3<N>) -> V3<N> {
     let row = |r: usize| m[r][2].mul_add(v[2], m[r][1].mul_add(v[1], m[r][0].mul_add(v[0], base[r])));
     [row(0), row(1), row(2)]
 }
 
 #[inline(always)]
-fn dot(a: V3, b: V3) -> Lanes {
+fn dot<const N: usize>(a: V3<N>, b: V3<N>) -> Lanes<N> {
     a[2].mul_add(b[2], a[1].mul_add(b[1], a[0] * b[0]))
 }
 
 #[inline(always)]
-fn mat_vec(m: &M3, v: V3) -> V3 {
+fn mat_vec<const N: usize>(m: &M3<N>, v: V3<N>) -> V3<N> {
     [dot(m[0], v), dot(m[1], v), dot(m[2], v)]
 }
 
@@ -144,22 +150,22 @@ const REDUCED_UP_TO: f64 = 1e6;
 /// ones of its `sin.c` and `cos.c`), their roles and signs set by k mod 4. The library's sincos is a
 /// call per number and was a third of the trajectory's time.
 #[inline(always)]
-fn sin_cos(x: Lanes) -> (Lanes, Lanes) {
+fn sin_cos<const N: usize>(x: Lanes<N>) -> (Lanes<N>, Lanes<N>) {
     const HALF_PI: [f64; 3] = [1.570_796_251_296_997_070_31, 7.549_789_415_861_596_353_35e-8, 5.390_302_858_158_119_052_90e-15];
     const SINE: [f64; 6] = [1.589_623_015_765_465_680_60e-10, -2.505_074_776_285_780_728_66e-8, 2.755_731_362_138_572_452_13e-6, -1.984_126_982_958_953_859_96e-4, 8.333_333_333_322_118_588_78e-3, -1.666_666_666_666_663_072_95e-1];
     const COSINE: [f64; 6] = [-1.135_853_652_138_768_173_00e-11, 2.087_570_084_197_473_167_78e-9, -2.755_731_417_929_673_881_12e-7, 2.480_158_728_885_170_453_48e-5, -1.388_888_888_887_305_641_16e-3, 4.166_666_666_666_659_292_18e-2];
     if x.0.iter().any(|v| !(v.abs() <= REDUCED_UP_TO)) {
-        let mut sin = Lanes::default();
-        let mut cos = Lanes::default();
-        for k in 0..LANES {
+        let mut sin = Lanes::<N>::default();
+        let mut cos = Lanes::<N>::default();
+        for k in 0..N {
             (sin.0[k], cos.0[k]) = x.0[k].sin_cos();
         }
         return (sin, cos);
     }
     // written so that every line is one instruction on all lanes (a rounding, a comparison, a
     // blend): no lane is taken out of its register
-    let mut k = Lanes::default();
-    for lane in 0..LANES {
+    let mut k = Lanes::<N>::default();
+    for lane in 0..N {
         k.0[lane] = (x.0[lane] * std::f64::consts::FRAC_2_PI).round_ties_even();
     }
     let r = x - k * Lanes::splat(HALF_PI[0]) - k * Lanes::splat(HALF_PI[1]) - k * Lanes::splat(HALF_PI[2]);
@@ -168,13 +174,13 @@ fn sin_cos(x: Lanes) -> (Lanes, Lanes) {
     let sine = (r * z).mul_add(horner(&SINE), r);
     let cosine = (z * z).mul_add(horner(&COSINE), Lanes::splat(-0.5).mul_add(z, Lanes::splat(1.0)));
     // the quadrant k mod 4, exactly, as a float
-    let mut quadrant = Lanes::default();
-    for lane in 0..LANES {
+    let mut quadrant = Lanes::<N>::default();
+    for lane in 0..N {
         quadrant.0[lane] = k.0[lane] - 4.0 * (k.0[lane] * 0.25).floor();
     }
-    let mut sin = Lanes::default();
-    let mut cos = Lanes::default();
-    for lane in 0..LANES {
+    let mut sin = Lanes::<N>::default();
+    let mut cos = Lanes::<N>::default();
+    for lane in 0..N {
         let (s, c, q) = (sine.0[lane], cosine.0[lane], quadrant.0[lane]);
         let odd = q == 1.0 || q == 3.0;
         let (a, b) = if odd { (c, s) } else { (s, c) };
@@ -186,12 +192,12 @@ fn sin_cos(x: Lanes) -> (Lanes, Lanes) {
 
 /// A motion or force vector: angular part, linear part (in a body's frame, about its origin).
 #[derive(Clone, Copy, Default)]
-struct Spatial {
-    angular: V3,
-    linear: V3,
+struct Spatial<const N: usize> {
+    angular: V3<N>,
+    linear: V3<N>,
 }
 
-impl Spatial {
+impl<const N: usize> Spatial<N> {
     /// base + v ×* f (v = self, a motion; f a force).
     #[inline(always)]
     fn cross_force_add(self, f: Self, base: Self) -> Self {
@@ -202,14 +208,14 @@ impl Spatial {
 /// A body's spatial inertia about its own frame's origin, in its frame (as
 /// [`SpatialInertia`](crate::spatial::SpatialInertia)): constant, so made once with the workspace.
 #[derive(Clone, Copy, Default)]
-struct Inertia {
-    mass: Lanes,
-    first_moment: V3,
+struct Inertia<const N: usize> {
+    mass: Lanes<N>,
+    first_moment: V3<N>,
     /// xx, yy, zz, xy, xz, yz.
-    rotational: [Lanes; 6],
+    rotational: [Lanes<N>; 6],
 }
 
-impl Inertia {
+impl<const N: usize> Inertia<N> {
     /// The rigid body's inertia about its own frame's origin (SpatialInertia's numbers, in lanes).
     fn of_body(body: &crate::spatial::RigidInertia) -> Self {
         let about_origin = crate::spatial::SpatialInertia::of_body(body, &crate::spatial::Pose::identity());
@@ -217,7 +223,7 @@ impl Inertia {
     }
 
     #[inline(always)]
-    fn mul_motion(&self, m: Spatial) -> Spatial {
+    fn mul_motion(&self, m: Spatial<N>) -> Spatial<N> {
         let [xx, yy, zz, xy, xz, yz] = self.rotational;
         let w = m.angular;
         let rotational = [dot([xx, xy, xz], w), dot([xy, yy, yz], w), dot([xz, yz, zz], w)];
@@ -263,29 +269,29 @@ impl JointAxisKind {
 /// One body's constants, each number as lanes (so the arithmetic reads them straight from
 /// memory), made once with the workspace.
 #[derive(Clone, Copy)]
-struct BodyLanes {
+struct BodyLanes<const N: usize> {
     parent: Option<usize>,
     /// The coordinate moving the joint: its position is multiplier·q + offset.
     coordinate: usize,
-    multiplier: Lanes,
-    offset: Lanes,
+    multiplier: Lanes<N>,
+    offset: Lanes<N>,
     kind: JointAxisKind,
     /// The joint's axis in the body's frame (the same as in the joint's: the joint moves along
     /// it), times its coupling's multiplier.
-    axis: V3,
+    axis: V3<N>,
     /// The body frame's axes in its parent's, E = fixed + cos·C + sin·S (a prismatic joint's:
     /// fixed).
-    fixed: M3,
-    cosine: M3,
-    sine: M3,
+    fixed: M3<N>,
+    cosine: M3<N>,
+    sine: M3<N>,
     /// The joint frame's origin in the parent's frame, and a prismatic joint's direction there:
     /// the body frame's origin is origin + slide·position.
-    origin: V3,
-    slide: V3,
-    inertia: Inertia,
+    origin: V3<N>,
+    slide: V3<N>,
+    inertia: Inertia<N>,
 }
 
-impl BodyLanes {
+impl<const N: usize> BodyLanes<N> {
     fn new(model: &Model, i: usize) -> Self {
         let (body, coupling, motion) = (&model.bodies[i], &model.couplings[i], &model.motions[i]);
         let axis = body.axis * coupling.multiplier;
@@ -308,42 +314,42 @@ impl BodyLanes {
 
 /// A revolute joint's axis in the lanes' arithmetic: its products with a joint rate, and the
 /// part of the joint's pose its angle turns.
-trait JointAxis: Copy {
+trait JointAxis<const N: usize>: Copy {
     /// The axis times a joint rate, in the form the products below take.
     type Along: Copy;
-    fn along(self, rate: Lanes) -> Self::Along;
+    fn along(self, rate: Lanes<N>) -> Self::Along;
     /// base + along.
-    fn plus(self, base: V3, along: Self::Along) -> V3;
+    fn plus(self, base: V3<N>, along: Self::Along) -> V3<N>;
     /// base + w × along.
-    fn plus_cross(self, base: V3, w: V3, along: Self::Along) -> V3;
+    fn plus_cross(self, base: V3<N>, w: V3<N>, along: Self::Along) -> V3<N>;
     /// The entries of E = fixed + cos·C + sin·S that the angle changes (the others were set
     /// with the workspace).
-    fn turn(body: &BodyLanes, sin: Lanes, cos: Lanes, rotation: &mut M3);
+    fn turn(body: &BodyLanes<N>, sin: Lanes<N>, cos: Lanes<N>, rotation: &mut M3<N>);
 }
 
 /// A revolute joint about its frame's axis `K` (0, 1, 2: x, y, z), times `scale`.
 #[derive(Clone, Copy)]
-struct CoordinateAxis<const K: usize> {
-    scale: Lanes,
+struct CoordinateAxis<const K: usize, const N: usize> {
+    scale: Lanes<N>,
 }
 
-impl<const K: usize> JointAxis for CoordinateAxis<K> {
-    type Along = Lanes;
+impl<const K: usize, const N: usize> JointAxis<N> for CoordinateAxis<K, N> {
+    type Along = Lanes<N>;
 
     #[inline(always)]
-    fn along(self, rate: Lanes) -> Lanes {
+    fn along(self, rate: Lanes<N>) -> Lanes<N> {
         self.scale * rate
     }
 
     #[inline(always)]
-    fn plus(self, mut base: V3, along: Lanes) -> V3 {
+    fn plus(self, mut base: V3<N>, along: Lanes<N>) -> V3<N> {
         base[K] = base[K] + along;
         base
     }
 
     /// w × e_K·x = (w_j·x, −w_i·x) on the other two axes (i, j, K in cyclic order), 0 on K.
     #[inline(always)]
-    fn plus_cross(self, mut base: V3, w: V3, along: Lanes) -> V3 {
+    fn plus_cross(self, mut base: V3<N>, w: V3<N>, along: Lanes<N>) -> V3<N> {
         let (i, j) = ((K + 1) % 3, (K + 2) % 3);
         base[i] = w[j].mul_add(along, base[i]);
         base[j] = w[i].neg_mul_add(along, base[j]);
@@ -352,7 +358,7 @@ impl<const K: usize> JointAxis for CoordinateAxis<K> {
 
     /// All but column K (the fixed part's alone: see [`JointAxisKind::of`]).
     #[inline(always)]
-    fn turn(body: &BodyLanes, sin: Lanes, cos: Lanes, rotation: &mut M3) {
+    fn turn(body: &BodyLanes<N>, sin: Lanes<N>, cos: Lanes<N>, rotation: &mut M3<N>) {
         for r in 0..3 {
             for c in [(K + 1) % 3, (K + 2) % 3] {
                 rotation[r][c] = body.sine[r][c].mul_add(sin, body.cosine[r][c] * cos);
@@ -363,28 +369,28 @@ impl<const K: usize> JointAxis for CoordinateAxis<K> {
 
 /// A revolute joint about any axis (in its body's frame, times its coupling's multiplier).
 #[derive(Clone, Copy)]
-struct GeneralAxis(V3);
+struct GeneralAxis<const N: usize>(V3<N>);
 
-impl JointAxis for GeneralAxis {
-    type Along = V3;
+impl<const N: usize> JointAxis<N> for GeneralAxis<N> {
+    type Along = V3<N>;
 
     #[inline(always)]
-    fn along(self, rate: Lanes) -> V3 {
+    fn along(self, rate: Lanes<N>) -> V3<N> {
         scale(self.0, rate)
     }
 
     #[inline(always)]
-    fn plus(self, base: V3, along: V3) -> V3 {
+    fn plus(self, base: V3<N>, along: V3<N>) -> V3<N> {
         add(base, along)
     }
 
     #[inline(always)]
-    fn plus_cross(self, base: V3, w: V3, along: V3) -> V3 {
+    fn plus_cross(self, base: V3<N>, w: V3<N>, along: V3<N>) -> V3<N> {
         add(base, cross(w, along))
     }
 
     #[inline(always)]
-    fn turn(body: &BodyLanes, sin: Lanes, cos: Lanes, rotation: &mut M3) {
+    fn turn(body: &BodyLanes<N>, sin: Lanes<N>, cos: Lanes<N>, rotation: &mut M3<N>) {
         for r in 0..3 {
             for c in 0..3 {
                 rotation[r][c] = body.sine[r][c].mul_add(sin, body.cosine[r][c].mul_add(cos, body.fixed[r][c]));
@@ -393,33 +399,31 @@ impl JointAxis for GeneralAxis {
     }
 }
 
-/// The workspace of [`rnea_many`]: the bodies' constants in lanes; per body, its lanes' pose in
-/// its parent's frame and its velocity, acceleration and force in its own frame. Sized once for a
-/// model.
+/// The lanes' part of [`RneaManyData`], for `N` states side by side: the bodies' constants in
+/// lanes; per body, its lanes' pose in its parent's frame and its velocity, acceleration and force
+/// in its own frame.
 #[derive(Clone)]
-pub struct RneaManyData {
-    bodies: Vec<BodyLanes>,
+struct LanesData<const N: usize> {
+    bodies: Vec<BodyLanes<N>>,
     /// The body frame's axes in its parent's frame (columns), E.
-    rotation: Vec<M3>,
+    rotation: Vec<M3<N>>,
     /// The body frame's origin in its parent's frame, r.
-    translation: Vec<V3>,
+    translation: Vec<V3<N>>,
     /// The states' positions, velocities and accelerations, a coordinate at a time.
-    inputs: [Vec<Lanes>; 3],
-    velocity: Vec<Spatial>,
-    acceleration: Vec<Spatial>,
-    force: Vec<Spatial>,
+    inputs: [Vec<Lanes<N>>; 3],
+    velocity: Vec<Spatial<N>>,
+    acceleration: Vec<Spatial<N>>,
+    force: Vec<Spatial<N>>,
     /// Per coordinate, its motor's rotor inertia seen at the joint, J_r·N².
-    armature: Vec<Lanes>,
-    tau: Vec<Lanes>,
-    /// The states left over when the count is not a multiple of [`LANES`], one at a time.
-    scalar: Data,
+    armature: Vec<Lanes<N>>,
+    tau: Vec<Lanes<N>>,
     /// The world's acceleration upward (the negated gravity), in the world's frame.
-    lift: Spatial,
+    lift: Spatial<N>,
 }
 
-impl RneaManyData {
-    pub fn new(model: &Model) -> Self {
-        let bodies: Vec<BodyLanes> = (0..model.bodies.len()).map(|i| BodyLanes::new(model, i)).collect();
+impl<const N: usize> LanesData<N> {
+    fn new(model: &Model) -> Self {
+        let bodies: Vec<BodyLanes<N>> = (0..model.bodies.len()).map(|i| BodyLanes::new(model, i)).collect();
         // what the angles never change: a coordinate joint's fixed column, a prismatic joint's
         // rotation and a revolute joint's origin
         let rotation = bodies.iter().map(|body| match body.kind {
@@ -431,16 +435,59 @@ impl RneaManyData {
             rotation: rotation.collect(),
             translation: bodies.iter().map(|body| body.origin).collect(),
             bodies,
-            inputs: std::array::from_fn(|_| vec![Lanes::default(); model.dof()]),
+            inputs: std::array::from_fn(|_| vec![Lanes::<N>::default(); model.dof()]),
             velocity: vec![Spatial::default(); model.bodies.len()],
             acceleration: vec![Spatial::default(); model.bodies.len()],
             force: vec![Spatial::default(); model.bodies.len()],
             armature: model.armature.iter().map(|&j| Lanes::splat(j)).collect(),
-            tau: vec![Lanes::default(); model.dof()],
-            scalar: Data::new(model),
+            tau: vec![Lanes::<N>::default(); model.dof()],
             lift: Spatial { angular: V3::default(), linear: v3(&-model.gravity) },
         }
     }
+}
+
+/// How many states run side by side, chosen for the processor when the workspace is made.
+#[derive(Clone)]
+enum Width {
+    /// Four: one AVX2 register (or the target's own vectors, off x86-64).
+    Four(LanesData<4>),
+    /// Eight: one AVX-512 register. With 32 registers instead of 16 the model's numbers stay in
+    /// registers instead of spilling to the stack: ~1.6× the states a second of four lanes on a
+    /// Xeon (Cascade Lake).
+    Eight(LanesData<8>),
+}
+
+/// The workspace of [`rnea_many`], sized once for a model: the lanes' (see `LanesData`), and the
+/// scalar algorithm's for the states left over when the count is not a multiple of the lanes.
+#[derive(Clone)]
+pub struct RneaManyData {
+    width: Width,
+    scalar: Data,
+}
+
+impl RneaManyData {
+    pub fn new(model: &Model) -> Self {
+        Self::with_width(model, has_avx512())
+    }
+
+    /// Four lanes on any processor (the benchmarks compare it with the eight of AVX-512).
+    pub fn with_four_lanes(model: &Model) -> Self {
+        Self::with_width(model, false)
+    }
+
+    /// Eight lanes or four, as asked (the tests run both on any processor).
+    fn with_width(model: &Model, eight: bool) -> Self {
+        let width = if eight { Width::Eight(LanesData::new(model)) } else { Width::Four(LanesData::new(model)) };
+        Self { width, scalar: Data::new(model) }
+    }
+}
+
+/// Whether the processor runs AVX-512 (with its FMA and the 256-bit forms the compiler mixes in).
+fn has_avx512() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    return std::arch::is_x86_feature_detected!("avx512f") && std::arch::is_x86_feature_detected!("avx512vl") && std::arch::is_x86_feature_detected!("avx512dq") && std::arch::is_x86_feature_detected!("fma");
+    #[cfg(not(target_arch = "x86_64"))]
+    false
 }
 
 /// Inverse dynamics of every state of a trajectory: row k of `q`, `v`, `a` (each states × dof,
@@ -450,24 +497,46 @@ impl RneaManyData {
 pub fn rnea_many(model: &Model, data: &mut RneaManyData, q: &[f64], v: &[f64], a: &[f64], tau: &mut [f64]) {
     let n = model.dof();
     assert!(q.len() == tau.len() && v.len() == tau.len() && a.len() == tau.len() && (n == 0 || tau.len() % n == 0), "rnea_many: rows of {n} values each");
-    assert!(data.bodies.len() == model.bodies.len() && data.tau.len() == n, "rnea_many: a workspace made for another model");
+    let (bodies, dof) = match &data.width {
+        Width::Four(lanes) => (lanes.bodies.len(), lanes.tau.len()),
+        Width::Eight(lanes) => (lanes.bodies.len(), lanes.tau.len()),
+    };
+    assert!(bodies == model.bodies.len() && dof == n, "rnea_many: a workspace made for another model");
     if n == 0 {
         return;
     }
     let states = tau.len() / n;
-    let whole = states / LANES * LANES;
-    // an x86-64 without AVX2 and FMA (none made since 2015) takes the scalar algorithm: FMA is a
-    // library call there
-    #[cfg(target_arch = "x86_64")]
-    let whole = if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
-        // SAFETY: the processor has AVX2 and FMA (checked just above)
-        unsafe { lanes_avx2(data, q, v, a, tau, whole) };
-        whole
-    } else {
-        0
+    let whole = match &mut data.width {
+        Width::Eight(lanes) => {
+            let whole = states / 8 * 8;
+            #[cfg(target_arch = "x86_64")]
+            if has_avx512() {
+                // SAFETY: the processor has AVX-512 F, VL, DQ and FMA (checked just above)
+                unsafe { lanes_avx512(lanes, q, v, a, tau, whole) };
+            } else {
+                lanes_portable(lanes, q, v, a, tau, whole);
+            }
+            #[cfg(not(target_arch = "x86_64"))]
+            lanes_portable(lanes, q, v, a, tau, whole);
+            whole
+        }
+        Width::Four(lanes) => {
+            let whole = states / 4 * 4;
+            // an x86-64 without AVX2 and FMA (none made since 2015) takes the scalar algorithm:
+            // FMA is a library call there
+            #[cfg(target_arch = "x86_64")]
+            let whole = if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
+                // SAFETY: the processor has AVX2 and FMA (checked just above)
+                unsafe { lanes_avx2(lanes, q, v, a, tau, whole) };
+                whole
+            } else {
+                0
+            };
+            #[cfg(not(target_arch = "x86_64"))]
+            lanes_portable(lanes, q, v, a, tau, whole);
+            whole
+        }
     };
-    #[cfg(not(target_arch = "x86_64"))]
-    lanes_portable(data, q, v, a, tau, whole);
     for k in whole..states {
         let row = k * n..(k + 1) * n;
         tau[row.clone()].copy_from_slice(rnea(model, &mut data.scalar, &q[row.clone()], &v[row.clone()], &a[row]));
@@ -476,19 +545,25 @@ pub fn rnea_many(model: &Model, data: &mut RneaManyData, q: &[f64], v: &[f64], a
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-fn lanes_avx2(data: &mut RneaManyData, q: &[f64], v: &[f64], a: &[f64], tau: &mut [f64], whole: usize) {
+fn lanes_avx2(data: &mut LanesData<4>, q: &[f64], v: &[f64], a: &[f64], tau: &mut [f64], whole: usize) {
     lanes_portable(data, q, v, a, tau, whole);
 }
 
-/// The first `whole` states (a multiple of [`LANES`]), [`LANES`] at a time: the bodies' poses,
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512vl,avx512dq,avx2,fma")]
+fn lanes_avx512(data: &mut LanesData<8>, q: &[f64], v: &[f64], a: &[f64], tau: &mut [f64], whole: usize) {
+    lanes_portable(data, q, v, a, tau, whole);
+}
+
+/// The first `whole` states (a multiple of `N`), `N` at a time: the bodies' poses,
 /// then their motion out from the root, the forces it needs, and the torques back in, each pass a
 /// loop of its own (each loop's numbers fit the registers better than one loop doing all).
 #[inline(always)]
-fn lanes_portable(data: &mut RneaManyData, q: &[f64], v: &[f64], a: &[f64], tau: &mut [f64], whole: usize) {
-    let RneaManyData { bodies, rotation, translation, inputs, velocity, acceleration, force, armature, tau: torque, lift, .. } = data;
+fn lanes_portable<const N: usize>(data: &mut LanesData<N>, q: &[f64], v: &[f64], a: &[f64], tau: &mut [f64], whole: usize) {
+    let LanesData { bodies, rotation, translation, inputs, velocity, acceleration, force, armature, tau: torque, lift } = data;
     let n = torque.len();
-    let group = LANES * n;
-    for (first, out) in (0..whole).step_by(LANES).zip(tau[..whole * n].chunks_exact_mut(group)) {
+    let group = N * n;
+    for (first, out) in (0..whole).step_by(N).zip(tau[..whole * n].chunks_exact_mut(group)) {
         let rows = first * n..first * n + group;
         // the group's rows into lanes, a coordinate at a time: one register from four rows
         for (lanes, x) in inputs.iter_mut().zip([&q[rows.clone()], &v[rows.clone()], &a[rows]]) {
@@ -510,7 +585,7 @@ fn lanes_portable(data: &mut RneaManyData, q: &[f64], v: &[f64], a: &[f64], tau:
 
 /// Eᵀ·x: a vector of the parent's frame in the body's.
 #[inline(always)]
-fn to_body(e: &M3, x: V3) -> V3 {
+fn to_body<const N: usize>(e: &M3<N>, x: V3<N>) -> V3<N> {
     let column = |c: usize| e[2][c].mul_add(x[2], e[1][c].mul_add(x[1], e[0][c] * x[0]));
     [column(0), column(1), column(2)]
 }
@@ -518,13 +593,13 @@ fn to_body(e: &M3, x: V3) -> V3 {
 /// A motion of the parent's frame (about its origin) in the body's frame (about the body's origin
 /// r): ω' = Eᵀ·ω, v' = Eᵀ·(v + ω × r).
 #[inline(always)]
-fn motion_to_body(e: &M3, r: V3, m: Spatial) -> Spatial {
+fn motion_to_body<const N: usize>(e: &M3<N>, r: V3<N>, m: Spatial<N>) -> Spatial<N> {
     Spatial { angular: to_body(e, m.angular), linear: to_body(e, cross_add(m.angular, r, m.linear)) }
 }
 
 /// A force of the body's frame added to one of its parent's: F = E·f, N = E·n + r × F.
 #[inline(always)]
-fn add_force_to_parent(e: &M3, r: V3, f: Spatial, parent: Spatial) -> Spatial {
+fn add_force_to_parent<const N: usize>(e: &M3<N>, r: V3<N>, f: Spatial<N>, parent: Spatial<N>) -> Spatial<N> {
     let linear = mat_vec(e, f.linear);
     Spatial { angular: cross_add(r, linear, mat_vec_add(e, f.angular, parent.angular)), linear: add(parent.linear, linear) }
 }
@@ -532,7 +607,7 @@ fn add_force_to_parent(e: &M3, r: V3, f: Spatial, parent: Spatial) -> Spatial {
 /// Each body's pose in its parent's frame at `positions`: the entries of its rotation the joint
 /// turns, a prismatic joint's translation.
 #[inline(always)]
-fn poses(bodies: &[BodyLanes], positions: &[Lanes], rotation: &mut [M3], translation: &mut [V3]) {
+fn poses<const N: usize>(bodies: &[BodyLanes<N>], positions: &[Lanes<N>], rotation: &mut [M3<N>], translation: &mut [V3<N>]) {
     for ((body, e), r) in bodies.iter().zip(rotation.iter_mut()).zip(translation.iter_mut()) {
         let position = body.multiplier.mul_add(positions[body.coordinate], body.offset);
         if body.kind == JointAxisKind::Prismatic {
@@ -541,9 +616,9 @@ fn poses(bodies: &[BodyLanes], positions: &[Lanes], rotation: &mut [M3], transla
         }
         let (sin, cos) = sin_cos(position);
         match body.kind {
-            JointAxisKind::Coordinate { index: 0 } => CoordinateAxis::<0>::turn(body, sin, cos, e),
-            JointAxisKind::Coordinate { index: 1 } => CoordinateAxis::<1>::turn(body, sin, cos, e),
-            JointAxisKind::Coordinate { .. } => CoordinateAxis::<2>::turn(body, sin, cos, e),
+            JointAxisKind::Coordinate { index: 0 } => CoordinateAxis::<0, N>::turn(body, sin, cos, e),
+            JointAxisKind::Coordinate { index: 1 } => CoordinateAxis::<1, N>::turn(body, sin, cos, e),
+            JointAxisKind::Coordinate { .. } => CoordinateAxis::<2, N>::turn(body, sin, cos, e),
             _ => GeneralAxis::turn(body, sin, cos, e),
         }
     }
@@ -555,7 +630,7 @@ fn poses(bodies: &[BodyLanes], positions: &[Lanes], rotation: &mut [M3], transla
 /// independent of the others', is vectorized by the compiler across bodies, lane by lane).
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-fn motions(bodies: &[BodyLanes], rates: &[Lanes], accelerations: &[Lanes], rotation: &[M3], translation: &[V3], lift: &Spatial, velocity: &mut [Spatial], acceleration: &mut [Spatial], force: &mut [Spatial]) {
+fn motions<const N: usize>(bodies: &[BodyLanes<N>], rates: &[Lanes<N>], accelerations: &[Lanes<N>], rotation: &[M3<N>], translation: &[V3<N>], lift: &Spatial<N>, velocity: &mut [Spatial<N>], acceleration: &mut [Spatial<N>], force: &mut [Spatial<N>]) {
     for (i, body) in bodies.iter().enumerate() {
         let (e, r) = (&rotation[i], translation[i]);
         let (v_parent, a_parent) = match body.parent {
@@ -564,9 +639,9 @@ fn motions(bodies: &[BodyLanes], rates: &[Lanes], accelerations: &[Lanes], rotat
         };
         let (rate, joint_acceleration) = (rates[body.coordinate], accelerations[body.coordinate]);
         (velocity[i], acceleration[i]) = match body.kind {
-            JointAxisKind::Coordinate { index: 0 } => revolute_motion(CoordinateAxis::<0> { scale: body.axis[0] }, v_parent, a_parent, rate, joint_acceleration),
-            JointAxisKind::Coordinate { index: 1 } => revolute_motion(CoordinateAxis::<1> { scale: body.axis[1] }, v_parent, a_parent, rate, joint_acceleration),
-            JointAxisKind::Coordinate { .. } => revolute_motion(CoordinateAxis::<2> { scale: body.axis[2] }, v_parent, a_parent, rate, joint_acceleration),
+            JointAxisKind::Coordinate { index: 0 } => revolute_motion(CoordinateAxis::<0, N> { scale: body.axis[0] }, v_parent, a_parent, rate, joint_acceleration),
+            JointAxisKind::Coordinate { index: 1 } => revolute_motion(CoordinateAxis::<1, N> { scale: body.axis[1] }, v_parent, a_parent, rate, joint_acceleration),
+            JointAxisKind::Coordinate { .. } => revolute_motion(CoordinateAxis::<2, N> { scale: body.axis[2] }, v_parent, a_parent, rate, joint_acceleration),
             JointAxisKind::General => revolute_motion(GeneralAxis(body.axis), v_parent, a_parent, rate, joint_acceleration),
             JointAxisKind::Prismatic => {
                 let joint_velocity = scale(body.axis, rate);
@@ -583,7 +658,7 @@ fn motions(bodies: &[BodyLanes], rates: &[Lanes], accelerations: &[Lanes], rotat
 
 /// A revolute joint's body's velocity and acceleration from its parent's (in the body's frame).
 #[inline(always)]
-fn revolute_motion<A: JointAxis>(axis: A, v_parent: Spatial, a_parent: Spatial, rate: Lanes, joint_acceleration: Lanes) -> (Spatial, Spatial) {
+fn revolute_motion<const N: usize, A: JointAxis<N>>(axis: A, v_parent: Spatial<N>, a_parent: Spatial<N>, rate: Lanes<N>, joint_acceleration: Lanes<N>) -> (Spatial<N>, Spatial<N>) {
     let joint_velocity = axis.along(rate);
     let velocity = Spatial { angular: axis.plus(v_parent.angular, joint_velocity), linear: v_parent.linear };
     // v ×ₘ (s·q̇, 0) = (ω × s·q̇, v × s·q̇)
@@ -595,7 +670,7 @@ fn revolute_motion<A: JointAxis>(axis: A, v_parent: Spatial, a_parent: Spatial, 
 /// The recursion from the leaves in: each joint's torque, the body's force carried to its parent;
 /// then the motors' rotors (J_r·N²·q̈).
 #[inline(always)]
-fn torques(bodies: &[BodyLanes], rotation: &[M3], translation: &[V3], accelerations: &[Lanes], armature: &[Lanes], force: &mut [Spatial], torque: &mut [Lanes]) {
+fn torques<const N: usize>(bodies: &[BodyLanes<N>], rotation: &[M3<N>], translation: &[V3<N>], accelerations: &[Lanes<N>], armature: &[Lanes<N>], force: &mut [Spatial<N>], torque: &mut [Lanes<N>]) {
     for ((t, j), q̈) in torque.iter_mut().zip(armature).zip(accelerations) {
         *t = *j * *q̈;
     }
@@ -627,9 +702,9 @@ mod tests {
     #[test]
     fn lanes_sine_and_cosine_are_the_librarys() {
         let mut worst: f64 = 0.0;
-        let mut check = |values: [f64; LANES]| {
+        let mut check = |values: [f64; 4]| {
             let (sin, cos) = sin_cos(Lanes(values));
-            for k in 0..LANES {
+            for k in 0..4 {
                 let (s, c) = values[k].sin_cos();
                 worst = worst.max((sin.0[k] - s).abs()).max((cos.0[k] - c).abs());
             }
@@ -673,36 +748,38 @@ mod tests {
     #[test]
     fn joint_axis_kinds_are_read_from_the_model() {
         let model = every_joint_kind();
-        let kinds: Vec<JointAxisKind> = RneaManyData::new(&model).bodies.iter().map(|b| b.kind).collect();
+        let kinds: Vec<JointAxisKind> = LanesData::<4>::new(&model).bodies.iter().map(|b| b.kind).collect();
         use JointAxisKind::*;
         assert_eq!(kinds, [Coordinate { index: 0 }, Coordinate { index: 1 }, Coordinate { index: 2 }, General, Prismatic, Coordinate { index: 2 }]);
         let so101 = robot("so101.urdf");
-        assert!(RneaManyData::new(&so101).bodies.iter().all(|b| matches!(b.kind, Coordinate { .. })), "the SO-101's joints all turn about an axis of their frames");
+        assert!(LanesData::<4>::new(&so101).bodies.iter().all(|b| matches!(b.kind, Coordinate { .. })), "the SO-101's joints all turn about an axis of their frames");
     }
 
     /// Every state's torques are the scalar RNEA's: the same dynamics in the bodies' frames instead
     /// of the world's, so within a few roundings (1e-12 of the largest torque), on a 6-joint chain, a
     /// branched tree with prismatic joints (Tiago), one with mimic joints (Baxter) and a chain with
-    /// a joint of every kind, over a count of states that leaves a remainder for the scalar path.
+    /// a joint of every kind, in four lanes and in eight (in AVX-512 where the processor has it,
+    /// else in the portable form), over a count of states that leaves a remainder for the scalar
+    /// path.
     #[test]
     fn many_states_give_the_scalar_rneas_torques() {
-        for name in ["so101.urdf", "tiago.urdf", "baxter.urdf", "every joint kind"] {
+        for (name, eight) in ["so101.urdf", "tiago.urdf", "baxter.urdf", "every joint kind"].into_iter().flat_map(|name| [(name, false), (name, true)]) {
             let model = if name == "every joint kind" { every_joint_kind() } else { robot(name) };
             let n = model.dof();
-            let states = 4 * LANES + 3;
+            let states = 4 * 8 + 5;
             let wave = |k: usize, c: usize, f: f64| ((k * n + c) as f64 * f).sin();
             let q: Vec<f64> = (0..states * n).map(|i| wave(i / n, i % n, 0.37)).collect();
             let v: Vec<f64> = (0..states * n).map(|i| 2.0 * wave(i / n, i % n, 0.71)).collect();
             let a: Vec<f64> = (0..states * n).map(|i| 5.0 * wave(i / n, i % n, 1.13)).collect();
             let mut tau = vec![f64::NAN; states * n];
-            rnea_many(&model, &mut RneaManyData::new(&model), &q, &v, &a, &mut tau);
+            rnea_many(&model, &mut RneaManyData::with_width(&model, eight), &q, &v, &a, &mut tau);
             let mut data = Data::new(&model);
             for k in 0..states {
                 let row = k * n..(k + 1) * n;
                 let expected = rnea(&model, &mut data, &q[row.clone()], &v[row.clone()], &a[row.clone()]).to_vec();
                 let scale = expected.iter().fold(1.0f64, |m, x| m.max(x.abs()));
                 for (c, (got, want)) in tau[row].iter().zip(&expected).enumerate() {
-                    assert!((got - want).abs() <= 1e-12 * scale, "{name}: state {k}, coordinate {c}: {got} against rnea's {want}");
+                    assert!((got - want).abs() <= 1e-12 * scale, "{name}, {} lanes: state {k}, coordinate {c}: {got} against rnea's {want}", if eight { 8 } else { 4 });
                 }
             }
         }

@@ -34,7 +34,8 @@ fn algorithms(c: &mut Criterion) {
 }
 
 /// A trajectory's inverse dynamics, 1000 states of the box model and of the SO-101 (six joints):
-/// `rnea_many` (four states in SIMD lanes) against a loop of `rnea`.
+/// `rnea_many` (eight states in SIMD lanes where the processor has AVX-512, else four; and its
+/// four lanes on their own) against a loop of `rnea`.
 fn trajectory(c: &mut Criterion) {
     let so101 = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/robots/so101.urdf");
     let mut group = c.benchmark_group("trajectory_1000_states");
@@ -51,6 +52,13 @@ fn trajectory(c: &mut Criterion) {
         group.bench_function(format!("rnea_many/{robot}"), |b| {
             b.iter(|| {
                 rnea_many(&model, &mut many, black_box(&q), black_box(&v), black_box(&a), &mut tau);
+                black_box(tau[0])
+            })
+        });
+        let mut four = RneaManyData::with_four_lanes(&model);
+        group.bench_function(format!("rnea_many_four_lanes/{robot}"), |b| {
+            b.iter(|| {
+                rnea_many(&model, &mut four, black_box(&q), black_box(&v), black_box(&a), &mut tau);
                 black_box(tau[0])
             })
         });
