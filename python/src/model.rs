@@ -19,6 +19,9 @@ pub struct Model {
     model: armscope::model::Model,
     /// The workspace of single-state calls (a trajectory's call makes its own, without the GIL).
     data: Mutex<Data>,
+    /// A trajectory's RNEA workspace, made once: each call (each of its tasks, split over the
+    /// cores) clones it, sharing the model's numbers in lanes.
+    rnea_many: dynamics::RneaManyData,
 }
 
 /// A C-contiguous float64 array of `x` (a float64 NumPy array as it is; anything else through
@@ -191,7 +194,8 @@ impl Model {
             warnings.call_method1("warn", (format!("armscope: {notice}"),))?;
         }
         let data = Mutex::new(Data::new(&model));
-        Ok(Self { model, data })
+        let rnea_many = dynamics::RneaManyData::new(&model);
+        Ok(Self { model, data, rnea_many })
     }
 
     /// The URDF it was loaded from.
@@ -250,7 +254,7 @@ impl Model {
             return self.over(py, states, &[self.dof()], |model, data, x, out| out.copy_from_slice(dynamics::rnea(model, data, x[0], x[1], x[2])));
         }
         // a trajectory: eight states at a time in SIMD lanes (AVX-512), or four (AVX2)
-        self.over_blocks(py, states, &[self.dof()], dynamics::RneaManyData::new, |model, data, x, out| dynamics::rnea_many(model, data, x[0], x[1], x[2], out))
+        self.over_blocks(py, states, &[self.dof()], |_| self.rnea_many.clone(), |model, data, x, out| dynamics::rnea_many(model, data, x[0], x[1], x[2], out))
     }
 
     /// Forward dynamics (ABA): the accelerations the torques `tau` give at positions `q` and

@@ -15,6 +15,7 @@ use super::{Data, rnea};
 use crate::model::{JointMotion, Model};
 use nalgebra::{Matrix3, Vector3};
 use std::ops::{Add, Mul, Neg, Sub};
+use std::sync::Arc;
 
 /// One number of the algorithm, for each of `N` states side by side (four fill an AVX2 register,
 /// eight an AVX-512 one; aligned to a cache line for both: an eight split across two lines loads
@@ -399,12 +400,22 @@ impl<const N: usize> JointAxis<N> for GeneralAxis<N> {
     }
 }
 
-/// The lanes' part of [`RneaManyData`], for `N` states side by side: the bodies' constants in
-/// lanes; per body, its lanes' pose in its parent's frame and its velocity, acceleration and force
-/// in its own frame.
+/// The model's numbers in `N` lanes, made once and shared by every workspace cloned from the one
+/// that made them (a trajectory split over the cores clones one per task).
+struct LanesModel<const N: usize> {
+    bodies: Vec<BodyLanes<N>>,
+    /// Per coordinate, its motor's rotor inertia seen at the joint, J_r·N².
+    armature: Vec<Lanes<N>>,
+    /// The world's acceleration upward (the negated gravity), in the world's frame.
+    lift: Spatial<N>,
+}
+
+/// The lanes' part of [`RneaManyData`], for `N` states side by side: the model's numbers (shared);
+/// per body, its lanes' pose in its parent's frame and its velocity, acceleration and force in its
+/// own frame.
 #[derive(Clone)]
 struct LanesData<const N: usize> {
-    bodies: Vec<BodyLanes<N>>,
+    model: Arc<LanesModel<N>>,
     /// The body frame's axes in its parent's frame (columns), E.
     rotation: Vec<M3<N>>,
     /// The body frame's origin in its parent's frame, r.
@@ -414,11 +425,7 @@ struct LanesData<const N: usize> {
     velocity: Vec<Spatial<N>>,
     acceleration: Vec<Spatial<N>>,
     force: Vec<Spatial<N>>,
-    /// Per coordinate, its motor's rotor inertia seen at the joint, J_r·N².
-    armature: Vec<Lanes<N>>,
     tau: Vec<Lanes<N>>,
-    /// The world's acceleration upward (the negated gravity), in the world's frame.
-    lift: Spatial<N>,
 }
 
 impl<const N: usize> LanesData<N> {
@@ -434,14 +441,12 @@ impl<const N: usize> LanesData<N> {
         Self {
             rotation: rotation.collect(),
             translation: bodies.iter().map(|body| body.origin).collect(),
-            bodies,
-            inputs: std::array::from_fn(|_| vec![Lanes::<N>::default(); model.dof()]),
+            inputs: std::array::from_fn(|_| vec![Lanes::default(); model.dof()]),
             velocity: vec![Spatial::default(); model.bodies.len()],
             acceleration: vec![Spatial::default(); model.bodies.len()],
             force: vec![Spatial::default(); model.bodies.len()],
-            armature: model.armature.iter().map(|&j| Lanes::splat(j)).collect(),
-            tau: vec![Lanes::<N>::default(); model.dof()],
-            lift: Spatial { angular: V3::default(), linear: v3(&-model.gravity) },
+            tau: vec![Lanes::default(); model.dof()],
+            model: Arc::new(LanesModel { bodies, armature: model.armature.iter().map(|&j| Lanes::splat(j)).collect(), lift: Spatial { angular: V3::default(), linear: v3(&-model.gravity) } }),
         }
     }
 }
@@ -458,11 +463,13 @@ enum Width {
 }
 
 /// The workspace of [`rnea_many`], sized once for a model: the lanes' (see `LanesData`), and the
-/// scalar algorithm's for the states left over when the count is not a multiple of the lanes.
+/// scalar algorithm's for the states left over when the count is not a multiple of the lanes (made
+/// when first needed). A clone shares the model's numbers: cloning one made for a model is the
+/// cheap way to another (a microsecond, where making one takes ~10).
 #[derive(Clone)]
 pub struct RneaManyData {
     width: Width,
-    scalar: Data,
+    scalar: Option<Box<Data>>,
 }
 
 impl RneaManyData {
@@ -478,7 +485,7 @@ impl RneaManyData {
     /// Eight lanes or four, as asked (the tests run both on any processor).
     fn with_width(model: &Model, eight: bool) -> Self {
         let width = if eight { Width::Eight(LanesData::new(model)) } else { Width::Four(LanesData::new(model)) };
-        Self { width, scalar: Data::new(model) }
+        Self { width, scalar: None }
     }
 }
 
@@ -498,8 +505,8 @@ pub fn rnea_many(model: &Model, data: &mut RneaManyData, q: &[f64], v: &[f64], a
     let n = model.dof();
     assert!(q.len() == tau.len() && v.len() == tau.len() && a.len() == tau.len() && (n == 0 || tau.len() % n == 0), "rnea_many: rows of {n} values each");
     let (bodies, dof) = match &data.width {
-        Width::Four(lanes) => (lanes.bodies.len(), lanes.tau.len()),
-        Width::Eight(lanes) => (lanes.bodies.len(), lanes.tau.len()),
+        Width::Four(lanes) => (lanes.model.bodies.len(), lanes.tau.len()),
+        Width::Eight(lanes) => (lanes.model.bodies.len(), lanes.tau.len()),
     };
     assert!(bodies == model.bodies.len() && dof == n, "rnea_many: a workspace made for another model");
     if n == 0 {
@@ -537,9 +544,12 @@ pub fn rnea_many(model: &Model, data: &mut RneaManyData, q: &[f64], v: &[f64], a
             whole
         }
     };
-    for k in whole..states {
-        let row = k * n..(k + 1) * n;
-        tau[row.clone()].copy_from_slice(rnea(model, &mut data.scalar, &q[row.clone()], &v[row.clone()], &a[row]));
+    if whole < states {
+        let scalar = data.scalar.get_or_insert_with(|| Box::new(Data::new(model)));
+        for k in whole..states {
+            let row = k * n..(k + 1) * n;
+            tau[row.clone()].copy_from_slice(rnea(model, scalar, &q[row.clone()], &v[row.clone()], &a[row]));
+        }
     }
 }
 
@@ -560,7 +570,8 @@ fn lanes_avx512(data: &mut LanesData<8>, q: &[f64], v: &[f64], a: &[f64], tau: &
 /// loop of its own (each loop's numbers fit the registers better than one loop doing all).
 #[inline(always)]
 fn lanes_portable<const N: usize>(data: &mut LanesData<N>, q: &[f64], v: &[f64], a: &[f64], tau: &mut [f64], whole: usize) {
-    let LanesData { bodies, rotation, translation, inputs, velocity, acceleration, force, armature, tau: torque, lift } = data;
+    let LanesData { model, rotation, translation, inputs, velocity, acceleration, force, tau: torque } = data;
+    let LanesModel { bodies, armature, lift } = &**model;
     let n = torque.len();
     let group = N * n;
     for (first, out) in (0..whole).step_by(N).zip(tau[..whole * n].chunks_exact_mut(group)) {
@@ -748,11 +759,11 @@ mod tests {
     #[test]
     fn joint_axis_kinds_are_read_from_the_model() {
         let model = every_joint_kind();
-        let kinds: Vec<JointAxisKind> = LanesData::<4>::new(&model).bodies.iter().map(|b| b.kind).collect();
+        let kinds: Vec<JointAxisKind> = LanesData::<4>::new(&model).model.bodies.iter().map(|b| b.kind).collect();
         use JointAxisKind::*;
         assert_eq!(kinds, [Coordinate { index: 0 }, Coordinate { index: 1 }, Coordinate { index: 2 }, General, Prismatic, Coordinate { index: 2 }]);
         let so101 = robot("so101.urdf");
-        assert!(LanesData::<4>::new(&so101).bodies.iter().all(|b| matches!(b.kind, Coordinate { .. })), "the SO-101's joints all turn about an axis of their frames");
+        assert!(LanesData::<4>::new(&so101).model.bodies.iter().all(|b| matches!(b.kind, Coordinate { .. })), "the SO-101's joints all turn about an axis of their frames");
     }
 
     /// Every state's torques are the scalar RNEA's: the same dynamics in the bodies' frames instead
