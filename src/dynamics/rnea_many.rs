@@ -465,7 +465,7 @@ enum Width {
 /// The workspace of [`rnea_many`], sized once for a model: the lanes' (see `LanesData`), and the
 /// scalar algorithm's for the states left over when the count is not a multiple of the lanes (made
 /// when first needed). A clone shares the model's numbers: cloning one made for a model is the
-/// cheap way to another (a microsecond, where making one takes ~10).
+/// cheap way to another (3 µs for the UR5 here, where making one takes 6–12).
 #[derive(Clone)]
 pub struct RneaManyData {
     width: Width,
