@@ -132,7 +132,7 @@ pub(super) fn mat_vec<const N: usize>(m: &M3<N>, v: V3<N>) -> V3<N> {
 
 /// Beyond this many radians a lane's sine and cosine are the library's (the reduction below keeps its
 /// accuracy to about 1e8 rad; a joint is nowhere near either).
-pub(super) const REDUCED_UP_TO: f64 = 1e6;
+const REDUCED_UP_TO: f64 = 1e6;
 
 /// (sin x, cos x) of each lane, to within two units in the last place of the library's: x less the
 /// nearest multiple k of π/2 (π/2 in three parts, Cody and Waite's reduction, each product k·part

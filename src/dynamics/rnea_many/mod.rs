@@ -230,9 +230,9 @@ fn lanes_avx512(data: &mut LanesData<8>, q: &[f64], v: &[f64], a: &[f64], tau: &
     lanes_portable(data, q, v, a, tau, whole);
 }
 
-/// The first `whole` states (a multiple of `N`), `N` at a time: the bodies' poses,
-/// then their motion out from the root, the forces it needs, and the torques back in, each pass a
-/// loop of its own (each loop's numbers fit the registers better than one loop doing all).
+/// The first `whole` states (a multiple of `N`), `N` at a time: the bodies' poses in a loop of
+/// their own (independent of each other, and fewer numbers in the registers than one loop doing
+/// all), then their motion out from the root with the forces it needs, and the torques back in.
 #[inline(always)]
 fn lanes_portable<const N: usize>(data: &mut LanesData<N>, q: &[f64], v: &[f64], a: &[f64], tau: &mut [f64], whole: usize) {
     let LanesData { model, rotation, translation, inputs, velocity, acceleration, force, tau: torque } = data;
@@ -241,7 +241,7 @@ fn lanes_portable<const N: usize>(data: &mut LanesData<N>, q: &[f64], v: &[f64],
     let group = N * n;
     for (first, out) in (0..whole).step_by(N).zip(tau[..whole * n].chunks_exact_mut(group)) {
         let rows = first * n..first * n + group;
-        // the group's rows into lanes, a coordinate at a time: one register from four rows
+        // the group's rows into lanes, a coordinate at a time: one register from its N rows
         for (lanes, x) in inputs.iter_mut().zip([&q[rows.clone()], &v[rows.clone()], &a[rows]]) {
             for (c, coordinate) in lanes.iter_mut().enumerate() {
                 *coordinate = Lanes(std::array::from_fn(|k| x[k * n + c]));

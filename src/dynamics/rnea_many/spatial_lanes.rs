@@ -21,10 +21,10 @@ impl<const N: usize> Spatial<N> {
 /// [`SpatialInertia`](crate::spatial::SpatialInertia)): constant, so made once with the workspace.
 #[derive(Clone, Copy, Default)]
 pub(super) struct Inertia<const N: usize> {
-    pub(super) mass: Lanes<N>,
-    pub(super) first_moment: V3<N>,
+    mass: Lanes<N>,
+    first_moment: V3<N>,
     /// xx, yy, zz, xy, xz, yz.
-    pub(super) rotational: [Lanes<N>; 6],
+    rotational: [Lanes<N>; 6],
 }
 
 impl<const N: usize> Inertia<N> {
