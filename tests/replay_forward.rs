@@ -68,7 +68,7 @@ fn replay_forward_on(root: &Path, dir: &Path, payload: f64, motors: &Path) -> ar
     let commands = source.read(0, "action").unwrap();
     let map = JointMap::builtin(source.kind(), &model, &observed).expect("the SO-101's built-in map");
     let replayer = Replayer::new(model, &ReplayOptions { payload, motors: Some(motors.to_path_buf()), ..Default::default() }, map).unwrap();
-    let options = ForwardOptions { motors: motors.to_path_buf(), payload, tool: None, schedule: dir.join(format!("commands_{payload}.csv")), recordings: None, latency: None };
+    let options = ForwardOptions { motors: motors.to_path_buf(), payload, tool: None, schedule: dir.join(format!("commands_{payload}.csv")), recordings: None, latency: None, trace: None };
     forward(&replayer, &options, &commands, &observed).unwrap()
 }
 
@@ -125,7 +125,7 @@ fn forward_replay_from_the_command_line_writes_its_findings_and_needs_a_dataset(
     let root = dataset(dir.path());
     let json = dir.path().join("forward.json");
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_armscope"))
-        .args(["replay", root.to_str().unwrap(), "--urdf", so101().to_str().unwrap(), "--motors", motors().to_str().unwrap(), "--payload", "0.2", "--units", "degrees", "--forward", "--summary-json", json.to_str().unwrap()])
+        .args(["replay", root.to_str().unwrap(), "--urdf", so101().to_str().unwrap(), "--motors", motors().to_str().unwrap(), "--payload", "0.2", "--units", "degrees", "--forward", "--summary-json", json.to_str().unwrap(), "--trace", "frames.csv"])
         .current_dir(dir.path())
         .output()
         .unwrap();
@@ -135,6 +135,18 @@ fn forward_replay_from_the_command_line_writes_its_findings_and_needs_a_dataset(
     let doc: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
     assert_eq!(doc["episodes"][0]["joints"].as_array().unwrap().len(), 6);
     assert!(doc["episodes"][0]["joints"][1]["gap_mae"].as_f64().unwrap() < 2e-3);
+    // the frames compared, as --trace writes them: a row per frame, each joint's command, real and
+    // simulated position, from which the report's mean gap follows exactly
+    let trace = std::fs::read_to_string(dir.path().join("frames.csv")).unwrap();
+    let mut lines = trace.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    assert_eq!(header.len(), 1 + 3 * 6);
+    assert_eq!((header[0], header[2], header[8], header[14]), ("t", "command_shoulder_lift", "real_shoulder_lift", "model_shoulder_lift"));
+    let rows: Vec<Vec<f64>> = lines.map(|l| l.split(',').map(|v| v.parse().unwrap()).collect()).collect();
+    assert_eq!(rows.len(), FRAMES);
+    assert!((rows[FRAMES - 1][0] - (FRAMES - 1) as f64 / 30.0).abs() < 1e-6, "t from the first frame");
+    let gap: f64 = rows.iter().map(|r| (r[14] - r[8]).abs()).sum::<f64>() / FRAMES as f64;
+    assert!((gap - doc["episodes"][0]["joints"][1]["gap_mae"].as_f64().unwrap()).abs() < 1e-15, "the trace's gap {gap} is the report's");
     // the recordings: the simulated arm as a run records it, the real follower beside it — at each
     // frame's time exactly the recorded (mapped) position, between frames on the line between them
     let (rrd, mcap) = (dir.path().join("recordings/forward_so101_follow_episode_0.rrd"), dir.path().join("recordings/forward_so101_follow_episode_0.mcap"));

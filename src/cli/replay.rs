@@ -27,8 +27,9 @@ pub struct ReplayArgs {
     /// reflected inertia, the winding's heat); without it, the URDF's effort limits.
     #[arg(long, value_name = "FILE")]
     pub motors: Option<PathBuf>,
-    /// Write `t,q1..qN,qd1..qN,qdd1..qN,tau1..tauN` per sample (several episodes: one file each,
-    /// `STEM_episode_N.csv`).
+    /// Write `t,q1..qN,qd1..qN,qdd1..qN,tau1..tauN` per sample; with --forward, per frame each
+    /// joint's command, real and simulated position, `t,command_J..,real_J..,model_J..` (several
+    /// episodes: one file each, `STEM_episode_N.csv`).
     #[arg(long, value_name = "FILE")]
     pub trace: Option<PathBuf>,
     /// Write every episode's findings as JSON.
@@ -183,6 +184,7 @@ fn forward(args: &ReplayArgs, replayer: &Replayer, source: &crate::motion::Sourc
             None if dataset => None,
             None => Some(Latency::given(0.0, "a controller's set point, acted on when recorded")),
         },
+        trace: args.trace.as_ref().map(|path| if several { trace_path(path, index) } else { path.clone() }),
     };
     let wrote = |options: &ForwardOptions| {
         for path in options.recordings.iter().flat_map(|r| r.rrd.iter().chain(&r.mcap)) {

@@ -73,6 +73,8 @@ pub struct ForwardOptions {
     /// How long after its frame a command reaches the servos (None: the recording's frame period,
     /// a teleop loop's one frame).
     pub latency: Option<Latency>,
+    /// Where to write the frames compared, command, real and simulated (None: nowhere).
+    pub trace: Option<PathBuf>,
 }
 
 /// The longest command latency accepted, s: a teleop loop slower than this is not one.
@@ -105,7 +107,11 @@ impl Latency {
 pub fn forward(replayer: &Replayer, options: &ForwardOptions, commands: &Episode, observed: &Episode) -> Result<ForwardReplay, Error> {
     let case = ForwardCase::prepare(replayer, commands, observed, &options.schedule, options.latency.clone())?;
     let setup = FollowSetup { payload: options.payload, tool: options.tool.as_deref(), offsets: None };
-    follow(&replayer.base_model, &case, &Drives::File(&options.motors), &setup, options.recordings.as_ref())
+    let replay = follow(&replayer.base_model, &case, &Drives::File(&options.motors), &setup, options.recordings.as_ref())?;
+    if let Some(path) = &options.trace {
+        super::trace::write_forward(path, &replay)?;
+    }
+    Ok(replay)
 }
 
 /// An episode made ready to be followed, as many times as asked (identification follows it once per

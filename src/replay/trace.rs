@@ -1,6 +1,8 @@
 //! `replay --trace FILE.csv`: one row per sample, `t,q1..qN,qd1..qN,qdd1..qN,tau1..tauN` in the
 //! joint order of `armscope model`, t in seconds from the episode's first sample, every number
-//! round-trip exact. The CSV writer here also writes the joint schedules of [`super::schedule`].
+//! round-trip exact; with `--forward`, one row per frame, each compared joint's commanded, real and
+//! simulated position (`t,command_J..,real_J..,model_J..`). The CSV writer here also writes the
+//! joint schedules of [`super::schedule`].
 
 use super::inverse::Motion;
 use crate::error::Error;
@@ -17,6 +19,16 @@ pub fn header(n: usize) -> Vec<String> {
 
 pub fn write(path: &Path, motion: &Motion) -> Result<(), Error> {
     write_columns(path, &header(motion.q.len()), &motion.time, 0.0, &[&motion.q, &motion.qd, &motion.qdd, &motion.needed])
+}
+
+/// A forward replay's frames: `t`, then each compared joint's command, the real follower's and the
+/// simulated follower's positions, named by joint.
+pub fn write_forward(path: &Path, replay: &super::forward::ForwardReplay) -> Result<(), Error> {
+    let mut header = vec!["t".to_string()];
+    for prefix in ["command", "real", "model"] {
+        header.extend(replay.joints.iter().map(|g| format!("{prefix}_{}", g.joint)));
+    }
+    write_columns(path, &header, &replay.time, 0.0, &[&replay.commanded, &replay.observed, &replay.simulated])
 }
 
 /// A CSV under `header`: per sample k, `time[k] − t0`, then every joint of each of `series` in turn,
