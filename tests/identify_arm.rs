@@ -145,6 +145,11 @@ fn a_simulated_so101_is_identified_back_and_its_held_out_episode_predicted() {
     let stiffness = |p: &Value| p["kt"].as_f64().unwrap() * p["error_gain_ratio"].as_f64().unwrap();
     let truth_stiffness = truth.kt * truth.error_gain_ratio;
     assert!((stiffness(fitted) / truth_stiffness - 1.0).abs() < 0.1, "k_t × error gain {:.3}, truly {truth_stiffness:.3}", stiffness(fitted));
+    // the report holds it against the catalogue's (the same resistance): 1.04 in truth, within
+    // 3/4–4/3, so no verdict on the servos' strength
+    let against = doc["servos"][0]["against_start"]["holding_stiffness"].as_f64().unwrap();
+    assert!((against - stiffness(fitted) / (start.kt * start.error_gain_ratio)).abs() < 1e-12, "holding stiffness ×{against}");
+    assert!(stdout.contains(&format!("holding stiffness ×{against:.2}")) && !stdout.contains("the real servos hold"), "{stdout}");
     // the payload within 40 g of 150 (measured 129): on swings of ±0.4 rad it trades with the
     // loop's stiffness (a lighter payload on a softer loop sags the same)
     let payload = doc["payload_kg"].as_f64().unwrap();

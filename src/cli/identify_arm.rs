@@ -304,6 +304,13 @@ pub fn identify_arm(args: &IdentifyArgs, dataset: &Path) -> Result<i32, Error> {
                 p.friction.get("friction_base").unwrap_or(0.0),
                 p.friction.get("friction_viscous").unwrap_or(0.0)
             );
+            let strength = crate::identify::arm::Strength::of(p, &kind.start);
+            println!(
+                "    against the motor file's: holding stiffness ×{:.2} (k_t × error gain / R: the loop's torque per error), stall torque ×{:.2} (k_t / R){}",
+                strength.holding_stiffness,
+                strength.stall_torque,
+                strength.verdict().map_or(String::new(), |v| format!(": {v}"))
+            );
         }
         if arm.fit_payload {
             println!("  payload {:.3} kg", found.payload);
@@ -321,7 +328,7 @@ pub fn identify_arm(args: &IdentifyArgs, dataset: &Path) -> Result<i32, Error> {
         println!("wrote {} ({})", args.out.display(), servo_files.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", "));
     }
     if let Some(path) = &args.summary_json {
-        let kinds: Vec<serde_json::Value> = space.kinds.iter().zip(&found.params).map(|(k, p)| serde_json::json!({ "servo": k.name, "joints": k.joints.iter().map(|&j| name(j)).collect::<Vec<_>>(), "params": p.to_json() })).collect();
+        let kinds: Vec<serde_json::Value> = space.kinds.iter().zip(&found.params).map(|(k, p)| serde_json::json!({ "servo": k.name, "joints": k.joints.iter().map(|&j| name(j)).collect::<Vec<_>>(), "params": p.to_json(), "against_start": crate::identify::arm::Strength::of(p, &k.start) })).collect();
         let documents = |replays: &[ForwardReplay], episodes: &[i64]| -> Vec<serde_json::Value> { replays.iter().zip(episodes).map(|(r, &e)| ForwardSummary::of(e, r, Vec::new()).document).collect() };
         let doc = serde_json::json!({
             "from": dataset.display().to_string(),

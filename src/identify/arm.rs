@@ -59,6 +59,36 @@ pub fn fittable(motors: &MotorSet, fitted: &[usize]) -> Vec<&'static str> {
     keys
 }
 
+/// How a fitted servo holds against the one it started from, at the same P gain and supply: the
+/// position loop's torque per rad of error (k_t·e_g·r·k_p·V/R: the ratio of k_t × error gain / R)
+/// and its stall torque (k_t·d_max·V/R: the ratio of k_t / R). An arm's episodes pin the first
+/// (within 10 % on a simulated follower); k_t and the error gain apart trade with each other.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Strength {
+    pub holding_stiffness: f64,
+    pub stall_torque: f64,
+}
+
+impl Strength {
+    pub fn of(fitted: &ServoParams, start: &ServoParams) -> Self {
+        let stiffness = |p: &ServoParams| p.kt * p.error_gain_ratio / p.resistance;
+        let stall = |p: &ServoParams| p.kt / p.resistance;
+        Self { holding_stiffness: stiffness(fitted) / stiffness(start), stall_torque: stall(fitted) / stall(start) }
+    }
+
+    /// What a holding stiffness outside 3/4–4/3 of the start's says of the real servos, in words
+    /// (None within it: the catalogue's servo, as far as these episodes tell).
+    pub fn verdict(&self) -> Option<&'static str> {
+        if self.holding_stiffness < 0.75 {
+            Some("the real servos hold weaker than the motor file's: a lower supply, a weaker variant of the servo, or a load at the tool the URDF lacks (--fit-payload)")
+        } else if self.holding_stiffness > 4.0 / 3.0 {
+            Some("the real servos hold stiffer than the motor file's: a higher supply, a stronger variant of the servo, or a higher P gain than the motor file's kp")
+        } else {
+            None
+        }
+    }
+}
+
 /// The loss of a candidate whose run diverged or failed, rad: worse than any follower's gap.
 const FAILED: f64 = 10.0;
 
@@ -273,4 +303,34 @@ pub fn fit_arm(objective: &ArmObjective, options: &ArmFitOptions, progress: &(dy
     }
     let (params, payload, offsets) = objective.space.decode(&best);
     Ok(ArmFit { point: best, params, payload, offsets, loss: best_loss, start_loss, evaluations })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Strength;
+
+    #[test]
+    fn strength_is_held_against_the_start_at_the_same_gain_and_supply() {
+        let catalogue = crate::actuator::Catalogue::load(std::path::Path::new(crate::actuator::catalogue::DEFAULT_CATALOGUE)).unwrap();
+        let start = catalogue.servo_params("STS3215-C018").unwrap().unwrap();
+        let scaled = |kt: f64, gain: f64, resistance: f64| {
+            let mut p = start.clone();
+            p.kt *= kt;
+            p.error_gain_ratio *= gain;
+            p.resistance *= resistance;
+            Strength::of(&p, &start)
+        };
+        // a servo of 0.65 the torque constant (the STS3215's 19.5 kg·cm 7.4 V variant against the
+        // 30 kg·cm 12 V one) and 0.8 the loop gain holds with half the stiffness: said so
+        let weak = scaled(0.65, 0.8, 1.0);
+        assert!((weak.holding_stiffness - 0.52).abs() < 1e-12 && (weak.stall_torque - 0.65).abs() < 1e-12, "{weak:?}");
+        assert!(weak.verdict().unwrap().starts_with("the real servos hold weaker"));
+        // twice the resistance halves both
+        let resistive = scaled(1.0, 1.0, 2.0);
+        assert!((resistive.holding_stiffness - 0.5).abs() < 1e-12 && (resistive.stall_torque - 0.5).abs() < 1e-12);
+        // k_t and the gain traded against each other: the same stiffness, no verdict
+        assert!((scaled(0.8, 1.25, 1.0).holding_stiffness - 1.0).abs() < 1e-12);
+        assert_eq!(scaled(0.8, 1.25, 1.0).verdict(), None);
+        assert!(scaled(1.5, 1.0, 1.0).verdict().unwrap().starts_with("the real servos hold stiffer"));
+    }
 }
