@@ -85,6 +85,22 @@ fn a_range_dataset_is_read_as_a_range_and_its_calibration_gives_the_motors_angle
             assert!((a[j] - b[j]).abs() < 1e-9, "{a:?} vs {b:?}");
         }
     }
+    // the same calibration named by a joint map: the same angles, the gripper's 0…100 over its
+    // limits in both (LeRobot gives it no angle, so its calibrated travel's middle is no URDF zero)
+    let map = dir.path().join("map.toml");
+    let mut text = format!("calibration = {:?}\n", cal.file_name().unwrap().to_str().unwrap());
+    for (joint, unit) in [("shoulder_pan", "range_m100_100"), ("shoulder_lift", "range_m100_100"), ("elbow_flex", "range_m100_100"), ("wrist_flex", "range_m100_100"), ("wrist_roll", "range_m100_100"), ("gripper", "range_0_100")] {
+        text += &format!("[joints.{joint}]\ncolumn = \"{joint}.pos\"\nunit = \"{unit}\"\n");
+    }
+    std::fs::write(&map, text).unwrap();
+    let mapped = dir.path().join("mapped.csv");
+    let (code, _, stderr) = run(&["replay", root_s, "--urdf", urdf.to_str().unwrap(), "--joint-map", map.to_str().unwrap(), "--trace", mapped.to_str().unwrap(), "--no-rrd", "--no-mcap"]);
+    assert_eq!(code, 0, "{stderr}");
+    for (a, b) in trace_q(&mapped).iter().zip(&q) {
+        for j in 0..6 {
+            assert!((a[j] - b[j]).abs() < 1e-12, "{a:?} vs {b:?}");
+        }
+    }
     // a joint that barely moves leaves too few values to tell its range: its limits, said approximate
     let mut still = motions();
     still[4] = Sines { center: 0.0, terms: vec![(0.004, 0.9, 0.0)] };

@@ -145,9 +145,11 @@ impl JointMap {
             let ranged = matches!(e.unit, Unit::Range0To100 | Unit::RangeM100To100);
             let limits = model.joints[joint].lower.is_finite() && model.joints[joint].upper.is_finite();
             let motor = e.motor.clone().unwrap_or_else(|| e.column.trim_end_matches(".pos").to_string());
+            // a 0…100 column (LeRobot's gripper) keeps its limits, as the built-in map does: LeRobot
+            // gives it no angle, so where the URDF's zero lies in its calibrated travel nothing says
             let calibration = match &calibration {
-                Some(c) => Some(*c.get(&motor).ok_or_else(|| fail(format!("[joints.{name}]: no motor '{motor}' in the calibration file (motors: {})", c.keys().cloned().collect::<Vec<_>>().join(", "))))?),
-                None => None,
+                Some(c) if e.unit != Unit::Range0To100 => Some(*c.get(&motor).ok_or_else(|| fail(format!("[joints.{name}]: no motor '{motor}' in the calibration file (motors: {})", c.keys().cloned().collect::<Vec<_>>().join(", "))))?),
+                _ => None,
             };
             if ranged && calibration.is_none() && !limits {
                 return Err(fail(format!("[joints.{name}]: unit {} maps onto the joint's limits, and the URDF gives it none (give a calibration file, or unit deg/rad)", e.unit.name())));
