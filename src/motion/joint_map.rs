@@ -152,7 +152,8 @@ impl JointMap {
                 _ => None,
             };
             if ranged && calibration.is_none() && !limits {
-                return Err(fail(format!("[joints.{name}]: unit {} maps onto the joint's limits, and the URDF gives it none (give a calibration file, or unit deg/rad)", e.unit.name())));
+                let instead = if e.unit == Unit::Range0To100 { "unit deg/rad" } else { "give a calibration file, or unit deg/rad" };
+                return Err(fail(format!("[joints.{name}]: unit {} maps onto the joint's limits, and the URDF gives it none ({instead})", e.unit.name())));
             }
             entries.push(Entry { joint, column: e.column, unit: e.unit, sign: e.sign, offset: e.offset, calibration });
         }
@@ -337,6 +338,28 @@ mod tests {
         assert!(why.contains("2 exactly at ±100"), "{why}");
         let why = decide_body_unit(&[("shoulder_pan.pos", &[10.0, -40.0]), ("elbow_flex.pos", &[99.6])]).unwrap_err();
         assert!(why.contains("the widest elbow_flex.pos at 99.6") && why.contains("none at ±100"), "{why}");
+    }
+
+    #[test]
+    fn a_map_says_what_a_joint_without_limits_needs_for_its_unit() {
+        // a range maps onto limits; a calibration file gives a -100…100 column an angle of its own,
+        // never a 0…100 one (LeRobot gives a gripper no angle)
+        let urdf = r#"<robot name="wheel"><link name="base"/><link name="disc"><inertial><mass value="1"/><inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial></link>
+            <joint name="spin" type="continuous"><parent link="base"/><child link="disc"/><axis xyz="0 0 1"/></joint></robot>"#;
+        let model = crate::model::load_urdf_str(urdf, Path::new("wheel.urdf")).unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("cal.json"), r#"{"spin": {"id": 1, "drive_mode": 0, "homing_offset": 0, "range_min": 0, "range_max": 4095}}"#).unwrap();
+        let map = |unit: &str, calibrated: bool| {
+            let path = dir.path().join("map.toml");
+            let calibration = if calibrated { "calibration = \"cal.json\"\n" } else { "" };
+            std::fs::write(&path, format!("{calibration}[joints.spin]\ncolumn = \"spin.pos\"\nunit = \"{unit}\"\n")).unwrap();
+            JointMap::load(&path, &model).map(|_| ()).map_err(|e| e.to_string())
+        };
+        assert_eq!(map("range_m100_100", true), Ok(()));
+        let error = map("range_m100_100", false).unwrap_err();
+        assert!(error.contains("[joints.spin]: unit range_m100_100 maps onto the joint's limits, and the URDF gives it none (give a calibration file, or unit deg/rad)"), "{error}");
+        let error = map("range_0_100", true).unwrap_err();
+        assert!(error.contains("[joints.spin]: unit range_0_100 maps onto the joint's limits, and the URDF gives it none (unit deg/rad)"), "{error}");
     }
 
     #[test]
