@@ -210,7 +210,8 @@ fn forward(args: &ReplayArgs, replayer: &Replayer, source: &crate::motion::Sourc
     }
     if let (true, true, Some(widest)) = (several, wants_recordings, summaries.first()) {
         println!("recorded: episode {}, the widest gap ({:.1} mrad mean on its worst joint)", widest.index, widest.widest_gap * 1e3);
-        let options = options(widest.index, true);
+        // its trace was written with its summary
+        let options = ForwardOptions { trace: None, ..options(widest.index, true) };
         let (commands, observed) = source.read_forward(widest.index, &args.recorded.feature, &commands)?;
         forward(replayer, &options, &commands, &observed)?;
         wrote(&options);

@@ -321,7 +321,8 @@ mod tests {
             Strength::of(&p, &start)
         };
         // a servo of 0.65 the torque constant (the STS3215's 19.5 kg·cm 7.4 V variant against the
-        // 30 kg·cm 12 V one) and 0.8 the loop gain holds with half the stiffness: said so
+        // 30 kg·cm 12 V one, catalogue-sources.md §2) and 0.8 the loop gain holds with half the
+        // stiffness: said so
         let weak = scaled(0.65, 0.8, 1.0);
         assert!((weak.holding_stiffness - 0.52).abs() < 1e-12 && (weak.stall_torque - 0.65).abs() < 1e-12, "{weak:?}");
         assert!(weak.verdict().unwrap().starts_with("the real servos hold weaker"));

@@ -52,6 +52,13 @@ impl Unit {
             Unit::RangeM100To100 => "range_m100_100",
         }
     }
+
+    /// Whether a calibration file turns this unit's values into the motor's angle: all but LeRobot's
+    /// 0…100 (its gripper), which LeRobot gives no angle — where the URDF's zero lies in its
+    /// calibrated travel nothing says, so it maps onto the joint's limits.
+    pub fn takes_calibration(self) -> bool {
+        self != Unit::Range0To100
+    }
 }
 
 /// LeRobot's per-motor calibration record.
@@ -145,14 +152,12 @@ impl JointMap {
             let ranged = matches!(e.unit, Unit::Range0To100 | Unit::RangeM100To100);
             let limits = model.joints[joint].lower.is_finite() && model.joints[joint].upper.is_finite();
             let motor = e.motor.clone().unwrap_or_else(|| e.column.trim_end_matches(".pos").to_string());
-            // a 0…100 column (LeRobot's gripper) keeps its limits, as the built-in map does: LeRobot
-            // gives it no angle, so where the URDF's zero lies in its calibrated travel nothing says
             let calibration = match &calibration {
-                Some(c) if e.unit != Unit::Range0To100 => Some(*c.get(&motor).ok_or_else(|| fail(format!("[joints.{name}]: no motor '{motor}' in the calibration file (motors: {})", c.keys().cloned().collect::<Vec<_>>().join(", "))))?),
+                Some(c) if e.unit.takes_calibration() => Some(*c.get(&motor).ok_or_else(|| fail(format!("[joints.{name}]: no motor '{motor}' in the calibration file (motors: {})", c.keys().cloned().collect::<Vec<_>>().join(", "))))?),
                 _ => None,
             };
             if ranged && calibration.is_none() && !limits {
-                let instead = if e.unit == Unit::Range0To100 { "unit deg/rad" } else { "give a calibration file, or unit deg/rad" };
+                let instead = if e.unit.takes_calibration() { "give a calibration file, or unit deg/rad" } else { "unit deg/rad" };
                 return Err(fail(format!("[joints.{name}]: unit {} maps onto the joint's limits, and the URDF gives it none ({instead})", e.unit.name())));
             }
             entries.push(Entry { joint, column: e.column, unit: e.unit, sign: e.sign, offset: e.offset, calibration });
@@ -195,9 +200,8 @@ impl JointMap {
     /// `calibration`, each body motor's calibration record (by the motor's name: the column without
     /// `.pos` or `main_`).
     pub fn with_body_unit(mut self, unit: Unit, calibration: Option<(&Path, &BTreeMap<String, MotorCalibration>)>) -> Result<Self, Error> {
-        // the gripper keeps its 0…100 over its URDF limits: where its URDF zero lies in its
-        // calibrated travel, nothing says
-        for e in self.entries.iter_mut().filter(|e| e.unit != Unit::Range0To100) {
+        // the gripper keeps its 0…100 over its URDF limits
+        for e in self.entries.iter_mut().filter(|e| e.unit.takes_calibration()) {
             e.unit = unit;
             if let Some((path, records)) = calibration {
                 let motor = motor_of(&e.column);
