@@ -262,3 +262,28 @@ fn a_follower_whose_commands_arrive_late_is_met_once_the_replay_is_told_the_late
         assert!(lines.len() == 1 && lines[0].contains("--latency") && !lines[0].contains("NaN") && !lines[0].contains("inf"), "{err}");
     }
 }
+
+#[test]
+fn a_payload_left_out_of_an_arm_holding_still_is_a_gap_made_at_rest_and_said_so() {
+    // The follower holds one pose with 0.2 kg at the tool; the model, without it, sags less. The
+    // frames are still (commands and follower, but for any first settling), so the gap is made at rest,
+    // and the report says the model misses what holds the arm, not how it moves.
+    let dir = tempfile::tempdir().unwrap();
+    let pose: Vec<Sines> = common::follower::so101_commands().iter().map(|s| Sines { center: s.center, terms: Vec::new() }).collect();
+    let held = dataset_of(dir.path(), "so101_hold", &pose, PAYLOAD, &motors());
+    let without = replay_forward(&held, dir.path(), 0.0);
+    let lift = without.joints.iter().find(|g| g.joint == "shoulder_lift").unwrap();
+    assert!(lift.gap_mae > 2e-3, "shoulder_lift: the payload left out opens only {:.2} mrad", lift.gap_mae * 1e3);
+    // the episode's frames, a frame period each, less any first settling
+    assert!(lift.at_rest.seconds > 5.0 && lift.at_rest.seconds <= FRAMES as f64 / 30.0 + 1e-9, "{:?}", lift.at_rest);
+    assert!(lift.at_rest.gap_part > 0.9 * lift.gap_mae && lift.at_rest.gap_part <= lift.gap_mae + 1e-15, "{:?} of {}", lift.at_rest, lift.gap_mae);
+    // the real follower (with the payload) rests further from its commands than the model
+    assert!(lift.at_rest.real_offset > lift.at_rest.sim_offset + 2e-3, "{:?}", lift.at_rest);
+    let text = armscope::replay::forward::text(&without);
+    assert!(text.lines().any(|l| l.starts_with("  shoulder_lift: ") && l.contains("mean gap made at rest")), "{text}");
+    // the same payload left out of a moving arm: a gap made in motion, nothing at rest
+    let moving = replay_forward(&dataset(dir.path()), dir.path(), 0.0);
+    let lift = moving.joints.iter().find(|g| g.joint == "shoulder_lift").unwrap();
+    assert_eq!(lift.at_rest.seconds, 0.0, "{:?}", lift.at_rest);
+    assert!(!armscope::replay::forward::text(&moving).contains("made at rest"));
+}

@@ -3,6 +3,7 @@
 //! servo through its firmware loop — and held against what the real follower did
 //! (`observation.state`, the bag's joint states): the sim-to-real gap of the whole arm, per joint.
 
+use super::at_rest::{AtRest, REST_BAND};
 use super::{Replayer, inverse_replay, schedule};
 use crate::config::RunConfig;
 use crate::error::Error;
@@ -39,7 +40,10 @@ pub struct JointGap {
     /// How far the commands and the real joint ranged, rad (m).
     pub commanded_sweep: f64,
     pub observed_sweep: f64,
+    /// The part of the gap made where the commands and the real joint both stood still.
+    pub at_rest: AtRest,
 }
+
 
 /// One episode replayed forward.
 #[derive(Clone, Debug)]
@@ -339,6 +343,7 @@ impl JointGap {
             follows: !(commanded_sweep >= SWEEP_EXPECTED && observed_sweep < FOLLOWS_FRACTION * commanded_sweep),
             commanded_sweep,
             observed_sweep,
+            at_rest: AtRest::of(time, c, o, s),
         }
     }
 }
@@ -447,6 +452,17 @@ pub fn text(replay: &ForwardReplay) -> String {
             g.gap_mae * 1e3,
             g.gap_max * 1e3,
             g.gap_max_at
+        );
+    }
+    for g in replay.joints.iter().filter(|g| g.follows && g.gap_mae >= REST_BAND && g.at_rest.gap_part >= 0.5 * g.gap_mae) {
+        out += &format!(
+            "  {}: {:.1} of the {:.1} mrad mean gap made at rest ({:.1} s with the commands and the real joint still: the real joint {:.1} mrad from its commands, the model {:.1}): the model misses what holds the arm at rest (friction, a stop, a contact, a load), not how it moves\n",
+            g.joint,
+            g.at_rest.gap_part * 1e3,
+            g.gap_mae * 1e3,
+            g.at_rest.seconds,
+            g.at_rest.real_offset * 1e3,
+            g.at_rest.sim_offset * 1e3
         );
     }
     for joint in &replay.uncommanded {

@@ -6,6 +6,7 @@
 
 pub mod inverse;
 pub mod recording;
+pub mod at_rest;
 pub mod forward;
 pub mod report;
 pub mod schedule;
