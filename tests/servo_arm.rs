@@ -86,6 +86,19 @@ fn the_summary_names_the_servos_at_full_duty_and_their_current() {
     assert!(rms > 0.0 && rms < peak);
     let line = stdout.lines().find(|l| l.contains("shoulder_lift: its servo at full duty")).unwrap_or_else(|| panic!("{stdout}"));
     assert!(line.contains(&format!("drawing up to {peak:.2} A")), "{line}");
+    // every joint is its servo's: the PD controller drives none, and no gains are tuned for it
+    assert_eq!(summary["gains"]["source"], armscope::control::gains::NO_PD_JOINT, "{}", summary["gains"]);
+    assert!(summary["gains"]["spectral_radius"].is_null() && summary["gains"]["kp"].as_array().unwrap().iter().all(|k| k.as_f64() == Some(0.0)));
+    assert!(stdout.contains("  controller: none (the PD drives no joint") && !stdout.contains("auto-tuned"), "{stdout}");
+    // with --drive pd the PD drives them on the servos' torque lines: its gains tuned
+    let (code, stdout, stderr) = run(&[
+        "run", "--urdf", so101().to_str().unwrap(), "--motors", common::follower::so101_motors_bam12v().to_str().unwrap(), "--drive", "pd", "--duration", "0.1", "--no-rrd", "--no-mcap",
+        "--summary-json", json.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    let summary: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(summary["gains"]["source"], "auto-tuned", "{}", summary["gains"]);
+    assert!(stdout.contains("  controller: PD + gravity feed-forward"), "{stdout}");
 }
 
 #[test]

@@ -49,7 +49,8 @@ pub fn envelope(args: &EnvelopeArgs) -> Result<i32, Error> {
     let (kp, kd) = probe.controller().effective_gains();
     // the loop as it runs: the probe's model has the motors' rotors on M's diagonal
     let lin = Linearization::at(&probe.model, &vec![0.0; model.dof()]);
-    let (rho, _) = spectral_radius(&lin.closed_loop(&kp, &kd, args.dt, true, LoopPlant::Discrete));
+    // with every joint left to its servo's firmware (or a stepper) there is no PD loop to stabilise
+    let rho = if probe.gains.drives_a_joint() { spectral_radius(&lin.closed_loop(&kp, &kd, args.dt, true, LoopPlant::Discrete)).0 } else { 0.0 };
     if args.gains.kd.is_none() && rho >= 1.0 {
         let (kd, stable) = stabilizing_kd(&lin, &kp, &kd, args.dt, true, LoopPlant::Discrete);
         println!("gains {} are unstable at dt = {} ms (spectral radius {rho:.2}); using kd = {kd:.4?} (spectral radius {stable:.3})", probe.gains.source, args.dt * 1e3);

@@ -12,7 +12,7 @@ pub const TUTORIAL_KD: [f64; 6] = [12.0, 10.0, 4.5, 1.3, 0.4, 0.1];
 pub struct Gains {
     pub kp: Vec<f64>,
     pub kd: Vec<f64>,
-    /// Where they came from: "tutorial", "flags", "auto-tuned", or a mix.
+    /// Where they came from: "tutorial", "flags", "auto-tuned", a mix, or [`NO_PD_JOINT`].
     pub source: String,
     /// Effective inertia per joint (the smallest M_ii along the command) when auto-tuned.
     pub effective_inertia: Option<Vec<f64>>,
@@ -21,6 +21,22 @@ pub struct Gains {
     /// Per joint, when auto-tuned: the loop's bandwidth ω (rad/s) and damping ratio ζ.
     pub bandwidth: Option<Vec<f64>>,
     pub damping_ratio: Option<Vec<f64>>,
+}
+
+/// The source of the gains of a run whose every actuated joint is driven by its servo's firmware
+/// or an open-loop stepper: the PD controller drives none, so none are tuned.
+pub const NO_PD_JOINT: &str = "none: every joint is driven by its servo's firmware or a stepper";
+
+impl Gains {
+    /// No gains, for a run whose PD controller drives no joint ([`NO_PD_JOINT`]).
+    pub fn no_pd_joint(n: usize) -> Self {
+        Self { kp: vec![0.0; n], kd: vec![0.0; n], source: NO_PD_JOINT.into(), effective_inertia: None, spectral_radius: None, bandwidth: None, damping_ratio: None }
+    }
+
+    /// Whether the PD controller drives any joint with these gains.
+    pub fn drives_a_joint(&self) -> bool {
+        self.source != NO_PD_JOINT
+    }
 }
 
 /// Whether this is the tutorial's box model, whose gains are known.

@@ -96,16 +96,20 @@ impl Console {
             }
         }
         writeln!(self.out, "  command: {}", run.trajectory).map_err(io)?;
-        writeln!(
-            self.out,
-            "  controller: PD{} every {} ms, gains ({}): kp = {:?}, kd = {:?}",
-            if e.config.no_ff { " without gravity feed-forward (--no-ff)" } else { " + gravity feed-forward" },
-            e.config.dt * 1e3,
-            e.gains.source,
-            e.gains.kp,
-            e.gains.kd
-        )
-        .map_err(io)?;
+        if e.gains.drives_a_joint() {
+            writeln!(
+                self.out,
+                "  controller: PD{} every {} ms, gains ({}): kp = {:?}, kd = {:?}",
+                if e.config.no_ff { " without gravity feed-forward (--no-ff)" } else { " + gravity feed-forward" },
+                e.config.dt * 1e3,
+                e.gains.source,
+                e.gains.kp,
+                e.gains.kd
+            )
+            .map_err(io)?;
+        } else {
+            writeln!(self.out, "  controller: none (the PD drives no joint: each is driven by its servo's firmware or an open-loop stepper), commands every {} ms", e.config.dt * 1e3).map_err(io)?;
+        }
         if let Some(inertia) = &e.gains.effective_inertia {
             let radius = e.gains.spectral_radius.map_or(String::new(), |r| format!(", worst spectral radius of the sampled loop along the command {r:.3}"));
             writeln!(self.out, "  auto-tuned gains (kp = min(effort/0.05, I·ω² + D·ω), kd = 2·ζ·√(kp·I), I = smallest M_ii along the command, ω = 0.1/dt and ζ = 1 lowered for the joints of each mode of the sampled loop unstable with twice the gains{radius}):").map_err(io)?;

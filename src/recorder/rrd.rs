@@ -849,7 +849,7 @@ pub fn config_markdown(run: &RunInfo) -> String {
     let e = run.experiment;
     let m = &e.model;
     format!(
-        "# armscope run\n\n* model: **{}** (`{}`), {} dof, gravity ({}, {}, {}) m/s²\n* plant: {}\n* command: {}\n* controller: PD{}, control period {} ms\n* gains ({}): kp = {:?}, kd = {:?}\n* duration: {} s ({} steps)\n{}\n```json\n{}\n```\n",
+        "# armscope run\n\n* model: **{}** (`{}`), {} dof, gravity ({}, {}, {}) m/s²\n* plant: {}\n* command: {}\n* controller: {}, control period {} ms\n* gains ({}): kp = {:?}, kd = {:?}\n* duration: {} s ({} steps)\n{}\n```json\n{}\n```\n",
         m.name,
         m.source.display(),
         m.dof(),
@@ -858,7 +858,13 @@ pub fn config_markdown(run: &RunInfo) -> String {
         m.gravity.z,
         run.plant,
         run.trajectory,
-        if e.config.no_ff { " without gravity feed-forward" } else { " + gravity feed-forward" },
+        if !e.gains.drives_a_joint() {
+            "none (each joint's servo firmware or stepper)"
+        } else if e.config.no_ff {
+            "PD without gravity feed-forward"
+        } else {
+            "PD + gravity feed-forward"
+        },
         e.config.dt * 1e3,
         e.gains.source,
         e.gains.kp,
