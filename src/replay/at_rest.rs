@@ -26,32 +26,21 @@ pub const REST_SECONDS: f64 = 1.0;
 pub const REST_BAND: f64 = 0.005;
 
 impl AtRest {
-    /// The still stretches of a joint's `commanded` and `observed` positions at `time`, and what the
-    /// real and the `simulated` follower did there. Greedy: a stretch grows from its first frame
-    /// while both stay within [`REST_BAND`] of their values there.
+    /// The still frames ([`still_frames`]) of a joint's `commanded` and `observed` positions at
+    /// `time`, and what the real and the `simulated` follower did there.
     pub fn of(time: &[f64], commanded: &[f64], observed: &[f64], simulated: &[f64]) -> Self {
         let (c, o, s) = (commanded, observed, simulated);
         let frames = time.len();
         let period = if frames > 1 { (time[frames - 1] - time[0]) / (frames - 1) as f64 } else { 0.0 };
-        let (mut rest, mut start) = (Self::default(), 0usize);
+        let mut rest = Self::default();
         let mut count = 0usize;
-        while start < frames {
-            let mut end = start + 1;
-            while end < frames && (c[end] - c[start]).abs() <= REST_BAND && (o[end] - o[start]).abs() <= REST_BAND {
-                end += 1;
-            }
-            let seconds = (end - start) as f64 * period;
-            if seconds >= REST_SECONDS {
-                rest.seconds += seconds;
-                for k in start..end {
-                    rest.real_offset += (o[k] - c[k]).abs();
-                    rest.sim_offset += (s[k] - c[k]).abs();
-                    rest.gap_part += (s[k] - o[k]).abs();
-                }
-                count += end - start;
-            }
-            start = end;
+        for (k, _) in still_frames(time, commanded, observed).iter().enumerate().filter(|(_, still)| **still) {
+            rest.real_offset += (o[k] - c[k]).abs();
+            rest.sim_offset += (s[k] - c[k]).abs();
+            rest.gap_part += (s[k] - o[k]).abs();
+            count += 1;
         }
+        rest.seconds = count as f64 * period;
         if count > 0 {
             rest.real_offset /= count as f64;
             rest.sim_offset /= count as f64;
@@ -59,6 +48,28 @@ impl AtRest {
         }
         rest
     }
+}
+
+/// Per frame, whether it lies in a stretch of at least [`REST_SECONDS`] in which `commanded` and
+/// `observed` both stayed within [`REST_BAND`] of their values at the stretch's first frame (greedy,
+/// from the episode's start).
+fn still_frames(time: &[f64], commanded: &[f64], observed: &[f64]) -> Vec<bool> {
+    let (c, o) = (commanded, observed);
+    let frames = time.len();
+    let period = if frames > 1 { (time[frames - 1] - time[0]) / (frames - 1) as f64 } else { 0.0 };
+    let mut still = vec![false; frames];
+    let mut start = 0;
+    while start < frames {
+        let mut end = start + 1;
+        while end < frames && (c[end] - c[start]).abs() <= REST_BAND && (o[end] - o[start]).abs() <= REST_BAND {
+            end += 1;
+        }
+        if (end - start) as f64 * period >= REST_SECONDS {
+            still[start..end].fill(true);
+        }
+        start = end;
+    }
+    still
 }
 
 #[cfg(test)]
