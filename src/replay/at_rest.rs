@@ -14,8 +14,8 @@ pub struct AtRest {
     /// Over those frames, the mean |observed − commanded| and |simulated − commanded|, rad (m).
     pub real_offset: f64,
     pub sim_offset: f64,
-    /// Those frames' share of [`JointGap::gap_mae`](super::forward::JointGap::gap_mae): the sum of their |simulated − observed| over
-    /// all the episode's frames, rad (m).
+    /// Those frames' part of [`JointGap::gap_mae`](super::forward::JointGap::gap_mae): the sum of
+    /// their |simulated − observed| divided by the episode's frame count, rad (m).
     pub gap_part: f64,
 }
 

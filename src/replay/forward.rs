@@ -44,7 +44,6 @@ pub struct JointGap {
     pub at_rest: AtRest,
 }
 
-
 /// One episode replayed forward.
 #[derive(Clone, Debug)]
 pub struct ForwardReplay {
@@ -454,6 +453,7 @@ pub fn text(replay: &ForwardReplay) -> String {
             g.gap_max_at
         );
     }
+    // said where rest makes half the gap or more, and the gap is more than a resting leader's jitter
     for g in replay.joints.iter().filter(|g| g.follows && g.gap_mae >= REST_BAND && g.at_rest.gap_part >= 0.5 * g.gap_mae) {
         out += &format!(
             "  {}: {:.1} of the {:.1} mrad mean gap made at rest ({:.1} s with the commands and the real joint still: the real joint {:.1} mrad from its commands, the model {:.1}): the model misses what holds the arm at rest (friction, a stop, a contact, a load), not how it moves\n",

@@ -2,12 +2,14 @@
 //! needed, held against what its motor gives.
 //!
 //! config (URDF, payload, tool, motors) → [`Replayer`] (the model built once) → per episode:
-//! [`smoothing`] → [`inverse`] → [`verdict`] → [`report`] (text, JSON) and [`trace`] (CSV).
+//! [`smoothing`] → [`inverse`] → [`verdict`] → [`report`] (text, JSON) and [`trace`] (CSV);
+//! forward, the commands followed by the simulated arm and held against the real follower
+//! ([`forward`]; the part of its gap made at rest: [`at_rest`]).
 
-pub mod inverse;
-pub mod recording;
 pub mod at_rest;
 pub mod forward;
+pub mod inverse;
+pub mod recording;
 pub mod report;
 pub mod schedule;
 pub mod smoothing;
