@@ -127,9 +127,8 @@ impl Experiment {
             _ => None,
         };
         weight_notices(&mut model, &start);
-        // the joints left to a servo's firmware or an open-loop stepper: the PD drives none of them
-        let left: Vec<bool> = (0..model.dof()).map(|j| servos.as_ref().is_some_and(|s| s.driven[j]) || steppers.as_ref().is_some_and(|s| s.stepped[j])).collect();
-        let pd_drives_none = (0..model.dof()).all(|j| left[j] || !model.is_actuated(j));
+        // every actuated joint left to a servo's firmware or an open-loop stepper: the PD drives none
+        let pd_drives_none = (0..model.dof()).all(|j| !model.is_actuated(j) || servos.as_ref().is_some_and(|s| s.driven[j]) || steppers.as_ref().is_some_and(|s| s.stepped[j]));
         let gains = if pd_drives_none && config.kp.is_none() && config.kd.is_none() { Gains::no_pd_joint(model.dof()) } else { gains(&config, &model, &start, trajectory.as_ref(), &plant)? };
         let steps = (config.duration / config.dt - 1e-9).ceil() as usize;
         let mut config = config;

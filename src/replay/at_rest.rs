@@ -34,7 +34,7 @@ impl AtRest {
         let period = if frames > 1 { (time[frames - 1] - time[0]) / (frames - 1) as f64 } else { 0.0 };
         let mut rest = Self::default();
         let mut count = 0usize;
-        for (k, _) in still_frames(time, commanded, observed).iter().enumerate().filter(|(_, still)| **still) {
+        for (k, _) in still_frames(period, commanded, observed).iter().enumerate().filter(|(_, still)| **still) {
             rest.real_offset += (o[k] - c[k]).abs();
             rest.sim_offset += (s[k] - c[k]).abs();
             rest.gap_part += (s[k] - o[k]).abs();
@@ -50,13 +50,12 @@ impl AtRest {
     }
 }
 
-/// Per frame, whether it lies in a stretch of at least [`REST_SECONDS`] in which `commanded` and
-/// `observed` both stayed within [`REST_BAND`] of their values at the stretch's first frame (greedy,
-/// from the episode's start).
-fn still_frames(time: &[f64], commanded: &[f64], observed: &[f64]) -> Vec<bool> {
+/// Per frame (`period` s apart), whether it lies in a stretch of at least [`REST_SECONDS`] in which
+/// `commanded` and `observed` both stayed within [`REST_BAND`] of their values at the stretch's
+/// first frame (greedy, from the episode's start).
+fn still_frames(period: f64, commanded: &[f64], observed: &[f64]) -> Vec<bool> {
     let (c, o) = (commanded, observed);
-    let frames = time.len();
-    let period = if frames > 1 { (time[frames - 1] - time[0]) / (frames - 1) as f64 } else { 0.0 };
+    let frames = c.len();
     let mut still = vec![false; frames];
     let mut start = 0;
     while start < frames {
