@@ -25,6 +25,7 @@ impl Pendulum {
 
     /// The gravity torque at angle `q` (the bench's offset included by the caller):
     /// −(m + m_a/2)·g·l·sin q, N·m.
+    #[inline]
     pub fn gravity_torque(&self, q: f64) -> f64 {
         // BAM's product order: (m + m_a/2)·(−g)·l·sin q
         (self.mass + self.arm_mass / 2.0) * -self.gravity * self.length * q.sin()

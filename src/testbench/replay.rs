@@ -136,10 +136,17 @@ fn replay(log: &BenchLog, params: &ServoParams, options: &ReplayOptions, mut rec
     let mut firmware = FirmwareState::default();
     let friction = &bench.servo.friction;
     let delay_rows = params.command_delay / dt;
+    // J/Δt, the stopping torque's factor (BAM's order: (J/Δt)·q̇)
+    let inertia_per_row = bench.inertia / dt;
+    // rows until the next reset to the measured state (counted down: no division on every row)
+    let reset_every = options.reset_rows.filter(|&n| n > 0).unwrap_or(usize::MAX);
+    let mut until_reset = reset_every;
     for (row, entry) in log.entries.iter().enumerate() {
-        if options.reset_rows.is_some_and(|n| row > 0 && row % n == 0) {
+        if until_reset == 0 {
             (q, v) = (entry.position, entry.speed);
+            until_reset = reset_every;
         }
+        until_reset -= 1;
         let supply = bench.supply(log, row);
         let (goal, enabled) = delayed_command(log, row, delay_rows);
         match options.step {
@@ -151,7 +158,7 @@ fn replay(log: &BenchLog, params: &ServoParams, options: &ReplayOptions, mut rec
                 let external = bench.pendulum.gravity_torque(q + bench.q_offset);
                 let budget = friction.budget(out.torque, external, v) + friction.viscous * v.abs();
                 let net = out.torque + external;
-                let stop = bench.inertia / dt * v + net;
+                let stop = inertia_per_row * v + net;
                 let friction_torque = -sign(stop) * stop.abs().min(budget);
                 let acceleration = (net + friction_torque) / bench.inertia;
                 v = (v + acceleration * dt).clamp(-100.0, 100.0);
@@ -187,7 +194,8 @@ fn delayed_command(log: &BenchLog, row: usize, delay_rows: f64) -> (f64, bool) {
     if at <= 0.0 {
         return (entries[0].goal, entries[0].enabled);
     }
-    let i = at.floor() as usize;
+    // (at > 0: truncation is the floor, without libm's call on every row)
+    let i = at as usize;
     let w = at - i as f64;
     let next = &entries[(i + 1).min(row)];
     let goal = entries[i].goal + w * (next.goal - entries[i].goal);

@@ -169,6 +169,7 @@ impl Firmware {
     /// most max_velocity·dt), then the duty for position `q` (and speed `speed`, for the current
     /// limiter: I = (d·V − k_t·q̇)/R within ±I_max narrows d), clipped at ±d_max.
     #[allow(clippy::too_many_arguments)]
+    #[inline]
     pub fn tick(&self, state: &mut FirmwareState, goal: f64, q: f64, speed: f64, dt: f64, supply: f64, kt: f64, resistance: f64) -> f64 {
         state.target = if self.family.goal_speed_limiter {
             let step = self.max_velocity * dt;

@@ -230,6 +230,7 @@ impl ServoFriction {
     }
 
     /// s = exp(−|q̇/q̇_s|^α): 1 at rest, falling towards 0 as the joint moves.
+    #[inline]
     pub fn stribeck_factor(&self, speed: f64) -> f64 {
         if speed == 0.0 {
             // exactly what the formula gives, without its two transcendental calls (a stuck joint)
@@ -240,6 +241,7 @@ impl ServoFriction {
 
     /// The Coulomb budget B (N·m, without the viscous part) with motor torque `motor`, external
     /// torque `external` and joint speed `speed`.
+    #[inline]
     pub fn budget(&self, motor: f64, external: f64, speed: f64) -> f64 {
         let m = self.model;
         let mut budget = self.base;
@@ -278,6 +280,7 @@ impl ServoFriction {
 }
 
 /// NumPy's sign: −1, 0 or +1 (BAM's models and bench step use it; `f64::signum` gives ±1 at 0).
+#[inline]
 pub(crate) fn sign(x: f64) -> f64 {
     if x > 0.0 {
         1.0

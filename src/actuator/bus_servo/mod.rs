@@ -118,6 +118,7 @@ impl BusServo {
 
     /// The supply voltage at duty `duty` and speed `speed` from open-circuit `supply` (see the
     /// module's note).
+    #[inline]
     pub fn supply_at(&self, supply: f64, duty: f64, speed: f64) -> f64 {
         if self.supply_resistance == 0.0 {
             return supply;
@@ -128,6 +129,7 @@ impl BusServo {
 
     /// The motor at duty `duty`, speed `speed`, on an open-circuit supply of `supply` V, with the
     /// torque on or off.
+    #[inline]
     pub fn drive(&self, duty: f64, speed: f64, supply: f64, enabled: bool) -> ServoOutput {
         if !enabled {
             // the bridge is off: no voltage across the motor, no current (the firmware still runs)
@@ -150,6 +152,7 @@ impl BusServo {
     /// One firmware tick of `dt` s and the motor's answer over it: `goal` at position `q`, speed
     /// `speed`; a tripped protection limits the duty or switches the torque off, and the tick's
     /// duty and current run its timers.
+    #[inline]
     pub fn tick(&self, state: &mut FirmwareState, goal: f64, q: f64, speed: f64, dt: f64, supply: f64, enabled: bool) -> ServoOutput {
         let protection = &self.firmware.protection;
         let limit = protection.duty_limit(&state.protection, self.firmware.family.max_duty);

@@ -121,6 +121,7 @@ impl Protection {
 
     /// The largest duty the firmware may give now: the protective duty once the overload
     /// protection has tripped, `max_duty` otherwise.
+    #[inline]
     pub fn duty_limit(&self, state: &ProtectionState, max_duty: f64) -> f64 {
         match (state.trip, self.overload) {
             (Some(Trip { kind: TripKind::Overload, .. }), Some(o)) => o.protective.min(max_duty),
@@ -129,12 +130,14 @@ impl Protection {
     }
 
     /// Whether the overcurrent protection has unloaded the servo.
+    #[inline]
     pub fn torque_off(&self, state: &ProtectionState) -> bool {
         matches!(state.trip, Some(Trip { kind: TripKind::Overcurrent, .. }))
     }
 
     /// Advance the timers by `dt` s over which the servo gives `duty` and draws `current` A; the
     /// trip when one happens in it (at the instant its condition has lasted its time).
+    #[inline]
     pub fn update(&self, state: &mut ProtectionState, duty: f64, current: f64, dt: f64) -> Option<Trip> {
         let start = state.clock;
         state.clock += dt;
@@ -168,6 +171,7 @@ impl Protection {
 
 /// One protection's timer over [start, end]: its condition held since `since`; Some((since, when))
 /// once it has held for `hold` s.
+#[inline]
 fn timer(since: &mut Option<f64>, condition: bool, start: f64, end: f64, hold: f64) -> Option<(f64, f64)> {
     if !condition {
         *since = None;
