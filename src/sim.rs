@@ -47,17 +47,35 @@ impl Observed {
 
 /// [`simulate`], recording `observed` (a real arm's positions) beside the simulated arm's.
 pub fn simulate_beside(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], stop: Option<&AtomicBool>, observed: Option<&Observed>) -> Result<Summary, Error> {
-    simulate_loop(experiment, recorders, stop, observed, None)
+    simulate_loop(experiment, recorders, stop, observed, None, Keep::Everything)
+}
+
+/// A run for its joint positions alone (identification's candidates, run hundreds of times): the
+/// same motion as [`simulate`]'s, with the energy audit's divergence check, but no statistics and no
+/// tool poses (the samples' `tool_position` and `tool_target` are zero). Its status: completed,
+/// interrupted or diverged.
+pub fn simulate_positions(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], stop: Option<&AtomicBool>) -> Result<RunStatus, Error> {
+    Ok(simulate_loop(experiment, recorders, stop, None, None, Keep::Positions)?.status)
+}
+
+/// What a run keeps beside its motion.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Keep {
+    /// The summary's statistics and the tool's poses.
+    Everything,
+    /// The joint positions alone.
+    Positions,
 }
 
 /// [`simulate`] with `law` asking the joints' torques in place of the PD controller (through the
 /// same motor limits, plant and recorders). A law's error stops the run at that step: the
 /// recorders are finished with what was run, then the error is returned.
 pub fn simulate_with_law(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], stop: Option<&AtomicBool>, law: &mut dyn crate::control::law::TorqueLaw) -> Result<Summary, Error> {
-    simulate_loop(experiment, recorders, stop, None, Some(law))
+    simulate_loop(experiment, recorders, stop, None, Some(law), Keep::Everything)
 }
 
-fn simulate_loop(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], stop: Option<&AtomicBool>, observed: Option<&Observed>, mut law: Option<&mut dyn crate::control::law::TorqueLaw>) -> Result<Summary, Error> {
+fn simulate_loop(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], stop: Option<&AtomicBool>, observed: Option<&Observed>, mut law: Option<&mut dyn crate::control::law::TorqueLaw>, keep: Keep) -> Result<Summary, Error> {
+    let everything = keep == Keep::Everything;
     let model = &*experiment.model;
     let n = model.dof();
     let dt = experiment.dt();
@@ -72,7 +90,7 @@ fn simulate_loop(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], s
         experiment,
         plant: plant.describe(),
         trajectory: experiment.trajectory.describe(),
-        commanded_tool_path: if recorders.is_empty() { Vec::new() } else { experiment.commanded_tool_path(0.01) },
+        commanded_tool_path: if recorders.is_empty() || !everything { Vec::new() } else { experiment.commanded_tool_path(0.01) },
         torque_axes: crate::recorder::torque_axis::LazyAxes::of(experiment),
     };
     for r in recorders.iter_mut() {
@@ -149,7 +167,9 @@ fn simulate_loop(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], s
             previous_u[i] = u[i];
             previous_saturated[i] = saturated[i];
         }
-        body_poses(model, &cmd, &mut command_poses);
+        if everything {
+            body_poses(model, &cmd, &mut command_poses);
+        }
         let mut collided = None;
         if let (Some(c), Some((cd, state, log))) = (experiment.collisions.as_ref(), collision_check.as_mut()) {
             crate::collision::check_state(model, &c.shapes, &c.pairs, &c.world, cd, &data.body_pose, COLLISION_BAND, state);
@@ -190,11 +210,13 @@ fn simulate_loop(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], s
             },
             supply: &supply,
             collisions: collision_check.as_ref().map_or(&[], |(_, state, _)| state.close.as_slice()),
-            tool_position: frame_pose(model, &data, model.tool_frame).translation,
-            tool_target: frame_pose_in(model, &command_poses, model.tool_frame).translation,
+            tool_position: if everything { frame_pose(model, &data, model.tool_frame).translation } else { Default::default() },
+            tool_target: if everything { frame_pose_in(model, &command_poses, model.tool_frame).translation } else { Default::default() },
             body_pose: &data.body_pose,
         };
-        stats.record(&sample);
+        if everything {
+            stats.record(&sample);
+        }
         for r in recorders.iter_mut() {
             r.record(&sample)?;
         }

@@ -262,3 +262,46 @@ fn protection_registers_are_checked_and_set_in_their_units() {
     assert!((overcurrent.current - 1.625).abs() < 1e-12 && (overload.threshold - 0.25).abs() < 1e-12 && (overload.time - 0.5).abs() < 1e-12);
     assert!((overload.protective - 0.2).abs() < 1e-12 && (overcurrent.time - 2.0).abs() < 1e-12, "the others keep the factory's");
 }
+
+/// Every sample's joint positions and speeds, and its tool position.
+#[derive(Default)]
+struct Motion {
+    states: Vec<(Vec<f64>, Vec<f64>)>,
+    tool: Vec<[f64; 3]>,
+}
+
+impl armscope::recorder::Recorder for Motion {
+    fn start(&mut self, _: &armscope::recorder::RunInfo) -> Result<(), armscope::error::Error> {
+        Ok(())
+    }
+    fn record(&mut self, s: &armscope::sample::Sample) -> Result<(), armscope::error::Error> {
+        self.states.push((s.q.to_vec(), s.v.to_vec()));
+        self.tool.push([s.tool_position.x, s.tool_position.y, s.tool_position.z]);
+        Ok(())
+    }
+    fn finish(&mut self, _: &armscope::recorder::RunInfo, _: &armscope::summary::Summary) -> Result<(), armscope::error::Error> {
+        Ok(())
+    }
+}
+
+#[test]
+fn a_positions_only_run_moves_exactly_as_the_full_run() {
+    // identification runs each candidate for its joint positions alone (no statistics, no tool
+    // poses): the motion must be the full run's to the bit, the SO-101 on its servos carrying 0.2 kg
+    // along its default trajectory
+    let config = RunConfig { urdf: so101(), motors: Some(so101_motors()), payload: 0.2, duration: 1.5, ..RunConfig::default() };
+    let experiment = Experiment::prepare(config).unwrap();
+    assert!(experiment.servos.is_some(), "firmware mode");
+    let (mut full, mut lean) = (Motion::default(), Motion::default());
+    let summary = armscope::sim::simulate(&experiment, &mut [&mut full], None).unwrap();
+    let status = armscope::sim::simulate_positions(&experiment, &mut [&mut lean], None).unwrap();
+    assert_eq!(summary.status, armscope::summary::RunStatus::Completed);
+    assert_eq!(status, summary.status);
+    assert_eq!(full.states.len(), experiment.steps + 1);
+    assert_eq!(lean.states, full.states, "the same motion, bit for bit");
+    let moved = full.states.iter().map(|(q, _)| (q[1] - full.states[0].0[1]).abs()).fold(0.0, f64::max);
+    assert!(moved > 0.05, "the shoulder moved {moved} rad");
+    // the full run's tool moves; the positions-only run's samples carry none
+    assert!(full.tool.iter().any(|p| p != &full.tool[0]));
+    assert!(lean.tool.iter().all(|p| p == &[0.0; 3]));
+}

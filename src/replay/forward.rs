@@ -260,8 +260,7 @@ pub fn gap_within(model: &crate::model::Model, case: &ForwardCase, drives: &Driv
         budget,
         stop: &stop,
     };
-    let summary = crate::sim::simulate(&experiment, &mut [&mut watch], Some(&stop))?;
-    match summary.status {
+    match crate::sim::simulate_positions(&experiment, &mut [&mut watch], Some(&stop))? {
         crate::summary::RunStatus::Completed => Ok((watch.sum, false)),
         crate::summary::RunStatus::Interrupted { .. } => Ok((watch.sum, true)),
         other => Err(Error::Diverged(format!("{}: the forward replay did not complete: {other:?}", case.label))),
