@@ -73,6 +73,10 @@ pub struct IdentifyArgs {
     /// Generations at most of the refinement on the free-running replay (the second stage).
     #[arg(long, default_value_t = FitOptions::default().refine_generations)]
     pub refine_generations: usize,
+    /// Nelder–Mead iterations a simplex of the polish on the free-running replay (the last stage;
+    /// 0: 36 000 log replays' worth, 600 to 1000).
+    #[arg(long, default_value_t = FitOptions::default().polish_iterations)]
+    pub polish_iterations: usize,
     /// Independent searches of the first stage, from different starts; the best is refined.
     #[arg(long, default_value_t = FitOptions::default().searches)]
     pub searches: usize,
@@ -200,7 +204,7 @@ pub fn identify(args: &IdentifyArgs) -> Result<i32, Error> {
     };
     let fit_voltage_cap = args.fit_motor_voltage_limit || (!args.no_motor_voltage_limit && above_max_supply(&family, &train, args.supply));
     let space = Space::new(family, args.friction_model, args.fit_supply_resistance, fit_voltage_cap, !args.no_command_delay);
-    let options = FitOptions { searches: args.searches, population: args.population, generations, refine_generations: args.refine_generations, seed: args.seed, start };
+    let options = FitOptions { searches: args.searches, population: args.population, generations, refine_generations: args.refine_generations, polish_iterations: args.polish_iterations, seed: args.seed, start };
     let started = std::time::Instant::now();
     let bar = generations_bar(0, args.quiet);
     let progress = |p: Progress| {
