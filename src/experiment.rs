@@ -118,6 +118,9 @@ impl Experiment {
         }
         let motors = motors.map(Arc::new);
         let mut plant = plant_spec(&config)?;
+        if motors.as_ref().is_some_and(|m| m.floor.is_some()) && matches!(plant, PlantSpec::Continuous { .. }) {
+            return Err(Error::flag("--time-step", "0 (the continuous plant): the motor file's [floor] is a contact the discrete plant takes"));
+        }
         let steppers = match &motors {
             Some(motors) if config.drive == DriveMode::Native && motors.has_steppers() => stepper_setup(&config, &mut model, motors, trajectory.as_ref(), &mut start, &mut plant),
             _ => None,
@@ -170,7 +173,13 @@ impl Experiment {
     pub fn make_plant(&self) -> Box<dyn Plant> {
         let gears = self.gears();
         match self.plant {
-            PlantSpec::Discrete { time_step, substeps } => Box::new(DiscretePlant::with_friction(&self.model, time_step, substeps, self.joint_friction())),
+            PlantSpec::Discrete { time_step, substeps } => {
+                let plant = DiscretePlant::with_friction(&self.model, time_step, substeps, self.joint_friction());
+                match self.motors.as_ref().and_then(|m| m.floor) {
+                    Some(floor) => Box::new(plant.with_floor(floor, self.model.dof())),
+                    None => Box::new(plant),
+                }
+            }
             PlantSpec::Continuous { rtol, atol } => {
                 Box::new(ContinuousPlant::with_gears(&self.model, self.config.dt, Tolerances { rtol, atol }, &gears))
             }

@@ -96,12 +96,66 @@ fn a_followers_command_delay_is_identified_to_within_a_control_step() {
     // the control step is 1 ms
     assert!((delay - 0.060).abs() < 1e-3, "delay {:.2} ms, truly 60", delay * 1e3);
     assert!(stderr.contains("gripper left out of the fit"), "{stderr}");
+    // a follower swinging freely shows no floor
+    assert!(!stderr.contains("a floor under it"), "{stderr}");
     // the motor file written reads back, its servos on the fitted parameters
     let params = armscope::actuator::bus_servo::ServoParams::load(&dir.path().join("fit.STS3215-C018.json"), &mut Vec::new()).unwrap();
     assert_eq!(params.command_delay, delay);
     let model = armscope::model::load_urdf(&so101()).unwrap();
     let set = armscope::actuator::load_motor_file(&out, &model).unwrap();
     assert!(set.joints.iter().flatten().all(|d| d.servo.as_ref().is_some_and(|s| s.command_delay == delay && s.firmware.kp == 16.0)));
+    assert!(set.floor.is_none());
+}
+
+#[test]
+fn a_follower_resting_on_a_table_has_the_table_found_and_followed() {
+    // the catalogue's follower with a table under its tool, a centimetre under where the episodes
+    // start at most: the commands ask the tool below it in a good part of their frames, and the
+    // follower rests on it there
+    let dir = tempfile::tempdir().unwrap();
+    let motions = &motions()[..2];
+    let model = armscope::model::load_urdf(&so101()).unwrap();
+    let tool = model.frames.iter().position(|f| f.name == "gripper_frame_link").unwrap();
+    let mut data = armscope::dynamics::Data::new(&model);
+    let mut height = |q: &[f64]| {
+        armscope::dynamics::forward_kinematics(&model, &mut data, q);
+        armscope::dynamics::frame_pose(&model, &data, tool).translation.z
+    };
+    let commanded = |m: &[Sines], t: f64| m.iter().map(|s| s.q(t)).collect::<Vec<_>>();
+    let mut asked: Vec<f64> = motions.iter().flat_map(|m| (0..FRAMES).map(|f| commanded(m, f as f64 / FPS)).collect::<Vec<_>>()).map(|q| height(&q)).collect();
+    let starts: Vec<f64> = motions.iter().map(|m| height(&commanded(m, 0.0))).collect();
+    asked.sort_by(f64::total_cmp);
+    let table = asked[asked.len() / 4].min(starts.iter().copied().fold(f64::INFINITY, f64::min) - 0.01);
+    let below = asked.iter().filter(|&&z| z < table - 2e-3).count();
+    assert!(below * 10 > asked.len(), "{below} of {} frames asked below the table", asked.len());
+    let truth = dir.path().join("on_table.toml");
+    std::fs::write(&truth, std::fs::read_to_string(common::follower::so101_motors()).unwrap() + &format!("\n[floor]\nheight = {table:?}\nlink = \"gripper_frame_link\"\n")).unwrap();
+    let root = dataset(dir.path(), "on_table", &truth, 0.0, motions);
+    let (urdf, motors) = (so101(), common::follower::so101_motors());
+    let fit = |name: &str, extra: &[&str]| {
+        let (out, summary) = (dir.path().join(format!("{name}.toml")), dir.path().join(format!("{name}.json")));
+        let mut args = vec!["--from", root.to_str().unwrap(), "--urdf", urdf.to_str().unwrap(), "--motors", motors.to_str().unwrap(), "--units", "degrees", "--fit-params", "command_delay", "--out", out.to_str().unwrap(), "--summary-json", summary.to_str().unwrap(), "--quiet"];
+        args.extend_from_slice(extra);
+        let (code, _, stderr) = identify(&args);
+        assert_eq!(code, 0, "{stderr}");
+        (out, read_json(&summary), stderr)
+    };
+    let (out, doc, stderr) = fit("found", &[]);
+    assert!(stderr.contains("the real tool ('gripper_frame_link') rested at its lowest") && stderr.contains("a floor under it"), "{stderr}");
+    // the table's height within 1 mm: the encoder's quantum (2π/4096) at the tool's 0.3 m reach is
+    // 0.46 mm, and the search starts at the follower's lowest, read through those quanta
+    let found = doc["floor"]["height_m"].as_f64().unwrap();
+    assert!((found - table).abs() < 1e-3, "table at {found} m, truly {table}: {stderr} {}", doc["train_gap_rad"]);
+    // the motor file carries it, and the follower is followed within the encoder's quantum
+    let set = armscope::actuator::load_motor_file(&out, &model).unwrap();
+    assert_eq!(set.floor, Some(armscope::plant::FloorContact { frame: tool, height: found }));
+    let gap = doc["train_gap_rad"].as_f64().unwrap();
+    assert!(gap < 1.53e-3, "gap {:.2} mrad", gap * 1e3);
+    // without the table the same fit misses the follower by several times as much
+    let (out, doc, _) = fit("no_floor", &["--no-floor"]);
+    assert!(doc["floor"].is_null() && armscope::actuator::load_motor_file(&out, &model).unwrap().floor.is_none());
+    let without = doc["train_gap_rad"].as_f64().unwrap();
+    assert!(without > 3.0 * gap, "without the table {:.2} mrad, with it {:.2}", without * 1e3, gap * 1e3);
 }
 
 #[test]

@@ -305,3 +305,41 @@ fn a_positions_only_run_moves_exactly_as_the_full_run() {
     assert!(full.tool.iter().any(|p| p != &full.tool[0]));
     assert!(lean.tool.iter().all(|p| p == &[0.0; 3]));
 }
+
+#[test]
+fn a_floor_holds_the_tool_on_it_and_a_floor_out_of_reach_changes_nothing() {
+    // the SO-101 on its servos with 0.2 kg along its default trajectory; a floor under the tool
+    // halfway down from where it starts to its lowest stops it there, the tool resting on it while
+    // the commands ask lower. The floor gives like a stiff spring (5e4 N/m): the SO-101's servos
+    // press its tool with at most about 12 N (the shoulder's 2.94 N·m stall torque over its 0.25 m
+    // reach), which sinks it 0.24 mm: never a millimetre below, resting within one
+    let dir = tempfile::tempdir().unwrap();
+    let with_floor = |height: Option<f64>| {
+        let motors = dir.path().join("m.toml");
+        let text = std::fs::read_to_string(so101_motors()).unwrap();
+        std::fs::write(&motors, match height {
+            Some(z) => text + &format!("\n[floor]\nheight = {z:?}\n"),
+            None => text,
+        })
+        .unwrap();
+        let config = RunConfig { urdf: so101(), motors: Some(motors), payload: 0.2, duration: 3.0, ..RunConfig::default() };
+        let experiment = Experiment::prepare(config).unwrap();
+        let mut motion = Motion::default();
+        let summary = armscope::sim::simulate(&experiment, &mut [&mut motion], None).unwrap();
+        assert_eq!(summary.status, armscope::summary::RunStatus::Completed, "the energy audit passes");
+        motion
+    };
+    let free = with_floor(None);
+    let start = free.tool[0][2];
+    let lowest = free.tool.iter().map(|p| p[2]).fold(f64::INFINITY, f64::min);
+    assert!(start - lowest > 5e-3, "the tool goes {} mm down", (start - lowest) * 1e3);
+    let table = 0.5 * (start + lowest);
+    let held = with_floor(Some(table));
+    let held_lowest = held.tool.iter().map(|p| p[2]).fold(f64::INFINITY, f64::min);
+    assert!(held_lowest >= table - 1e-3, "never below the table: {held_lowest} against {table} (free {lowest}, start {start})");
+    let resting = held.tool.iter().filter(|p| (p[2] - table).abs() < 1e-3).count();
+    assert!(resting >= 100, "on the table for {resting} ms");
+    // a floor a metre under the arm: the same motion to the bit
+    let far = with_floor(Some(lowest - 1.0));
+    assert_eq!(far.states, free.states);
+}

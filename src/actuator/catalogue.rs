@@ -674,13 +674,31 @@ impl Fields<'_> {
     }
 }
 
+/// A motor file's `[floor]`: `height` (world z, m) under the origin of `link` (the model's tool
+/// frame if left out).
+fn floor_contact(t: &toml::Table, path: &Path, model: &Model) -> Result<crate::plant::FloorContact, Error> {
+    let fields = Fields { file: path, what: "[floor]", table: t };
+    fields.known(&["height", "link"])?;
+    let height = match t.get("height") {
+        Some(Value::Float(z)) if z.is_finite() => *z,
+        Some(Value::Integer(z)) => *z as f64,
+        _ => return Err(fields.err("height", "must be a height in m (world z)")),
+    };
+    let frame = match t.get("link") {
+        None => model.tool_frame,
+        Some(Value::String(link)) => model.frames.iter().position(|f| &f.name == link).ok_or_else(|| fields.err("link", &format!("'{link}' is no link of {}", model.source.display())))?,
+        Some(_) => return Err(fields.err("link", "must be a link's name")),
+    };
+    Ok(crate::plant::FloorContact { frame, height })
+}
+
 /// A motor file for `model`: the drive train of each joint it names (the others keep the URDF's
 /// constant effort limit).
 pub fn load_motor_file(path: &Path, model: &Model) -> Result<MotorSet, Error> {
     let text = crate::builtin::read_to_string(path).map_err(|e| fail(path, format!("cannot read: {e}")))?;
     let table: toml::Table = text.parse().map_err(|e: toml::de::Error| fail(path, e.message().to_string()))?;
-    if let Some(k) = table.keys().find(|k| !["catalogue", "joints", "motors", "description", "in_urdf"].contains(&k.as_str())) {
-        return Err(fail(path, format!("unknown key '{k}' (known: catalogue, joints, motors, description, in_urdf)")));
+    if let Some(k) = table.keys().find(|k| !["catalogue", "joints", "motors", "description", "in_urdf", "floor"].contains(&k.as_str())) {
+        return Err(fail(path, format!("unknown key '{k}' (known: catalogue, joints, motors, description, in_urdf, floor)")));
     }
     let all_in_urdf = match table.get("in_urdf") {
         None => false,
@@ -703,6 +721,11 @@ pub fn load_motor_file(path: &Path, model: &Model) -> Result<MotorSet, Error> {
         _ => return Err(fail(path, "no [joints.NAME] tables".into())),
     };
     let mut set = MotorSet::empty(model.dof(), path);
+    set.floor = match table.get("floor") {
+        Some(Value::Table(t)) => Some(floor_contact(t, path, model)?),
+        Some(_) => return Err(fail(path, "[floor] must be a table: height = z in m, link = the link resting on it".into())),
+        None => None,
+    };
     for (name, value) in joints {
         let what = format!("joint '{name}'");
         let Some(index) = model.joint_index(name) else {

@@ -301,12 +301,15 @@ pub struct MotorSet {
     pub mounts: Vec<Mount>,
     /// The motor file it came from.
     pub source: std::path::PathBuf,
+    /// A floor under a point of the arm (the file's `[floor]`: the table a real arm's gripper
+    /// rests on, as `identify --from` finds it).
+    pub floor: Option<crate::plant::FloorContact>,
 }
 
 impl MotorSet {
     /// No motors yet on `dof` coordinates.
     pub fn empty(dof: usize, source: impl Into<std::path::PathBuf>) -> Self {
-        Self { joints: (0..dof).map(|_| None).collect(), microsteps: vec![None; dof], acceleration: vec![None; dof], mounts: vec![Mount::AtJoint; dof], source: source.into() }
+        Self { joints: (0..dof).map(|_| None).collect(), microsteps: vec![None; dof], acceleration: vec![None; dof], mounts: vec![Mount::AtJoint; dof], source: source.into(), floor: None }
     }
 
     /// For people: one line per joint with a motor — the motor, the drive train, the torque at rest,

@@ -74,6 +74,11 @@ pub struct ArmArgs {
     /// With --from: candidates run at once (default: every core).
     #[arg(long, requires = "from")]
     pub jobs: Option<usize>,
+    /// With --from: no floor under the tool, even where the episodes show the real tool resting on
+    /// one (by default a floor at the lowest it rested, written as the motor file's [floor]; a
+    /// motor file that has a [floor] keeps its own).
+    #[arg(long, requires = "from")]
+    pub no_floor: bool,
 }
 
 /// An episode shorter than this (s) holds too little motion to identify from.
@@ -238,6 +243,24 @@ pub fn identify_arm(args: &IdentifyArgs, dataset: &Path) -> Result<i32, Error> {
     };
     let joint_names: Vec<String> = model.joints.iter().map(|j| j.name.clone()).collect();
     let space = ArmSpace::new(&start_set, &fitted, &keys, arm.fit_payload.then_some(arm.payload_max), arm.fit_offsets, arm.per_joint.then_some(joint_names.as_slice()));
+    // the table the real tool rested on, where the episodes show one
+    let tool_frame = match &arm.tool {
+        Some(link) => model.frames.iter().position(|f| &f.name == link).ok_or_else(|| Error::flag("--tool", format!("'{link}' is no link of {}", urdf.display())))?,
+        None => model.tool_frame,
+    };
+    let touch = if arm.no_floor || start_set.floor.is_some() { None } else { crate::identify::floor::touched(&model, tool_frame, &train_cases) };
+    if let Some(t) = &touch {
+        eprintln!(
+            "armscope: notice: the real tool ('{}') rested at its lowest, z = {:.4} to {:.4} m by episode, in {} frames while its commands asked it lower (to {:.4} m): a floor under it at z = {:.4} m, written as the motor file's [floor] (--no-floor: none)",
+            model.frames[tool_frame].name,
+            t.height,
+            t.highest,
+            t.frames,
+            t.commanded_lowest,
+            t.height
+        );
+    }
+    let floor = touch.map(|t| crate::plant::FloorContact { frame: tool_frame, height: t.height });
     if space.is_empty() {
         return Err(Error::flag("--fit-params", "nothing left to fit"));
     }
@@ -259,7 +282,7 @@ pub fn identify_arm(args: &IdentifyArgs, dataset: &Path) -> Result<i32, Error> {
         );
     }
     let search_cases: Vec<ForwardCase> = chosen.iter().map(|&i| train_cases[i].clone()).collect();
-    let objective = ArmObjective { model: &model, motor_file: motors, tool: arm.tool.as_deref(), space: &space, cases: &search_cases, fitted: is_fitted.clone() };
+    let objective = ArmObjective { model: &model, motor_file: motors, tool: arm.tool.as_deref(), space: &space, cases: &search_cases, fitted: is_fitted.clone(), floor };
     let jobs = arm.jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get())).max(1);
     let options = ArmFitOptions { population: args.population, generations, seed: args.seed, jobs, ..ArmFitOptions::default() };
     let bar = super::identify::generations_bar(generations as u64, args.quiet);
@@ -271,7 +294,7 @@ pub fn identify_arm(args: &IdentifyArgs, dataset: &Path) -> Result<i32, Error> {
     bar.finish_and_clear();
     let seconds = started.elapsed().as_secs_f64();
 
-    let servo_files = write_motor_file(&args.out, motors, &model, &start_set, &space, dataset, &train, &found)?;
+    let servo_files = write_motor_file(&args.out, motors, &model, &start_set, &space, dataset, &train, &found, floor)?;
     // the file as written, replayed: what `replay --forward --motors FILE` will give
     let payload = if arm.fit_payload { found.payload } else { arm.payload };
     let replay_with = |cases: &[ForwardCase]| -> Result<Vec<ForwardReplay>, Error> { cases.iter().map(|c| follow(&model, c, &Drives::File(&args.out), &FollowSetup { payload, tool: arm.tool.as_deref(), offsets: arm.fit_offsets.then_some(found.offsets.as_slice()) }, None)).collect() };
@@ -315,6 +338,9 @@ pub fn identify_arm(args: &IdentifyArgs, dataset: &Path) -> Result<i32, Error> {
         if arm.fit_payload {
             println!("  payload {:.3} kg", found.payload);
         }
+        if let Some(floor) = floor {
+            println!("  a floor under '{}' at z = {:.4} m (where the real tool rested at its lowest)", model.frames[floor.frame].name, floor.height);
+        }
         if arm.fit_offsets {
             println!("  calibration offsets (the arm's angle less the recording's): {}", fitted.iter().map(|&j| format!("{} {:+.1} mrad", name(j), 1e3 * found.offsets[j])).collect::<Vec<_>>().join(", "));
         }
@@ -339,6 +365,7 @@ pub fn identify_arm(args: &IdentifyArgs, dataset: &Path) -> Result<i32, Error> {
             "left_out": left_out.iter().map(|(j, why)| serde_json::json!({ "joint": j, "why": why })).collect::<Vec<_>>(),
             "payload_kg": payload,
             "payload_fitted": arm.fit_payload,
+            "floor": touch.map(|t| serde_json::json!({ "link": model.frames[tool_frame].name, "height_m": t.height, "highest_rest_m": t.highest, "resting_frames": t.frames, "commanded_lowest_m": t.commanded_lowest })),
             "offsets_rad": arm.fit_offsets.then(|| fitted.iter().map(|&j| (name(j), found.offsets[j])).collect::<std::collections::BTreeMap<_, _>>()),
             "servos": kinds,
             "start_gap_rad": found.start_loss,
@@ -362,7 +389,7 @@ pub fn identify_arm(args: &IdentifyArgs, dataset: &Path) -> Result<i32, Error> {
 /// kind's parameters (`OUT_STEM.KIND.json`, beside it), the files it names made absolute so that it
 /// reads from anywhere. Returns the parameter files written.
 #[allow(clippy::too_many_arguments)]
-fn write_motor_file(out: &Path, motors: &Path, model: &crate::model::Model, set: &crate::actuator::MotorSet, space: &ArmSpace, dataset: &Path, train: &[i64], found: &crate::identify::arm::ArmFit) -> Result<Vec<PathBuf>, Error> {
+fn write_motor_file(out: &Path, motors: &Path, model: &crate::model::Model, set: &crate::actuator::MotorSet, space: &ArmSpace, dataset: &Path, train: &[i64], found: &crate::identify::arm::ArmFit, floor: Option<crate::plant::FloorContact>) -> Result<Vec<PathBuf>, Error> {
     use toml::Value;
     let fail = |m: String| Error::flag(motors.display().to_string(), m);
     let text = crate::builtin::read_to_string(motors).map_err(|e| fail(format!("cannot read: {e}")))?;
@@ -405,13 +432,20 @@ fn write_motor_file(out: &Path, motors: &Path, model: &crate::model::Model, set:
             }
         }
     }
+    if let Some(floor) = floor {
+        let mut t = toml::Table::new();
+        t.insert("height".into(), Value::Float(floor.height));
+        t.insert("link".into(), Value::String(model.frames[floor.frame].name.clone()));
+        table.insert("floor".into(), Value::Table(t));
+    }
     let header = format!(
-        "# Identified by `armscope identify --from {}` on episode(s) {} of it, from {}: the mean gap between the\n# simulated and the real follower {:.2} mrad ({:.2} with the parameters started from). Each servo's parameters are\n# in the file its servo_params names.\n",
+        "# Identified by `armscope identify --from {}` on episode(s) {} of it, from {}: the mean gap between the\n# simulated and the real follower {:.2} mrad ({:.2} with the parameters started from). Each servo's parameters are\n# in the file its servo_params names.{}\n",
         dataset.display(),
         train.iter().map(i64::to_string).collect::<Vec<_>>().join(", "),
         motors.display(),
         1e3 * found.loss,
-        1e3 * found.start_loss
+        1e3 * found.start_loss,
+        if floor.is_some() { " [floor]: the table the real tool rested on in those episodes, at the lowest it rested." } else { "" }
     );
     let body = toml::to_string(&table).map_err(|e| fail(e.to_string()))?;
     std::fs::write(out, header + &body).map_err(|e| Error::output(out, e))?;

@@ -156,6 +156,9 @@ fn forward(args: &ReplayArgs, replayer: &Replayer, source: &crate::motion::Sourc
     if let Some(latency) = args.latency {
         crate::replay::forward::check_latency(latency)?;
     }
+    if let Some(floor) = replayer.motors.as_ref().and_then(|m| m.floor) {
+        eprintln!("armscope: notice: {}: the simulated tool ('{}') rests on a floor at z = {:.4} m (its [floor]: a contact without friction; the arm's own links pass through it)", motors.display(), replayer.base_model.frames[floor.frame].name, floor.height);
+    }
     // the command schedules go where the recordings go
     let dir = args.files.folder();
     std::fs::create_dir_all(&dir).map_err(|e| Error::output(&dir, e))?;

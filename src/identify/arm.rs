@@ -199,12 +199,17 @@ pub struct ArmObjective<'a> {
     pub cases: &'a [ForwardCase],
     /// Per model coordinate: in the loss.
     pub fitted: Vec<bool>,
+    /// The floor the real tool rested on, where the episodes show one (else the motor file's).
+    pub floor: Option<crate::plant::FloorContact>,
 }
 
 impl ArmObjective<'_> {
     /// The motor file's drives with the servo parameters `params` (by kind).
     pub fn motors(&self, params: &[ServoParams]) -> Result<MotorSet, Error> {
         let mut set = load_motor_file(self.motor_file, self.model)?;
+        if self.floor.is_some() {
+            set.floor = self.floor;
+        }
         for (kind, p) in self.space.kinds.iter().zip(params) {
             for (j, d) in set.joints.iter_mut().enumerate() {
                 if let Some(servo) = d.as_mut().and_then(|d| d.servo.as_mut()).filter(|s| kind.drives(j, &s.name)) {

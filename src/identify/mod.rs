@@ -4,6 +4,7 @@
 pub mod arm;
 pub mod cmaes;
 pub mod fit;
+pub mod floor;
 pub mod space;
 
 pub use fit::{Fit, FitOptions, Progress, fit};

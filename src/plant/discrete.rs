@@ -1,11 +1,13 @@
 use super::Plant;
+use super::floor_contact::{FloorContact, FloorSolve};
 use super::joint_friction::JointFriction;
 use super::stick_slip::{JointLaw, StickSlipSolver};
 use crate::actuator::LossyGear;
 use crate::dynamics::{Data, crba_from_kinematics, forward_kinematics, gravity_and_bias_from_kinematics};
 use crate::model::Model;
 
-/// Drake's discrete MultibodyPlant without contact: semi-implicit Euler with the joint damping
+/// Drake's discrete MultibodyPlant without contact (but for an optional floor under one point,
+/// [`FloorContact`], its work booked with the friction's): semi-implicit Euler with the joint damping
 /// taken implicitly, everything evaluated at the start of the step,
 ///
 /// ```text
@@ -44,6 +46,8 @@ pub struct DiscretePlant {
     stuck: Vec<bool>,
     /// Work of the friction over the last `advance` (≤ 0), J.
     friction_work: f64,
+    /// A floor under a point of the arm, if any.
+    floor: Option<FloorSolve>,
 }
 
 impl DiscretePlant {
@@ -76,7 +80,14 @@ impl DiscretePlant {
             friction_torque: vec![0.0; n],
             stuck: vec![false; n],
             friction_work: 0.0,
+            floor: None,
         }
+    }
+
+    /// The plant with a floor under a point of the arm.
+    pub fn with_floor(mut self, contact: FloorContact, dof: usize) -> Self {
+        self.floor = Some(FloorSolve::new(contact, dof));
+        self
     }
 
     /// One plant step; `data` must hold kinematics, τ_g and C·v at (q, v).
@@ -115,7 +126,12 @@ impl DiscretePlant {
         }
         // M + hD is symmetric positive definite for any valid model; a failure means the state is
         // no longer finite, which the simulation loop reports as divergence
-        if self.solver.solve(mass, &self.damping_step, &self.rhs, &self.laws, &mut self.v_next, &mut self.residual).is_err() {
+        let mut solved = self.solver.solve(mass, &self.damping_step, &self.rhs, &self.laws, &mut self.v_next, &mut self.residual);
+        if let (Ok(()), Some(floor)) = (&solved, self.floor.as_mut()) {
+            solved = floor.impose(model, data, h, v, &mut self.solver, mass, &self.damping_step, &self.rhs, &self.laws, &mut self.v_next, &mut self.residual);
+            self.friction_work += floor.work;
+        }
+        if solved.is_err() {
             self.v_next.fill(f64::NAN);
         }
         for i in 0..n {
@@ -203,8 +219,8 @@ impl Plant for DiscretePlant {
             "discrete plant: semi-implicit Euler, implicit joint damping (Drake's update){}, h = {} ms{}",
             if self.friction.has_servos() { ", exact Coulomb stick–slip with the servos' friction budgets" } else if self.friction.has_gears() { ", exact Coulomb stick–slip with the gearboxes' losses" } else if self.friction.any { ", exact Coulomb stick–slip" } else { "" },
             self.time_step * 1e3,
-            if self.substeps > 1 { format!(", {} steps per control period", self.substeps) } else { String::new() }
-        )
+            if self.substeps > 1 { format!(", {} steps per control period", self.substeps) } else { String::new() },
+        ) + &self.floor.as_ref().map_or(String::new(), |f| format!(", a floor at z = {} m under one point of the arm", f.contact.height))
     }
 }
 

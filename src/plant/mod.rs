@@ -2,11 +2,13 @@
 
 mod continuous;
 mod discrete;
+mod floor_contact;
 mod joint_friction;
 mod stick_slip;
 
 pub use continuous::{ContinuousPlant, Tolerances};
 pub use discrete::DiscretePlant;
+pub use floor_contact::FloorContact;
 pub use joint_friction::JointFriction;
 pub use stick_slip::{JointLaw, NotPositiveDefinite, StickSlipSolver};
 
@@ -34,8 +36,8 @@ pub trait Plant: Send {
     /// the last `advance`.
     fn stuck(&self) -> &[bool];
 
-    /// The work the friction did over the last `advance`, J (≤ 0: it dissipates), for the energy
-    /// audit.
+    /// The work the friction (and a floor's contact) did over the last `advance`, J (the friction's
+    /// ≤ 0: it dissipates), for the energy audit.
     fn friction_work(&self) -> f64;
 
     /// One line for the console and the recordings.

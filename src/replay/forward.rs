@@ -166,6 +166,16 @@ impl ForwardCase {
         &self.mapped
     }
 
+    /// The commands as the model's joint positions (per coordinate, per frame).
+    pub fn commanded(&self) -> &super::Motion {
+        &self.command
+    }
+
+    /// The real follower's positions (per coordinate, per frame).
+    pub fn real(&self) -> &super::Motion {
+        &self.reality
+    }
+
     /// The episode's frames.
     pub fn frames(&self) -> usize {
         self.command.len()
