@@ -343,3 +343,27 @@ fn a_floor_holds_the_tool_on_it_and_a_floor_out_of_reach_changes_nothing() {
     let far = with_floor(Some(lowest - 1.0));
     assert_eq!(far.states, free.states);
 }
+
+#[test]
+fn a_bad_floor_is_refused_in_one_line_naming_its_field() {
+    let dir = tempfile::tempdir().unwrap();
+    let urdf = so101();
+    let attempt = |floor: &str, extra: &[&str]| {
+        let motors = dir.path().join("f.toml");
+        std::fs::write(&motors, std::fs::read_to_string(so101_motors()).unwrap() + "\n[floor]\n" + floor + "\n").unwrap();
+        let mut args = vec!["run", "--urdf", urdf.to_str().unwrap(), "--motors", motors.to_str().unwrap(), "--duration", "0.01", "--no-rrd", "--no-mcap"];
+        args.extend_from_slice(extra);
+        run(&args)
+    };
+    for (floor, extra, expected) in [
+        ("height = \"low\"", &[][..], "[floor]: field 'height' must be a height in m (world z)"),
+        ("height = 0.0\nlink = \"table_link\"", &[][..], "[floor]: field 'link' 'table_link' is no link of"),
+        ("height = 0.0\nfriction = 0.5", &[][..], "[floor]: unknown field 'friction'"),
+        ("height = 0.0", &["--time-step", "0"][..], "--time-step: 0 (the continuous plant): the motor file's [floor] is a contact the discrete plant takes"),
+    ] {
+        let (code, _, stderr) = attempt(floor, extra);
+        assert_ne!(code, 0, "{floor}");
+        let errors: Vec<&str> = stderr.lines().filter(|l| !l.starts_with("armscope: notice")).collect();
+        assert!(errors.len() == 1 && errors[0].contains(expected), "{floor}: {stderr}");
+    }
+}
