@@ -883,6 +883,9 @@ pub fn summary_markdown(summary: &Summary) -> String {
     format!("# summary\n\n```\n{}\n```\n\n```json\n{}\n```\n", String::from_utf8_lossy(&text).trim(), serde_json::to_string_pretty(summary).unwrap_or_default())
 }
 
+/// The side of the plate drawn for a motor file's floor, m: a desk under a desktop arm.
+const FLOOR_PLATE: f64 = 0.8;
+
 impl Recorder for RerunRecorder {
     fn start(&mut self, run: &RunInfo) -> Result<(), Error> {
         let e = run.experiment;
@@ -920,6 +923,12 @@ impl Recorder for RerunRecorder {
             send_blueprint(&rec, &layout, &torque_ranges).map_err(|x| self.err(x))?;
         }
         self.log_static_scene(&rec, model)?;
+        if let Some(floor) = e.motors.as_ref().and_then(|m| m.floor) {
+            // the table the tool rests on (the motor file's [floor]): a thin plate, its top there
+            let plate = Geometry::Box { size: [FLOOR_PLATE, FLOOR_PLATE, 0.002] };
+            rec.log_static("world/floor", &transform(&Pose::new(nalgebra::Matrix3::identity(), nalgebra::Vector3::new(0.0, 0.0, floor.height - 0.001)))).map_err(|x| self.err(x))?;
+            log_geometry(&rec, "world/floor", &plate, Some(rerun::Color::from_unmultiplied_rgba(150, 150, 150, 120))).map_err(|x| self.err(x))?;
+        }
         self.log_series_styles(&rec, e.joint_has_friction().contains(&true))?;
         rec.log_static("config", &rerun::TextDocument::from_markdown(config_markdown(run))).map_err(|x| self.err(x))?;
         let commanded: Vec<[f32; 3]> = run.commanded_tool_path.iter().map(|p| [p.x as f32, p.y as f32, p.z as f32]).collect();
