@@ -686,7 +686,7 @@ fn floor_contact(t: &toml::Table, path: &Path, model: &Model) -> Result<crate::p
     };
     let frame = match t.get("link") {
         None => model.tool_frame,
-        Some(Value::String(link)) => model.frames.iter().position(|f| &f.name == link).ok_or_else(|| fields.err("link", &format!("'{link}' is no link of {}", model.source.display())))?,
+        Some(Value::String(link)) => model.frame_index(link).ok_or_else(|| fields.err("link", &format!("'{link}' is no link of {}", model.source.display())))?,
         Some(_) => return Err(fields.err("link", "must be a link's name")),
     };
     Ok(crate::plant::FloorContact { frame, height })

@@ -244,10 +244,8 @@ pub fn identify_arm(args: &IdentifyArgs, dataset: &Path) -> Result<i32, Error> {
     let joint_names: Vec<String> = model.joints.iter().map(|j| j.name.clone()).collect();
     let space = ArmSpace::new(&start_set, &fitted, &keys, arm.fit_payload.then_some(arm.payload_max), arm.fit_offsets, arm.per_joint.then_some(joint_names.as_slice()));
     // the table the real tool rested on, where the episodes show one
-    let tool_frame = match &arm.tool {
-        Some(link) => model.frames.iter().position(|f| &f.name == link).ok_or_else(|| Error::flag("--tool", format!("'{link}' is no link of {}", urdf.display())))?,
-        None => model.tool_frame,
-    };
+    // (the replayer's model has --tool's frame, checked when it was built)
+    let tool_frame = replayer.model.tool_frame;
     let touch = if arm.no_floor || start_set.floor.is_some() { None } else { crate::identify::floor::touched(&model, tool_frame, &train_cases) };
     if let Some(t) = &touch {
         eprintln!(

@@ -16,7 +16,7 @@ use rerun::blueprint::{Blueprint, BlueprintActivation, BlueprintPanel, Container
 use rerun::blueprint::components::{PanelState, PlayState};
 use rerun::{RecordingStream, TimeColumn};
 use super::torque_axis::TorqueAxis;
-use super::rrd_collisions::{Recolour, RrdCollisions, log_geometry};
+use super::rrd_collisions::{Recolour, RrdCollisions, floor_plate, log_geometry};
 use super::column_pool::ColumnPool;
 use super::plot_colours::{CHATTER_RGB, CURRENT_RGB, FRICTION_RGB, GRAVITY_TORQUE_RGB, LIMIT_RGB, MEASURED_GAP_RGB, MEASURED_RGB, MOTOR_SPEED_RGB, SATURATED_RGB, STUCK_RGB, TARGET_RGB, joint_rgb, observed_rgb};
 use rerun::external::arrow::buffer::{Buffer, OffsetBuffer};
@@ -924,9 +924,9 @@ impl Recorder for RerunRecorder {
         }
         self.log_static_scene(&rec, model)?;
         if let Some(floor) = e.motors.as_ref().and_then(|m| m.floor) {
-            // the table the tool rests on (the motor file's [floor]): a thin plate, its top there
-            let plate = Geometry::Box { size: [FLOOR_PLATE, FLOOR_PLATE, 0.002] };
-            rec.log_static("world/floor", &transform(&Pose::new(nalgebra::Matrix3::identity(), nalgebra::Vector3::new(0.0, 0.0, floor.height - 0.001)))).map_err(|x| self.err(x))?;
+            // the table the tool rests on (the motor file's [floor])
+            let (plate, pose) = floor_plate(floor.height, FLOOR_PLATE);
+            rec.log_static("world/floor", &transform(&pose)).map_err(|x| self.err(x))?;
             log_geometry(&rec, "world/floor", &plate, Some(rerun::Color::from_unmultiplied_rgba(150, 150, 150, 120))).map_err(|x| self.err(x))?;
         }
         self.log_series_styles(&rec, e.joint_has_friction().contains(&true))?;

@@ -35,6 +35,11 @@ pub struct Recolour {
 
 /// Log `geometry` at `path` (its transform logged by the caller); its colour static when given,
 /// else left to temporal colour updates. Returns the archetype used.
+/// A floor drawn: a thin square plate `side` m wide about the world's z axis, its top at `height`.
+pub fn floor_plate(height: f64, side: f64) -> (Geometry, Pose) {
+    (Geometry::Box { size: [side, side, 0.002] }, Pose::new(nalgebra::Matrix3::identity(), nalgebra::Vector3::new(0.0, 0.0, height - 0.001)))
+}
+
 pub fn log_geometry(rec: &RecordingStream, path: &str, geometry: &Geometry, colour: Option<Color>) -> Result<Kind, String> {
     // (no colour at all when none is given: an empty static batch would hide the temporal one)
     let r = |x: RecordingStreamResult<()>| x.map_err(|e| e.to_string());
@@ -185,11 +190,7 @@ impl RrdCollisions {
             let path = format!("world/scene/{}", shape.name);
             let (geometry, pose) = match &shape.drawn {
                 Some((g, p)) => (g.clone(), *p),
-                // the floor: a thin square plate, its top at the floor's height
-                None => {
-                    let z = shape.pose.translation.z;
-                    (Geometry::Box { size: [2.0, 2.0, 0.002] }, Pose::new(nalgebra::Matrix3::identity(), nalgebra::Vector3::new(0.0, 0.0, z - 0.001)))
-                }
+                None => floor_plate(shape.pose.translation.z, 2.0),
             };
             rec.log_static(path.as_str(), &transform(&pose, scale_of(&geometry))).map_err(|e| e.to_string())?;
             let kind = log_geometry(rec, &path, &geometry, None)?;
