@@ -91,7 +91,7 @@ fn simulate_loop(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], s
         plant: plant.describe(),
         trajectory: experiment.trajectory.describe(),
         commanded_tool_path: if recorders.is_empty() || !everything { Vec::new() } else { experiment.commanded_tool_path(0.01) },
-        torque_axes: crate::recorder::torque_axis::LazyAxes::of(experiment),
+        torque_axes: crate::recorder::shared::torque_axis::LazyAxes::of(experiment),
     };
     for r in recorders.iter_mut() {
         r.start(&info)?;

@@ -344,6 +344,53 @@ fn a_floor_holds_the_tool_on_it_and_a_floor_out_of_reach_changes_nothing() {
     assert_eq!(far.states, free.states);
 }
 
+/// The motor file's table is drawn where the plant has it, in the `.rrd` and in both encodings of
+/// the MCAP: a 0.8 m plate with its top at the floor's height (to float32 round-off in the `.rrd`,
+/// exactly in the MCAP's float64 poses).
+#[test]
+fn a_motor_files_table_is_drawn_at_its_height_in_every_recording() {
+    use armscope::ros2::Message;
+    use prost::Message as _;
+    let dir = tempfile::tempdir().unwrap();
+    let height = -0.0217;
+    let motors = dir.path().join("table.toml");
+    std::fs::write(&motors, std::fs::read_to_string(so101_motors()).unwrap() + &format!("\n[floor]\nheight = {height:?}\n")).unwrap();
+    let (rrd, mcap, ros2) = (dir.path().join("t.rrd"), dir.path().join("t.mcap"), dir.path().join("t-ros2.mcap"));
+    let urdf = so101();
+    let recorded = |extra: &[&str]| {
+        let mut args = vec!["run", "--urdf", urdf.to_str().unwrap(), "--motors", motors.to_str().unwrap(), "--duration", "0.05"];
+        args.extend_from_slice(extra);
+        let (code, _, stderr) = run(&args);
+        assert_eq!(code, 0, "{stderr}");
+    };
+    recorded(&["--rrd", rrd.to_str().unwrap(), "--mcap", mcap.to_str().unwrap()]);
+    recorded(&["--no-rrd", "--mcap", ros2.to_str().unwrap(), "--mcap-encoding", "ros2"]);
+
+    let file = common::rrd::Rrd::open(&rrd);
+    let half = file.static_numbers("/world/floor", "Boxes3D:half_sizes");
+    assert_eq!(half.len(), 3, "one box");
+    assert!((half[0] - 0.4).abs() < 1e-6 && (half[1] - 0.4).abs() < 1e-6, "0.8 m wide: {half:?}");
+    let centre = file.static_numbers("/world/floor", "Transform3D:translation");
+    assert!((centre[2] + half[2] - height).abs() < 1e-6, "its top at the floor: centre {centre:?}, half {half:?}");
+
+    let first_geometry = |path: &std::path::Path| {
+        let bytes = std::fs::read(path).unwrap();
+        mcap::MessageStream::new(&bytes).unwrap().map(|m| m.unwrap()).find(|m| m.channel.topic == "/robot/geometry").expect("the geometry").data.to_vec()
+    };
+    let scene = foxglove::messages::SceneUpdate::decode(&first_geometry(&mcap)[..]).unwrap();
+    let table = scene.entities.iter().find(|e| e.id == "floor").expect("the table in the scene");
+    assert_eq!((table.frame_id.as_str(), table.cubes.len()), ("world", 1));
+    let (size, pose) = (table.cubes[0].size.as_ref().unwrap(), table.cubes[0].pose.as_ref().unwrap());
+    assert_eq!((size.x, size.y), (0.8, 0.8));
+    assert!((pose.position.as_ref().unwrap().z + size.z / 2.0 - height).abs() < 1e-12);
+
+    let markers = armscope::ros2::messages::MarkerArray::decode(&first_geometry(&ros2)).unwrap();
+    let table: Vec<_> = markers.markers.iter().filter(|m| m.ns == "floor").collect();
+    assert_eq!(table.len(), 1, "one marker for the table");
+    assert_eq!((table[0].header.frame_id.as_str(), table[0].scale.x, table[0].scale.y), ("world", 0.8, 0.8));
+    assert!((table[0].pose.position.z + table[0].scale.z / 2.0 - height).abs() < 1e-12);
+}
+
 #[test]
 fn a_bad_floor_is_refused_in_one_line_naming_its_field() {
     let dir = tempfile::tempdir().unwrap();

@@ -4,7 +4,7 @@
 //! compare A.mcap B.mcap …` and the merge of shards read them back from the runs' `.mcap` files.
 
 use crate::error::Error;
-use crate::recorder::rrd_file::RrdFile;
+use crate::recorder::rrd::file::RrdFile;
 use crate::recorder::{ControllerTelemetry, Recorder, RunInfo, TOPIC_CONTROLLER, TOPIC_JOINT_STATES, rrd};
 use crate::sample::Sample;
 use crate::summary::Summary;

@@ -140,7 +140,7 @@ pub struct RunArgs {
     pub connect: Option<String>,
     /// Serve the run live to Foxglove (Open connection → Foxglove WebSocket), the MCAP's channels,
     /// at HOST:PORT (default 127.0.0.1:8765); with --realtime the arm moves at real speed.
-    #[arg(long, value_name = "HOST:PORT", num_args = 0..=1, default_missing_value = crate::recorder::foxglove_live::DEFAULT_ADDRESS)]
+    #[arg(long, value_name = "HOST:PORT", num_args = 0..=1, default_missing_value = crate::recorder::mcap::live::DEFAULT_ADDRESS)]
     pub foxglove: Option<String>,
     /// Pace the simulation to the wall clock, FACTOR × real time (default 1).
     #[arg(long, value_name = "FACTOR", num_args = 0..=1, default_missing_value = "1")]

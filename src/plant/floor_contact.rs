@@ -106,3 +106,52 @@ impl FloorSolve {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::{DAMPING, FloorContact, STIFFNESS};
+    use crate::dynamics::{Data, forward_kinematics, frame_pose, gravity_and_bias_from_kinematics};
+    use crate::plant::{DiscretePlant, Plant};
+
+    /// A half-kilogram block on a vertical slider, dropped 1 cm onto a floor, comes to rest sunk by
+    /// its weight over the floor's stiffness, m·g/K = 98.1 µm: at rest the implicit contact's force
+    /// is K·d exactly, so the block's height is the floor's less m·g/K to the solve's round-off.
+    /// Damped about critically (C = 300 against 2·√(K·m) = 316 N·s/m), it is at rest within a second.
+    /// Landing at √(2·g·1 cm) = 0.44 m/s it sinks deeper first, but no deeper than the continuous
+    /// spring–damper would (its peak for that speed and damping ratio, 0.53 mm, plus the resting
+    /// depth): the implicit step adds no energy on impact.
+    #[test]
+    fn a_block_resting_on_the_floor_sinks_by_its_weight_over_the_stiffness() {
+        let mass = 0.5;
+        let urdf = format!(
+            r#"<robot name="slider"><link name="base"/><link name="block"><inertial><mass value="{mass}"/><inertia ixx="1e-3" iyy="1e-3" izz="1e-3" ixy="0" ixz="0" iyz="0"/></inertial></link>
+            <joint name="lift" type="prismatic"><parent link="base"/><child link="block"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="100" velocity="10"/></joint></robot>"#
+        );
+        let model = crate::model::load_urdf_str(&urdf, std::path::Path::new("slider.urdf")).unwrap();
+        let block = model.frame_index("block").unwrap();
+        let floor = -0.01;
+        let h = 1e-3;
+        let mut plant = DiscretePlant::new(&model, h, 1).with_floor(FloorContact { frame: block, height: floor }, model.dof());
+        let mut data = Data::new(&model);
+        let (mut q, mut v) = (vec![0.0], vec![0.0]);
+        let weight = mass * -model.gravity.z;
+        let resting = floor - weight / STIFFNESS;
+        let mut lowest = f64::INFINITY;
+        for _ in 0..2000 {
+            forward_kinematics(&model, &mut data, &q);
+            gravity_and_bias_from_kinematics(&model, &mut data, &v);
+            lowest = lowest.min(frame_pose(&model, &data, block).translation.z);
+            plant.advance(&model, &mut data, &[0.0], &mut q, &mut v);
+        }
+        forward_kinematics(&model, &mut data, &q);
+        let height = frame_pose(&model, &data, block).translation.z;
+        assert!((height - resting).abs() < 1e-9, "at rest at {height} m, m·g/K puts it at {resting} m");
+        assert!(v[0].abs() < 1e-9, "at rest: {} m/s", v[0]);
+        let (omega, zeta) = ((STIFFNESS / mass).sqrt(), DAMPING / (2.0 * (STIFFNESS * mass).sqrt()));
+        let landing_speed = (2.0 * weight / mass * (0.0 - floor)).sqrt();
+        let spread = (1.0 - zeta * zeta).sqrt();
+        let peak = landing_speed / omega * (-zeta / spread * (spread / zeta).atan()).exp() + weight / STIFFNESS;
+        let landed = floor - lowest;
+        assert!(landed > weight / STIFFNESS && landed <= peak, "landed {} µm deep: between the resting {} µm and the continuous contact's peak {} µm", landed * 1e6, weight / STIFFNESS * 1e6, peak * 1e6);
+    }
+}

@@ -1,37 +1,18 @@
 //! Recorders: everything that turns samples into output. The simulation loop knows only this
 //! trait; a new format is one new file.
 
-mod column_pool;
 mod console;
-mod contacts;
-pub mod foxglove_layout;
-pub mod foxglove_live;
-mod mcap;
-mod mcap_out;
-mod mcap_ros2;
-pub mod mcap_collisions;
-pub(crate) mod output_file;
-mod overview;
+pub mod mcap;
 mod pacer;
-mod plot_colours;
 pub mod rrd;
-mod robot_description;
-mod rrd_collisions;
-pub(crate) mod rrd_file;
-mod step_messages;
+pub mod shared;
 mod summary_json;
-pub mod telemetry;
 mod threaded;
-pub mod torque_axis;
-mod worker;
 mod trace;
 mod tutorial_csv;
 
 pub use console::Console;
-pub use mcap::{McapEncoding, McapOptions, McapRecorder, TOPIC_CONTROLLER, TOPIC_JOINT_STATES};
-pub use mcap_ros2::{Ros2McapRecorder, decode_controller_telemetry};
-pub use robot_description::{RobotDescription, decode as decode_robot_description};
-pub use telemetry::ControllerTelemetry;
+pub use mcap::{ControllerTelemetry, McapEncoding, McapOptions, McapRecorder, RobotDescription, Ros2McapRecorder, TOPIC_CONTROLLER, TOPIC_JOINT_STATES, decode_controller_telemetry, decode_robot_description};
 pub use pacer::Pacer;
 pub use rrd::{DEFAULT_CONNECT_URL, LiveViewer, RerunOptions, RerunRecorder};
 pub use summary_json::SummaryJson;
@@ -54,7 +35,7 @@ pub struct RunInfo<'a> {
     pub commanded_tool_path: Vec<nalgebra::Vector3<f64>>,
     /// Each joint's torque plot scale, worked out on first use: recorders read it through
     /// [`RunInfo::torque_axes`]; only the loop that makes a `RunInfo` sets it.
-    pub(crate) torque_axes: torque_axis::LazyAxes<'a>,
+    pub(crate) torque_axes: shared::torque_axis::LazyAxes<'a>,
     /// Per joint, whether the samples carry a measured effort beside the model's torque (a replayed
     /// bag's `effort`); empty for a simulation.
     pub measured_effort: Vec<bool>,
@@ -67,7 +48,7 @@ impl RunInfo<'_> {
     /// Each joint's torque plot scale, worked out when first asked for: a file's plots are laid out
     /// when the run ends (where one core is otherwise idle, waiting for Rerun's last chunks), and a
     /// run without recordings never needs them.
-    pub fn torque_axes(&self) -> &[torque_axis::TorqueAxis] {
+    pub fn torque_axes(&self) -> &[shared::torque_axis::TorqueAxis] {
         self.torque_axes.get()
     }
 }

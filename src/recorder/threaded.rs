@@ -1,4 +1,4 @@
-use super::worker::{BatchWorker, Reusable};
+use super::shared::worker::{BatchWorker, Reusable};
 use super::{Recorder, RunInfo};
 use crate::error::Error;
 use crate::sample::Sample;

@@ -76,7 +76,7 @@ pub fn record(replayer: &Replayer, replay: &EpisodeReplay, outputs: &RecordingOu
         plant: "a recorded motion, replayed by inverse dynamics (no simulation)".into(),
         trajectory: format!("{} as recorded", motion.label),
         commanded_tool_path: tool_path,
-        torque_axes: crate::recorder::torque_axis::LazyAxes::of(&experiment),
+        torque_axes: crate::recorder::shared::torque_axis::LazyAxes::of(&experiment),
     };
     let mut recorders = outputs.open()?;
     for r in recorders.iter_mut() {

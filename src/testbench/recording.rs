@@ -7,7 +7,7 @@ use super::log::BenchLog;
 use super::replay::Rollout;
 use crate::error::Error;
 use crate::recorder::rrd;
-use crate::recorder::rrd_file::RrdFile;
+use crate::recorder::rrd::file::RrdFile;
 use rerun::TimeColumn;
 use rerun::blueprint::components::{PanelState, PlayState};
 use rerun::blueprint::{Blueprint, BlueprintActivation, BlueprintPanel, Grid, SelectionPanel, TimePanel, TimeSeriesView, Vertical};
@@ -88,7 +88,7 @@ const ROW_SCHEMA: &str = r#"{"type": "object", "properties": {
 /// The `.mcap` of every replayed log: a channel `/testbench/LOG` each, one JSON message a row.
 pub fn write_mcap(path: &Path, runs: &[(&BenchLog, &Rollout)]) -> Result<(), Error> {
     let err = |e: String| Error::output(path, e);
-    let (file, _replaced) = crate::recorder::output_file::create_replacing(path).map_err(|e| err(e.to_string()))?;
+    let (file, _replaced) = crate::recorder::shared::output_file::create_replacing(path).map_err(|e| err(e.to_string()))?;
     let mut writer = mcap::WriteOptions::new().compression(None).profile("").create(BufWriter::new(file)).map_err(|e| err(e.to_string()))?;
     let schema = writer.add_schema("armscope.TestbenchRow", "jsonschema", ROW_SCHEMA.as_bytes()).map_err(|e| err(e.to_string()))?;
     for (log, rollout) in runs {

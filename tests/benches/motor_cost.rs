@@ -3,6 +3,11 @@
 //! time of each. On a machine whose speed drifts by tens of percent within minutes, runs timed minutes
 //! apart (criterion's groups) give ratios that scatter by ±10 %; timed in turn, they repeat within a
 //! few percent. `cargo bench --bench motor_cost [ROUNDS]` (default 30).
+//!
+//! Beside them, what a motor file's `[floor]` costs: the SO-101 on its servos with 0.2 kg along its
+//! default trajectory, against the same run with a table at z = 0.12 m, halfway down from where its
+//! tool starts (0.187 m) to its lowest (0.053 m): the tool is on the table a fifth of the run, and
+//! within reach of it (where the contact's Jacobian is taken) most of it.
 
 use armscope::config::{DriveMode, RunConfig};
 use armscope::experiment::Experiment;
@@ -23,14 +28,20 @@ fn main() {
     // that step is what its plant steps cost without them
     let stepper_plant_step = Experiment::prepare(steppers.clone()).expect("the tutorial's steppers").plant.time_step().expect("the default plant is discrete");
     let bare_at_stepper_step = RunConfig { time_step: Some(stepper_plant_step), ..bare.clone() };
+    let so101_motors = std::fs::read_to_string(root.join("assets/motors/so101.toml")).expect("the SO-101's motor file");
+    let table_file = std::env::temp_dir().join(format!("armscope-bench-table-{}.toml", std::process::id()));
+    std::fs::write(&table_file, so101_motors + "\n[floor]\nheight = 0.12\n").expect("a motor file with a table");
+    let so101 = RunConfig { urdf: root.join("tests/fixtures/robots/so101.urdf"), motors: Some(root.join("assets/motors/so101.toml")), payload: 0.2, ..RunConfig::default() };
+    let so101_on_table = RunConfig { motors: Some(table_file.clone()), ..so101.clone() };
     let pairs = [
         ("--drive pd", "the run without motors", bare, pd),
         ("open-loop steppers", "the run without motors at their plant step", bare_at_stepper_step, steppers),
+        ("the SO-101's servos with a table under the tool", "without the table", so101, so101_on_table),
     ];
-    println!("30 s default run, the tutorial's drive trains against none: best of {rounds} rounds, each pair in turn");
+    println!("the default run (30 s), with and without: best of {rounds} rounds, each pair in turn");
     for (with, without, config_without, config_with) in pairs {
-        let experiment_without = Experiment::prepare(config_without).expect("the box model");
-        let experiment_with = Experiment::prepare(config_with).expect("the tutorial's drive trains");
+        let experiment_without = Experiment::prepare(config_without).expect("the run without");
+        let experiment_with = Experiment::prepare(config_with).expect("the run with");
         let (mut best_without, mut best_with) = (Duration::MAX, Duration::MAX);
         for _ in 0..rounds {
             best_without = best_without.min(time(&experiment_without));
@@ -43,6 +54,7 @@ fn main() {
             best_with.as_secs_f64() / best_without.as_secs_f64()
         );
     }
+    let _ = std::fs::remove_file(table_file);
 }
 
 fn time(experiment: &Experiment) -> Duration {

@@ -170,6 +170,20 @@ impl Rrd {
         count
     }
 
+    /// An entity's static `component`, every static row's numbers flattened (a box's half sizes, a
+    /// transform's translation).
+    pub fn static_numbers(&self, entity: &str, component: &str) -> Vec<f64> {
+        let mut out = Vec::new();
+        for chunk in self.chunks.iter().filter(|c| c.is_static() && c.entity_path().to_string() == entity) {
+            if let Some(column) = chunk.components().0.values().find(|c| c.descriptor.component.as_str() == component) {
+                for k in (0..column.list_array.len()).filter(|&k| !column.list_array.is_null(k)) {
+                    out.extend(numbers(column.list_array.value(k).as_ref()));
+                }
+            }
+        }
+        out
+    }
+
     /// The `Scalars:scalars` rows of an entity.
     pub fn series(&self, entity: &str) -> Vec<(f64, Vec<f64>)> {
         self.component(entity, "Scalars:scalars")

@@ -5,11 +5,12 @@
 //! the whole set (all deleted, those in contact added), so the latest one, all a viewer reads after
 //! seeking, is right on its own; it is sent only when the set changes.
 
-use super::contacts::{Body, ContactTracker, pair_name};
+use super::scene::add_primitives;
+use crate::recorder::shared::contacts::{Body, ContactTracker, pair_name};
+use crate::recorder::shared::floor_plate::{SCENE_FLOOR_SIDE, floor_plate};
 use crate::collision::Collisions;
-use crate::model::{Geometry, Model};
-use crate::spatial::Pose;
-use foxglove::messages::{Color, CubePrimitive, CylinderPrimitive, SceneEntity, SceneEntityDeletion, SceneUpdate, SpherePrimitive, Timestamp, Vector3};
+use crate::model::Model;
+use foxglove::messages::{Color, SceneEntity, SceneEntityDeletion, SceneUpdate, Timestamp};
 use prost::Message;
 use prost_types::field_descriptor_proto::{Label, Type};
 use prost_types::{DescriptorProto, FieldDescriptorProto, FileDescriptorProto, FileDescriptorSet};
@@ -95,39 +96,6 @@ const RED: Color = Color { r: 0.92, g: 0.12, b: 0.12, a: 0.75 };
 const SCENE_GREY: Color = Color { r: 0.6, g: 0.6, b: 0.65, a: 0.6 };
 const PAYLOAD: Color = Color { r: 0.8, g: 0.63, b: 0.24, a: 1.0 };
 
-fn pose(p: &Pose) -> foxglove::messages::Pose {
-    let t = p.translation;
-    let [x, y, z, w] = p.quaternion_xyzw();
-    foxglove::messages::Pose { position: Some(Vector3 { x: t.x, y: t.y, z: t.z }), orientation: Some(foxglove::messages::Quaternion { x, y, z, w }) }
-}
-
-/// `geometry` at `origin` as primitives in `entity`, grown by `grow` (m, each side: a highlight over
-/// the link's own surfaces); a mesh as its bounding box.
-fn add_primitives(entity: &mut SceneEntity, geometry: &Geometry, origin: &Pose, colour: Color, grow: f64) {
-    let v = |x: f64, y: f64, z: f64| Some(Vector3 { x: x + 2.0 * grow, y: y + 2.0 * grow, z: z + 2.0 * grow });
-    match geometry {
-        Geometry::Box { size } => entity.cubes.push(CubePrimitive { pose: Some(pose(origin)), size: v(size[0], size[1], size[2]), color: Some(colour) }),
-        Geometry::Cylinder { radius, length } | Geometry::Capsule { radius, length } => {
-            entity.cylinders.push(CylinderPrimitive { pose: Some(pose(origin)), size: v(2.0 * radius, 2.0 * radius, *length), bottom_scale: 1.0, top_scale: 1.0, color: Some(colour) });
-            if matches!(geometry, Geometry::Capsule { .. }) {
-                for end in [-0.5, 0.5] {
-                    let cap = origin.compose(&Pose::new(nalgebra::Matrix3::identity(), nalgebra::Vector3::new(0.0, 0.0, end * length)));
-                    entity.spheres.push(SpherePrimitive { pose: Some(pose(&cap)), size: v(2.0 * radius, 2.0 * radius, 2.0 * radius), color: Some(colour) });
-                }
-            }
-        }
-        Geometry::Sphere { radius } => entity.spheres.push(SpherePrimitive { pose: Some(pose(origin)), size: v(2.0 * radius, 2.0 * radius, 2.0 * radius), color: Some(colour) }),
-        Geometry::Mesh { .. } => {
-            if let Ok(shape) = crate::collision::geometry::parry_shape(geometry) {
-                let aabb = shape.compute_local_aabb();
-                let (c, h) = (aabb.center(), aabb.half_extents());
-                let centre = origin.compose(&Pose::new(nalgebra::Matrix3::identity(), nalgebra::Vector3::new(c.x, c.y, c.z)));
-                entity.cubes.push(CubePrimitive { pose: Some(pose(&centre)), size: v(2.0 * h.x, 2.0 * h.y, 2.0 * h.z), color: Some(colour) });
-            }
-        }
-    }
-}
-
 /// The recorder's collision state over a run.
 pub struct McapCollisions {
     model: Arc<Model>,
@@ -153,8 +121,8 @@ impl McapCollisions {
             match &shape.drawn {
                 Some((g, p)) => add_primitives(&mut entity, g, p, SCENE_GREY, 0.0),
                 None => {
-                    let z = shape.pose.translation.z;
-                    add_primitives(&mut entity, &Geometry::Box { size: [2.0, 2.0, 0.002] }, &Pose::new(nalgebra::Matrix3::identity(), nalgebra::Vector3::new(0.0, 0.0, z - 0.001)), SCENE_GREY, 0.0);
+                    let (plate, pose) = floor_plate(shape.pose.translation.z, SCENE_FLOOR_SIDE);
+                    add_primitives(&mut entity, &plate, &pose, SCENE_GREY, 0.0);
                 }
             }
             out.push(entity);
@@ -218,8 +186,8 @@ impl McapCollisions {
                     match &shape.drawn {
                         Some((g, p)) => add_primitives(&mut e, g, p, RED, 0.002),
                         None => {
-                            let z = shape.pose.translation.z;
-                            add_primitives(&mut e, &Geometry::Box { size: [2.0, 2.0, 0.002] }, &Pose::new(nalgebra::Matrix3::identity(), nalgebra::Vector3::new(0.0, 0.0, z - 0.001)), RED, 0.001);
+                            let (plate, pose) = floor_plate(shape.pose.translation.z, SCENE_FLOOR_SIDE);
+                            add_primitives(&mut e, &plate, &pose, RED, 0.001);
                         }
                     }
                     e

@@ -28,7 +28,7 @@ struct State {
     /// `None` once closed, or after a write failed.
     encoder: Option<RrdEncoder>,
     /// The last run's file at this path, freed meanwhile on another thread.
-    _replaced: super::output_file::Replaced,
+    _replaced: crate::recorder::shared::output_file::Replaced,
     error: Option<String>,
 }
 
@@ -40,7 +40,7 @@ pub const FOOTER_UP_TO_SECONDS: f64 = 600.0;
 impl RrdFile {
     /// `footer`: end the file with Rerun's manifest of its chunks; `compress`: LZ4 its chunks.
     pub fn create(path: &Path, footer: bool, compress: bool) -> Result<Self, String> {
-        let (file, replaced) = super::output_file::create_replacing(path).map_err(|e| e.to_string())?;
+        let (file, replaced) = crate::recorder::shared::output_file::create_replacing(path).map_err(|e| e.to_string())?;
         // the encoder writes each message whole: a buffer smaller than a block's chunks (100–250 KB)
         // gathers the small messages and lets the chunks go straight to the file, uncopied
         let options = if compress { EncodingOptions::PROTOBUF_COMPRESSED } else { EncodingOptions::PROTOBUF_UNCOMPRESSED };

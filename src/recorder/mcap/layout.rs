@@ -6,8 +6,8 @@
 use crate::dynamics::{body_poses, frame_pose_in};
 use crate::model::Model;
 use crate::spatial::Pose;
-use super::plot_colours::{FRICTION_RGB, LIMIT_RGB, MEASURED_RGB, TARGET_RGB, hex, joint_rgb, observed_rgb};
-use super::torque_axis::TorqueAxis;
+use crate::recorder::shared::plot_colours::{FRICTION_RGB, LIMIT_RGB, MEASURED_RGB, TARGET_RGB, hex, joint_rgb, observed_rgb};
+use crate::recorder::shared::torque_axis::TorqueAxis;
 use serde_json::{Value, json};
 
 /// The plot settings every plot panel shares.
@@ -50,12 +50,6 @@ fn camera(model: &Model, q: &[f64]) -> ([f64; 3], f64) {
     let centre = (lo + hi) / 2.0;
     let spread = (hi - lo).norm();
     ([centre.x, centre.y, centre.z], (4.0 * spread).max(0.6))
-}
-
-/// The layout for `model`, whose run starts at joint positions `q0` (torque plots scaled by the
-/// viewer: the committed layout, for live runs of any command).
-pub fn layout(model: &Model, q0: &[f64]) -> Value {
-    layout_for_run(model, q0, &RunPlots::default())
 }
 
 /// What a run's plots show beyond angles and torques.
@@ -211,7 +205,7 @@ mod tests {
         let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
         let model = crate::model::load_urdf(&root.join(crate::builtin::DEFAULT_URDF)).unwrap();
         let path = root.join("assets/foxglove/armscope_layout.json");
-        let expected = layout(&model, &vec![0.0; model.dof()]);
+        let expected = layout_for_run(&model, &vec![0.0; model.dof()], &RunPlots::default());
         if std::env::var_os("ARMSCOPE_REGENERATE").is_some() {
             std::fs::write(&path, serde_json::to_string_pretty(&expected).unwrap() + "\n").unwrap();
         }
@@ -273,7 +267,7 @@ mod tests {
         let urdf = r#"<robot name="two"><link name="base"/><link name="a"><inertial><mass value="1"/><inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial></link>
             <joint name="shoulder_pan" type="continuous"><parent link="base"/><child link="a"/><axis xyz="0 0 1"/></joint></robot>"#;
         let model = crate::model::load_urdf_str(urdf, std::path::Path::new("two.urdf")).unwrap();
-        let l = layout(&model, &[0.0]);
+        let l = layout_for_run(&model, &[0.0], &RunPlots::default());
         let labels: Vec<&str> = l["configById"]["Plot!angles"]["paths"].as_array().unwrap().iter().map(|p| p["label"].as_str().unwrap()).collect();
         assert_eq!(labels, ["shoulder_pan angle", "shoulder_pan target"]);
         assert_eq!(l["configById"]["Plot!torque0"]["paths"][0]["label"], "shoulder_pan torque");

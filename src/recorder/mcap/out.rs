@@ -2,8 +2,11 @@
 //! clients, or both) written on a thread of its own from batches of encoded messages, channels and
 //! metadata added before the thread starts.
 
-use super::foxglove_live::FoxgloveLive;
-use super::worker::{BatchWorker, Reusable};
+use super::McapOptions;
+use super::live::FoxgloveLive;
+use crate::error::Error;
+use crate::recorder::shared::output_file::Replaced;
+use crate::recorder::shared::worker::{BatchWorker, Reusable};
 use foxglove::Encode;
 use mcap::records::MessageHeader;
 use std::collections::BTreeMap;
@@ -194,7 +197,7 @@ pub(super) fn zstd_level(level: i32) -> u32 {
 
 /// The run's configuration as both encodings write it (`armscope.config` metadata): model, URDF,
 /// settings, gains, notices, plant, command, and how the file's timestamps relate to the run's time.
-pub(super) fn config_metadata(run: &super::RunInfo, start_ns: u64, timestamps: &str) -> std::collections::BTreeMap<String, String> {
+pub(super) fn config_metadata(run: &crate::recorder::RunInfo, start_ns: u64, timestamps: &str) -> std::collections::BTreeMap<String, String> {
     let (e, model) = (run.experiment, &*run.experiment.model);
     let mut meta = std::collections::BTreeMap::new();
     meta.insert("model".into(), model.name.clone());
@@ -211,10 +214,84 @@ pub(super) fn config_metadata(run: &super::RunInfo, start_ns: u64, timestamps: &
 
 /// The `/controller` channel's metadata in both encodings: the joint order and torque limits,
 /// constant over a run (not repeated in every message).
-pub(super) fn controller_metadata(run: &super::RunInfo) -> std::collections::BTreeMap<String, String> {
+pub(super) fn controller_metadata(run: &crate::recorder::RunInfo) -> std::collections::BTreeMap<String, String> {
     let e = run.experiment;
     let mut meta = std::collections::BTreeMap::new();
     meta.insert("joints".to_string(), serde_json::to_string(&e.model.joints.iter().map(|j| &j.name).collect::<Vec<_>>()).unwrap_or_default());
     meta.insert("torque_limit".to_string(), serde_json::to_string(&e.controller().effort).unwrap_or_default());
     meta
+}
+
+/// The sinks of a recording: its file (the last one at its path freed meanwhile, see
+/// `create_replacing`), written with `profile` in the MCAP header ("": none; "ros2"), and the live
+/// Foxglove server, with `notice` told where it listens. Errors name `path_for_errors`.
+pub(super) fn open_sinks(options: &McapOptions, profile: &str, path_for_errors: &std::path::Path, notice: Option<fn(&str)>) -> Result<(Sinks, Option<Replaced>), Error> {
+    let mut replaced = None;
+    let file = match &options.file {
+        Some(path) => {
+            let (file, old) = crate::recorder::shared::output_file::create_replacing(path).map_err(|err| Error::output(path_for_errors, err))?;
+            replaced = Some(old);
+            Some(file)
+        }
+        None => None,
+    };
+    // zstd (with --compress) on the writer thread (`Out`): zstd's own worker threads cost more
+    // than they save here
+    let write_options = mcap::WriteOptions::new()
+        .compression(options.compress.then_some(mcap::Compression::Zstd))
+        .compression_level(zstd_level(ZSTD_LEVEL))
+        .compression_threads(0)
+        // within zstd's window at this level, so no block takes its slower "external
+        // dictionary" path (−5 % of the writer's work at the same size)
+        .chunk_size(Some(512 * 1024))
+        // CRCs with --compress only: the crate checksums every record field by field as it
+        // writes it, twice (5 % of the run's instructions), and the data section's CRC needs
+        // the chunks' (the default is rosbag2's "fastwrite": chunks as they are, no CRCs;
+        // readers skip a zero CRC)
+        .calculate_chunk_crcs(options.compress)
+        .calculate_data_section_crc(options.compress)
+        .profile(profile)
+        .library(if profile == "ros2" { format!("armscope {} (ROS 2 CDR, mcap-rust)", env!("CARGO_PKG_VERSION")) } else { format!("armscope {} (foxglove-sdk schemas, mcap-rust)", env!("CARGO_PKG_VERSION")) });
+    // zstd hands its output over in pieces of up to 128 KiB: gathered here, a chunk (~200 KiB
+    // compressed) takes a write call or two
+    let file = file.map(|file| write_options.create(BufWriter::with_capacity(1 << 20, file))).transpose().map_err(|err| Error::output(path_for_errors, err))?;
+    let live = match &options.live {
+        Some(address) => {
+            let live = FoxgloveLive::start(address).map_err(|err| Error::flag("--foxglove", err))?;
+            if let Some(notice) = notice {
+                notice(&format!("Foxglove live at ws://{} (Foxglove: Open connection → Foxglove WebSocket)", live.address()));
+            }
+            Some(live)
+        }
+        None => None,
+    };
+    Ok((Sinks { file, live }, replaced))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The same telemetry-like messages, written with zstd at `level`: the file's size.
+    fn mcap_size(level: u32) -> usize {
+        let options = mcap::WriteOptions::new().compression(Some(mcap::Compression::Zstd)).compression_level(level).compression_threads(0);
+        let mut writer = options.create(std::io::Cursor::new(Vec::new())).unwrap();
+        let channel = writer.add_channel(0, "/data", "binary", &BTreeMap::new()).unwrap();
+        for k in 0..20_000u32 {
+            // text with numbers, like a log line: repetitive enough that how hard zstd looks shows
+            let data = format!("step {k} joint J{} angle {:.4} target {:.4}", k % 6 + 1, (k as f64 * 1e-3).sin(), (k as f64 * 1e-3).cos()).into_bytes();
+            let header = MessageHeader { channel_id: channel, sequence: k, log_time: k as u64, publish_time: k as u64 };
+            writer.write_to_known_channel(&header, &data).unwrap();
+        }
+        writer.finish().unwrap();
+        writer.into_inner().into_inner().len()
+    }
+
+    #[test]
+    fn negative_zstd_levels_reach_zstd_through_mcap() {
+        // on this data level −3 writes 1.25× the bytes of level 1; the default level (3), level 1
+        // itself, or zstd's highest (22) write 0.8–1.02×: whichever mcap made of −3 shows
+        let (fast, level_1) = (mcap_size(zstd_level(ZSTD_LEVEL)), mcap_size(1));
+        assert!(fast as f64 > 1.15 * level_1 as f64, "level {ZSTD_LEVEL}: {fast} bytes, level 1: {level_1}");
+    }
 }

@@ -3,29 +3,29 @@
 //! are buffered and sent as one chunk per entity and block (per-step `log` calls cost ~170 µs
 //! here; a block of 4096 steps costs ~2.5 µs per step), to the `.rrd` and/or a live viewer.
 
-use super::overview::Overview;
-use super::rrd_file::{FOOTER_UP_TO_SECONDS, RrdFile};
-use super::{Recorder, RunInfo};
+use super::TIMELINE;
+use super::blueprint::{blueprint, joint_color, rgb, send_blueprint};
+use super::collisions::{CONTACT, RrdCollisions};
+use super::column_pool::ColumnPool;
+use super::columns::{Strips, float32_column, list_column, scalar_column, send_chunk_in_order, send_in_order};
+use super::file::{FOOTER_UP_TO_SECONDS, RrdFile};
+use super::geometry::{Recolour, log_geometry, quaternion_xyzw, transform};
+use crate::recorder::shared::floor_plate::{TABLE_SIDE, floor_plate};
+use super::markdown::{config_markdown, summary_markdown};
 use crate::dynamics::frame_pose_in;
 use crate::error::Error;
 use crate::model::{Geometry, Model};
+use crate::recorder::shared::overview::Overview;
+use crate::recorder::shared::plot_colours::{CHATTER_RGB, CURRENT_RGB, FRICTION_RGB, GRAVITY_TORQUE_RGB, LIMIT_RGB, MEASURED_GAP_RGB, MEASURED_RGB, MOTOR_SPEED_RGB, SATURATED_RGB, STUCK_RGB, TARGET_RGB, observed_rgb};
+use crate::recorder::{Recorder, RunInfo};
 use crate::sample::Sample;
-use crate::spatial::Pose;
 use crate::summary::Summary;
-use rerun::blueprint::{Blueprint, BlueprintActivation, BlueprintPanel, ContainerLike, Grid, Horizontal, SelectionPanel, Spatial3DView, TimePanel, TimeSeriesView, Vertical};
-use rerun::blueprint::components::{PanelState, PlayState};
+use rerun::external::arrow::buffer::OffsetBuffer;
 use rerun::{RecordingStream, TimeColumn};
-use super::torque_axis::TorqueAxis;
-use super::rrd_collisions::{Recolour, RrdCollisions, floor_plate, log_geometry};
-use super::column_pool::ColumnPool;
-use super::plot_colours::{CHATTER_RGB, CURRENT_RGB, FRICTION_RGB, GRAVITY_TORQUE_RGB, LIMIT_RGB, MEASURED_GAP_RGB, MEASURED_RGB, MOTOR_SPEED_RGB, SATURATED_RGB, STUCK_RGB, TARGET_RGB, joint_rgb, observed_rgb};
-use rerun::external::arrow::buffer::{Buffer, OffsetBuffer};
 use std::collections::VecDeque;
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
-
-pub const TIMELINE: &str = "sim_time";
 
 /// Where the recording goes besides the file.
 #[derive(Clone, Debug)]
@@ -416,7 +416,7 @@ impl RerunRecorder {
         .map_err(e)?;
         rec.log_static("tool_error", &rerun::SeriesLines::new().with_names(["tool tip error |p − p_cmd| (m)"]).with_colors([rerun::Color::from_rgb(230, 60, 60)])).map_err(e)?;
         if self.collisions.is_some() {
-            rec.log_static("collisions/in_contact", &rerun::SeriesLines::new().with_names(["pairs in contact"]).with_colors([super::rrd_collisions::CONTACT])).map_err(e)?;
+            rec.log_static("collisions/in_contact", &rerun::SeriesLines::new().with_names(["pairs in contact"]).with_colors([CONTACT])).map_err(e)?;
             rec.log_static("collisions/min_distance", &rerun::SeriesLines::new().with_names(["closest pair distance (m; < 0: overlap)"]).with_colors([rerun::Color::from_rgb(60, 90, 220)])).map_err(e)?;
         }
         Ok(())
@@ -548,132 +548,6 @@ impl RerunRecorder {
     }
 }
 
-/// A `Scalars` column of `width` values per row, its Arrow array copied straight from the buffer:
-/// Rerun's generic serialization first turns every value into an `Option` with a validity flag
-/// (a quarter of this recorder's thread's work, in memory that is new for every block).
-pub(crate) fn scalar_column(values: &[f64], width: usize) -> rerun::SerializedComponentColumn {
-    let rows = values.len() / width;
-    list_column(Buffer::from_slice_ref(values), OffsetBuffer::from_lengths(std::iter::repeat_n(width, rows)), rerun::Scalars::descriptor_scalars())
-}
-
-/// A column of float64 lists, the values' bytes in `values` and each row's in `offsets`.
-fn list_column(values: Buffer, offsets: OffsetBuffer<i32>, descriptor: rerun::ComponentDescriptor) -> rerun::SerializedComponentColumn {
-    use rerun::external::arrow::array::{ArrayRef, Float64Array, ListArray};
-    use rerun::external::arrow::buffer::ScalarBuffer;
-    use rerun::external::arrow::datatypes::{DataType, Field};
-    let count = values.len() / std::mem::size_of::<f64>();
-    let values: ArrayRef = Arc::new(Float64Array::new(ScalarBuffer::new(values, 0, count), None));
-    let list = ListArray::new(Arc::new(Field::new_list_field(DataType::Float64, true)), offsets, values, None);
-    rerun::SerializedComponentColumn::new(list, descriptor)
-}
-
-/// Line strips, one a row, stored as a `LineStrips3D` column keeps them: every strip's points back
-/// to back, and each strip's length. A trail update appends its strip without a vector of its own
-/// (one per update was a fifth of this recorder's thread), and the points move into Arrow uncopied.
-#[derive(Default)]
-struct Strips {
-    points: Vec<[f32; 3]>,
-    lengths: Vec<usize>,
-    /// Points the last block's strips had (the next block's room).
-    last_points: usize,
-}
-
-impl Strips {
-    fn is_empty(&self) -> bool {
-        self.lengths.is_empty()
-    }
-
-    /// Appends a strip; a block's first takes its points' memory from `pool`.
-    fn push(&mut self, strip: impl ExactSizeIterator<Item = [f32; 3]>, pool: &ColumnPool<[f32; 3]>) {
-        if self.points.capacity() == 0 {
-            self.points = pool.take(self.last_points.max(strip.len()));
-        }
-        self.lengths.push(strip.len());
-        self.points.extend(strip);
-    }
-
-    /// The strips so far as a column, one strip per row: what `LineStrips3D::update_fields()
-    /// .with_strips(..).columns_of_unit_batches()` makes (test below), without its generic
-    /// serialization. The next block starts empty.
-    fn take_column(&mut self, pool: &ColumnPool<[f32; 3]>) -> rerun::SerializedComponentColumn {
-        use rerun::external::arrow::array::{ArrayRef, FixedSizeListArray, Float32Array, ListArray};
-        use rerun::external::arrow::buffer::ScalarBuffer;
-        use rerun::external::arrow::datatypes::{DataType, Field};
-        let strip_type = <rerun::components::LineStrip3D as rerun::Loggable>::arrow_datatype();
-        let DataType::List(point_field) = &strip_type else { unreachable!("a line strip is a list of points") };
-        let DataType::FixedSizeList(coordinate_field, 3) = point_field.data_type() else { unreachable!("a point is three float32") };
-        let points = std::mem::take(&mut self.points);
-        self.last_points = points.len();
-        let count = 3 * points.len();
-        let coordinates = Float32Array::new(ScalarBuffer::new(pool.buffer(points), 0, count), None);
-        let points: ArrayRef = Arc::new(FixedSizeListArray::new(coordinate_field.clone(), 3, Arc::new(coordinates), None));
-        let strip_list: ArrayRef = Arc::new(ListArray::new(point_field.clone(), OffsetBuffer::from_lengths(self.lengths.iter().copied()), points, None));
-        let rows = ListArray::new(Arc::new(Field::new_list_field(strip_type.clone(), true)), OffsetBuffer::from_lengths(std::iter::repeat_n(1, self.lengths.len())), strip_list, None);
-        self.lengths.clear();
-        rerun::SerializedComponentColumn::new(rows, rerun::LineStrips3D::descriptor_strips())
-    }
-}
-
-/// A column of one fixed-size float32 component (a translation, a quaternion) per row, built
-/// from the values back to back, with the component's own Arrow type.
-fn float32_column<C: rerun::Loggable>(values: &[f32], descriptor: rerun::ComponentDescriptor) -> rerun::SerializedComponentColumn {
-    use rerun::external::arrow::array::{ArrayRef, FixedSizeListArray, Float32Array, ListArray};
-    use rerun::external::arrow::buffer::OffsetBuffer;
-    use rerun::external::arrow::datatypes::{DataType, Field};
-    let DataType::FixedSizeList(item, width) = C::arrow_datatype() else {
-        unreachable!("translations and quaternions are fixed-size lists of float32")
-    };
-    let rows = values.len() / width as usize;
-    let components: ArrayRef = Arc::new(FixedSizeListArray::new(item, width, Arc::new(Float32Array::from_iter_values(values.iter().copied())), None));
-    let list = ListArray::new(Arc::new(Field::new_list_field(C::arrow_datatype(), true)), OffsetBuffer::from_lengths(std::iter::repeat_n(1, rows)), components, None);
-    rerun::SerializedComponentColumn::new(list, descriptor)
-}
-
-/// `send_columns` for rows already in time order. Rerun's own first reorders every chunk by time
-/// (a sort and a shuffle of each column, a fifth of this recorder's work); a block's rows are in
-/// order, so here they keep it and get consecutive row ids.
-pub(crate) fn send_in_order(
-    rec: &RecordingStream,
-    entity: &str,
-    time: TimeColumn,
-    columns: impl IntoIterator<Item = rerun::SerializedComponentColumn>,
-) -> Result<(), rerun::log::ChunkError> {
-    send_chunk_in_order(rec, entity, time, columns, &ColumnPool::default())
-}
-
-/// `send_in_order`, the row ids in memory from `ids`.
-fn send_chunk_in_order(
-    rec: &RecordingStream,
-    entity: &str,
-    time: TimeColumn,
-    columns: impl IntoIterator<Item = rerun::SerializedComponentColumn>,
-    ids: &ColumnPool<[u8; 16]>,
-) -> Result<(), rerun::log::ChunkError> {
-    use rerun::log::{Chunk, ChunkId};
-    let row_ids = consecutive_row_ids(time.num_rows(), ids);
-    let components: rerun::log::ChunkComponents = columns.into_iter().map(|c| (c.descriptor, c.list_array)).collect();
-    let timelines = std::iter::once((*time.timeline().name(), time)).collect();
-    rec.send_chunk(Chunk::new(ChunkId::new(), entity.into(), Some(true), row_ids, timelines, components)?);
-    Ok(())
-}
-
-/// `rows` consecutive row ids from a new one (`RowId::new`, then `next`), as the Arrow column a
-/// chunk keeps them in: each id's 16 bytes big-endian, its time then its counter. Written straight
-/// into the column rather than through Rerun's generic serialization (`RowId::arrow_from_slice`),
-/// which walked every id through optional values and cost a tenth of this recorder's thread.
-fn consecutive_row_ids(rows: usize, pool: &ColumnPool<[u8; 16]>) -> rerun::external::arrow::array::FixedSizeBinaryArray {
-    let first = rerun::log::RowId::new();
-    let (time, counter) = (first.nanos_since_epoch().to_be_bytes(), first.inc());
-    let mut ids = pool.take(rows);
-    ids.extend((0..rows).map(|i| {
-        let mut id = [0u8; 16];
-        id[..8].copy_from_slice(&time);
-        id[8..].copy_from_slice(&counter.wrapping_add(i as u64).to_be_bytes());
-        id
-    }));
-    rerun::external::arrow::array::FixedSizeBinaryArray::new(16, pool.buffer(ids), None)
-}
-
 fn viewer_reachable(url: &str) -> Result<rerun::external::re_uri::ProxyUri, String> {
     let uri: rerun::external::re_uri::RedapUri = url.parse().map_err(|e| format!("{e}"))?;
     let rerun::external::re_uri::RedapUri::Proxy(proxy) = uri else {
@@ -693,198 +567,6 @@ fn viewer_reachable(url: &str) -> Result<rerun::external::re_uri::ProxyUri, Stri
 fn link_entity(name: &str) -> String {
     format!("world/robot/{name}")
 }
-
-pub(super) fn transform(pose: &Pose) -> rerun::Transform3D {
-    let t = pose.translation;
-    rerun::Transform3D::from_translation_mat3x3([t.x as f32, t.y as f32, t.z as f32], mat3(pose))
-}
-
-/// [x, y, z, w], as Rerun stores a quaternion.
-fn quaternion_xyzw(pose: &Pose) -> [f32; 4] {
-    pose.quaternion_xyzw().map(|x| x as f32)
-}
-
-fn mat3(pose: &Pose) -> rerun::components::TransformMat3x3 {
-    let m = pose.rotation.as_slice(); // column-major, as Rerun's Mat3x3
-    let mut cols = [0f32; 9];
-    for (c, v) in cols.iter_mut().zip(m) {
-        *c = *v as f32;
-    }
-    rerun::components::TransformMat3x3::from(rerun::datatypes::Mat3x3(cols))
-}
-
-fn rgb((r, g, b): (u8, u8, u8)) -> rerun::Color {
-    rerun::Color::from_rgb(r, g, b)
-}
-
-pub fn joint_color(j: usize) -> rerun::Color {
-    rgb(joint_rgb(j))
-}
-
-/// The layout the file opens to: the arm in 3D with the tool's position below it, and per joint
-/// its angle against the target and its torque against the motor's limits, saturated steps marked.
-/// With steppers driven open loop (`stepped`), a third row: each one's load angle and lost steps.
-/// Each torque view's y range is `torque_axes`' (the motion's own torque, the limit beside it where
-/// near; [`TorqueAxis`]): returned beside the blueprint as (view, half range), for [`send_blueprint`].
-pub fn blueprint(joint_names: &[String], stepped: &[bool], servo_driven: &[bool], heated: &[bool], collisions: bool, torque_axes: &[TorqueAxis], prefix: &str) -> (Blueprint, Vec<(rerun::EntityPath, f64)>) {
-    let angle_views = joint_names.iter().map(|j| {
-        TimeSeriesView::new(format!("{j} angle vs target"))
-            .with_origin(format!("{prefix}joints/{j}"))
-            .with_contents(["$origin/position", "$origin/observed"])
-            .into()
-    });
-    let mut torque_ranges = Vec::new();
-    let torque_views: Vec<ContainerLike> = joint_names
-        .iter()
-        .enumerate()
-        .map(|(i, j)| {
-            let axis = torque_axes.get(i);
-            let view: ContainerLike = TimeSeriesView::new(axis.map_or_else(|| format!("{j} torque vs ±limit"), |a| a.title(j)))
-                .with_origin(format!("{prefix}joints/{j}"))
-                .with_contents(["$origin/torque", "$origin/torque_limit", "$origin/saturated_torque", "$origin/friction", "$origin/measured_effort"])
-                .into();
-            if let (Some(axis), ContainerLike::View(v)) = (axis, &view) {
-                torque_ranges.push((v.blueprint_path(), axis.half_range));
-            }
-            view
-        })
-        .collect();
-    let columns = joint_names.len().div_ceil(2).clamp(1, 4) as u32;
-    let mut left_views: Vec<ContainerLike> = vec![
-        Spatial3DView::new("arm").with_origin(format!("{prefix}world")).into(),
-        TimeSeriesView::new("tool position").with_origin(format!("{prefix}tool")).into(),
-        TimeSeriesView::new("tool tip error").with_origin(format!("{prefix}tool_error")).into(),
-    ];
-    let mut left_shares = vec![4.0, 1.0, 1.0];
-    let windings: Vec<String> = joint_names.iter().zip(heated).filter(|(_, h)| **h).map(|(j, _)| format!("/{prefix}joints/{j}/winding_temperature")).collect();
-    if !windings.is_empty() {
-        left_views.push(TimeSeriesView::new("motor winding temperature (°C)").with_origin(format!("/{prefix}joints")).with_contents(windings).into());
-        left_shares.push(1.0);
-    }
-    if collisions {
-        left_views.push(
-            Horizontal::new([
-                TimeSeriesView::new("pairs in contact").with_origin(format!("{prefix}collisions/in_contact")).into(),
-                TimeSeriesView::new("closest pair within 5 cm (m)").with_origin(format!("{prefix}collisions/min_distance")).into(),
-                rerun::blueprint::TextLogView::new("contacts").with_origin(format!("{prefix}collisions/events")).into(),
-            ])
-            .into(),
-        );
-        left_shares.push(1.2);
-    }
-    let left = Vertical::new(left_views).with_row_shares(left_shares);
-    let stepper_views: Vec<_> = joint_names
-        .iter()
-        .zip(stepped.iter().chain(std::iter::repeat(&false)))
-        .filter(|(_, s)| **s)
-        .map(|(j, _)| TimeSeriesView::new(format!("{j} stepper: load angle, lost steps, motor rev/s")).with_origin(format!("{prefix}joints/{j}")).with_contents(["$origin/load_angle", "$origin/lost_steps", "$origin/motor_speed"]).into())
-        .collect();
-    let servo_views: Vec<_> = joint_names
-        .iter()
-        .zip(servo_driven.iter().chain(std::iter::repeat(&false)))
-        .filter(|(_, s)| **s)
-        .map(|(j, _)| TimeSeriesView::new(format!("{j} servo: PWM duty, current (A)")).with_origin(format!("{prefix}joints/{j}")).with_contents(["$origin/servo"]).into())
-        .collect();
-    let mut rows = vec![
-        Grid::new(angle_views).with_grid_columns(columns).with_name("joint angles").into(),
-        Grid::new(torque_views).with_grid_columns(columns).with_name("joint torques").into(),
-    ];
-    if !stepper_views.is_empty() {
-        rows.push(Grid::new(stepper_views).with_grid_columns(columns).with_name("steppers").into());
-    }
-    if !servo_views.is_empty() {
-        rows.push(Grid::new(servo_views).with_grid_columns(columns).with_name("servos").into());
-    }
-    let right = Vertical::new(rows);
-    let blueprint = Blueprint::new(Horizontal::new([left.into(), right.into()]).with_column_shares([2.0, 3.0]))
-        .with_time_panel(TimePanel::new().with_timeline(TIMELINE).with_play_state(PlayState::Following).with_state(PanelState::Collapsed))
-        .with_selection_panel(SelectionPanel::new().with_state(PanelState::Collapsed))
-        .with_blueprint_panel(BlueprintPanel::new().with_state(PanelState::Collapsed));
-    (blueprint, torque_ranges)
-}
-
-/// Send `blueprint` to `rec` with each listed view's y axis set to ±half range (a `ScalarAxis`
-/// property; the user can still zoom). rerun 0.36's Rust builder keeps view properties
-/// crate-private (only the graph and map views expose theirs), so the blueprint is built into
-/// memory and the axis properties are logged into the same blueprint store, at the views' own
-/// paths (`view/<id>/ScalarAxis`, as the Python SDK writes them), before its activation (the
-/// viewer copies a blueprint when it activates it: later messages would not reach the copy).
-pub fn send_blueprint(rec: &RecordingStream, blueprint: &Blueprint, axis_ranges: &[(rerun::EntityPath, f64)]) -> rerun::RecordingStreamResult<()> {
-    use rerun::external::re_log_types::LogMsg;
-    let activation = BlueprintActivation { make_active: true, make_default: true };
-    if axis_ranges.is_empty() {
-        return blueprint.send(rec, activation);
-    }
-    let application = rec.store_info().map(|info| info.application_id().clone()).unwrap_or_else(|| rerun::ApplicationId::from("armscope"));
-    let (staging, staged) = rerun::RecordingStreamBuilder::new(application).memory()?;
-    blueprint.send(&staging, activation)?;
-    let mut messages = staged.take();
-    let Some(command) = messages.iter().find_map(|m| match m {
-        LogMsg::BlueprintActivationCommand(c) => Some(c.clone()),
-        _ => None,
-    }) else {
-        return blueprint.send(rec, activation);
-    };
-    let store = command.blueprint_id.clone();
-    messages.retain(|m| !matches!(m, LogMsg::BlueprintActivationCommand(_)) && *m.store_id() == store);
-    messages.extend(axis_messages(&store, axis_ranges)?);
-    rec.send_blueprint(messages, command);
-    Ok(())
-}
-
-/// The blueprint store's messages setting each view's `ScalarAxis` range.
-fn axis_messages(store: &rerun::StoreId, axis_ranges: &[(rerun::EntityPath, f64)]) -> rerun::RecordingStreamResult<Vec<rerun::external::re_log_types::LogMsg>> {
-    use rerun::external::re_log_types::LogMsg;
-    use rerun::external::re_sdk_types::blueprint::archetypes::ScalarAxis;
-    let (axes, staged) = rerun::RecordingStreamBuilder::new(store.application_id().clone()).recording_id(store.recording_id().clone()).blueprint().memory()?;
-    axes.set_time_sequence("blueprint", 0);
-    for (view, half_range) in axis_ranges {
-        axes.log(format!("{view}/ScalarAxis"), &ScalarAxis::new().with_range(rerun::components::Range1D(rerun::datatypes::Range1D([-half_range, *half_range]))))?;
-    }
-    Ok(staged.take().into_iter().filter(|m| matches!(m, LogMsg::ArrowMsg(..)) && m.store_id() == store).collect())
-}
-
-/// The run's configuration as Markdown, for the recording.
-pub fn config_markdown(run: &RunInfo) -> String {
-    let e = run.experiment;
-    let m = &e.model;
-    format!(
-        "# armscope run\n\n* model: **{}** (`{}`), {} dof, gravity ({}, {}, {}) m/s²\n* plant: {}\n* command: {}\n* controller: {}, control period {} ms\n* gains ({}): kp = {:?}, kd = {:?}\n* duration: {} s ({} steps)\n{}\n```json\n{}\n```\n",
-        m.name,
-        m.source.display(),
-        m.dof(),
-        m.gravity.x,
-        m.gravity.y,
-        m.gravity.z,
-        run.plant,
-        run.trajectory,
-        if !e.gains.drives_a_joint() {
-            "none (each joint's servo firmware or stepper)"
-        } else if e.config.no_ff {
-            "PD without gravity feed-forward"
-        } else {
-            "PD + gravity feed-forward"
-        },
-        e.config.dt * 1e3,
-        e.gains.source,
-        e.gains.kp,
-        e.gains.kd,
-        e.config.duration,
-        e.steps,
-        // what armscope assumed on the user's behalf (a welded root, a moved start pose, …)
-        m.notices.iter().map(|n| format!("* notice: {n}\n")).collect::<String>(),
-        serde_json::to_string_pretty(&e.config).unwrap_or_default()
-    )
-}
-
-pub fn summary_markdown(summary: &Summary) -> String {
-    let mut text = Vec::new();
-    let _ = super::console::write_summary(&mut text, summary);
-    format!("# summary\n\n```\n{}\n```\n\n```json\n{}\n```\n", String::from_utf8_lossy(&text).trim(), serde_json::to_string_pretty(summary).unwrap_or_default())
-}
-
-/// The side of the plate drawn for a motor file's floor, m: a desk under a desktop arm.
-const FLOOR_PLATE: f64 = 0.8;
 
 impl Recorder for RerunRecorder {
     fn start(&mut self, run: &RunInfo) -> Result<(), Error> {
@@ -914,7 +596,7 @@ impl Recorder for RerunRecorder {
         self.model = Some(e.model.clone());
         self.collisions = e.collisions.clone().map(|c| RrdCollisions::new(e.model.clone(), c));
         self.steps_per_trail_point = ((1.0 / TRAIL_RATE_HZ) / e.config.dt).round().max(1.0) as usize;
-        self.steps_per_pose = super::steps_per_pose(e.config.dt);
+        self.steps_per_pose = crate::recorder::steps_per_pose(e.config.dt);
 
         // the layout: a live viewer needs it now (scaled by the motion's torque); a file gets it at
         // the end, scaled by what the run did as well
@@ -925,7 +607,7 @@ impl Recorder for RerunRecorder {
         self.log_static_scene(&rec, model)?;
         if let Some(floor) = e.motors.as_ref().and_then(|m| m.floor) {
             // the table the tool rests on (the motor file's [floor])
-            let (plate, pose) = floor_plate(floor.height, FLOOR_PLATE);
+            let (plate, pose) = floor_plate(floor.height, TABLE_SIDE);
             rec.log_static("world/floor", &transform(&pose)).map_err(|x| self.err(x))?;
             log_geometry(&rec, "world/floor", &plate, Some(rerun::Color::from_unmultiplied_rgba(150, 150, 150, 120))).map_err(|x| self.err(x))?;
         }
@@ -1053,39 +735,5 @@ impl Recorder for RerunRecorder {
             file.close().map_err(|e| Error::output(file.path(), e))?;
         }
         Ok(())
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use rerun::log::RowId;
-
-    #[test]
-    fn a_strips_column_built_straight_is_the_one_rerun_would_make() {
-        let strips = vec![vec![[0.0, 1.0, 2.0], [3.0, 4.0, 5.5]], vec![], vec![[-1.0, 0.25, 9.0]]];
-        let pool = super::ColumnPool::default();
-        let mut built = super::Strips::default();
-        for strip in &strips {
-            built.push(strip.iter().copied(), &pool);
-        }
-        let ours = built.take_column(&pool);
-        assert!(built.is_empty());
-        let mut rerun_s: Vec<_> = rerun::LineStrips3D::update_fields().with_strips(strips.iter().cloned()).columns_of_unit_batches().unwrap().collect();
-        assert_eq!(rerun_s.len(), 1);
-        let theirs = rerun_s.remove(0);
-        assert_eq!(ours.descriptor, theirs.descriptor);
-        assert_eq!(ours.list_array, theirs.list_array);
-    }
-
-    #[test]
-    fn row_ids_written_straight_are_the_column_rerun_would_make() {
-        let column = super::consecutive_row_ids(5, &super::ColumnPool::default());
-        let ids = RowId::slice_from_arrow(&column);
-        assert_eq!(ids.len(), 5);
-        for pair in ids.windows(2) {
-            assert_eq!(pair[1], pair[0].next(), "consecutive, as `next` makes them");
-        }
-        assert_eq!(RowId::arrow_from_slice(ids), column, "Rerun's own serialization of the same ids");
-        assert_eq!(rerun::external::arrow::array::Array::data_type(&column), &<RowId as rerun::Loggable>::arrow_datatype());
     }
 }

@@ -17,10 +17,13 @@
 //!
 //! Header stamps are the messages' log times.
 
-use super::mcap::{JointTransform, LinkTransforms, McapOptions, ToolPath, color, open_sinks, scene_interval_s};
-use super::mcap_out::{Out, Topic};
+use super::McapOptions;
+use super::collisions::{McapCollisions, TOPIC_COLLISIONS, TOPIC_CONTACTS};
+use super::out::{Out, Topic, config_metadata, controller_metadata, open_sinks};
+use super::scene::{JointTransform, LinkTransforms, ToolPath, color, line, scene_interval_s, table_entity};
 use super::telemetry::ControllerTelemetry;
-use super::{Recorder, RunInfo};
+use crate::recorder::shared::output_file::Replaced;
+use crate::recorder::{Recorder, RunInfo};
 use crate::dynamics::frame_pose_in;
 use crate::error::Error;
 use crate::model::{Geometry, Model};
@@ -68,8 +71,8 @@ pub struct Ros2McapRecorder {
     steps_per_tf: usize,
     steps_per_tool_pose: usize,
     steps_per_path_point: usize,
-    collisions: Option<super::mcap_collisions::McapCollisions>,
-    replaced: Option<super::output_file::Replaced>,
+    collisions: Option<McapCollisions>,
+    replaced: Option<Replaced>,
 }
 
 fn vector(v: &nalgebra::Vector3<f64>) -> Vector3 {
@@ -288,9 +291,9 @@ impl Recorder for Ros2McapRecorder {
         let mut out = Out::new(sinks);
         let now = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).unwrap_or_default();
         self.start_ns = now.as_nanos() as u64;
-        let meta = super::mcap_out::config_metadata(run, self.start_ns, "log time = header stamp = start_time_unix_ns + simulation time (s) × 1e9");
+        let meta = config_metadata(run, self.start_ns, "log time = header stamp = start_time_unix_ns + simulation time (s) × 1e9");
         out.write_metadata("armscope.config", meta).map_err(|err| self.err(err))?;
-        let controller_meta = super::mcap_out::controller_metadata(run);
+        let controller_meta = controller_metadata(run);
         let stream = Qos::Stream { depth: 10 };
         let channels = (|| -> Result<Channels, String> {
             Ok(Channels {
@@ -305,8 +308,8 @@ impl Recorder for Ros2McapRecorder {
                 geometry: Self::channel(&mut out, "/robot/geometry", MarkerArray::NAME, Qos::Latched, BTreeMap::new())?,
                 collisions: match e.collisions {
                     Some(_) => Some((
-                        Self::channel(&mut out, super::mcap_collisions::TOPIC_COLLISIONS, "armscope_msgs/msg/CollisionState", stream, BTreeMap::new())?,
-                        Self::channel(&mut out, super::mcap_collisions::TOPIC_CONTACTS, MarkerArray::NAME, Qos::Latched, BTreeMap::new())?,
+                        Self::channel(&mut out, TOPIC_COLLISIONS, "armscope_msgs/msg/CollisionState", stream, BTreeMap::new())?,
+                        Self::channel(&mut out, TOPIC_CONTACTS, MarkerArray::NAME, Qos::Latched, BTreeMap::new())?,
                     )),
                     None => None,
                 },
@@ -318,7 +321,7 @@ impl Recorder for Ros2McapRecorder {
         let steps_per = |period: f64| ((period / e.config.dt).round() as usize).max(1);
         self.steps_per_path_point = steps_per(0.05);
         self.steps_per_tool_pose = steps_per(0.02);
-        self.steps_per_tf = super::steps_per_pose(e.config.dt);
+        self.steps_per_tf = crate::recorder::steps_per_pose(e.config.dt);
         let links = LinkTransforms::of(model);
         let header = |parent: &str| Header { stamp: Time::default(), frame_id: parent.to_string() };
         self.tf = TfMessage { transforms: links.moving.iter().map(|((parent, child), _)| TransformStamped { header: header(parent), child_frame_id: child.clone(), transform: Pose::default() }).collect() };
@@ -363,7 +366,12 @@ impl Recorder for Ros2McapRecorder {
         self.motors = e.motors.clone();
         self.model = Some(e.model.clone());
         self.geometry = geometry_markers(model);
-        self.collisions = e.collisions.clone().map(|c| super::mcap_collisions::McapCollisions::new(e.model.clone(), c));
+        if let Some(floor) = e.motors.as_ref().and_then(|m| m.floor) {
+            // the table the tool rests on (the motor file's [floor])
+            let table = foxglove::messages::SceneUpdate { deletions: vec![], entities: vec![table_entity(floor.height)] };
+            self.geometry.markers.extend(markers_of(&table, stamp0).markers);
+        }
+        self.collisions = e.collisions.clone().map(|c| McapCollisions::new(e.model.clone(), c));
         if let Some(c) = &self.collisions {
             let world = foxglove::messages::SceneUpdate { deletions: vec![], entities: c.world_entities() };
             self.geometry.markers.extend(markers_of(&world, stamp0).markers);
@@ -377,7 +385,7 @@ impl Recorder for Ros2McapRecorder {
         let points: Vec<foxglove::messages::Point3> = run.commanded_tool_path.iter().map(|p| foxglove::messages::Point3 { x: p.x, y: p.y, z: p.z }).collect();
         let commanded = foxglove::messages::SceneUpdate {
             deletions: vec![],
-            entities: vec![foxglove::messages::SceneEntity { frame_id: "world".into(), id: "commanded".into(), lines: vec![super::mcap::line(points, color([0.6, 0.6, 0.6, 1.0]), 1.5)], ..Default::default() }],
+            entities: vec![foxglove::messages::SceneEntity { frame_id: "world".into(), id: "commanded".into(), lines: vec![line(points, color([0.6, 0.6, 0.6, 1.0]), 1.5)], ..Default::default() }],
         };
         self.log(|c| &mut c.commanded_path, &markers_of(&commanded, stamp0), t0)?;
         self.out.as_mut().expect("started").spawn().map_err(|e| Error::output(&self.path, e))
