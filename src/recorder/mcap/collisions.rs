@@ -12,8 +12,8 @@ use crate::collision::Collisions;
 use crate::model::Model;
 use foxglove::messages::{Color, SceneEntity, SceneEntityDeletion, SceneUpdate, Timestamp};
 use prost::Message;
-use prost_types::field_descriptor_proto::{Label, Type};
-use prost_types::{DescriptorProto, FieldDescriptorProto, FileDescriptorProto, FileDescriptorSet};
+use super::protobuf_schema::{Field, encode_as_protobuf, file_descriptor_set as file_descriptor_set_of};
+use prost_types::field_descriptor_proto::Type;
 use std::sync::Arc;
 
 pub const TOPIC_COLLISIONS: &str = "/collisions";
@@ -43,54 +43,20 @@ pub struct CollisionState {
 }
 
 pub fn file_descriptor_set() -> Vec<u8> {
-    let field = |name: &str, number: i32, repeated: bool, r#type: Type| FieldDescriptorProto {
-        name: Some(name.into()),
-        number: Some(number),
-        label: Some(if repeated { Label::Repeated } else { Label::Optional } as i32),
-        r#type: Some(r#type as i32),
-        json_name: Some(name.into()),
-        ..Default::default()
-    };
-    let message = DescriptorProto {
-        name: Some("CollisionState".into()),
-        field: vec![
-            field("time", 1, false, Type::Double),
-            field("in_contact", 2, false, Type::Uint32),
-            field("min_distance", 3, false, Type::Double),
-            field("pairs", 4, true, Type::String),
-            field("distances", 5, true, Type::Double),
+    file_descriptor_set_of(
+        "collision_state",
+        "CollisionState",
+        &[
+            Field("time", 1, false, Type::Double),
+            Field("in_contact", 2, false, Type::Uint32),
+            Field("min_distance", 3, false, Type::Double),
+            Field("pairs", 4, true, Type::String),
+            Field("distances", 5, true, Type::Double),
         ],
-        ..Default::default()
-    };
-    let file = FileDescriptorProto {
-        name: Some("armscope/collision_state.proto".into()),
-        package: Some("armscope".into()),
-        message_type: vec![message],
-        syntax: Some("proto3".into()),
-        ..Default::default()
-    };
-    FileDescriptorSet { file: vec![file] }.encode_to_vec()
+    )
 }
 
-impl foxglove::Encode for CollisionState {
-    type Error = prost::EncodeError;
-
-    fn get_schema() -> Option<foxglove::Schema> {
-        Some(foxglove::Schema::new(SCHEMA_NAME, "protobuf", file_descriptor_set()))
-    }
-
-    fn get_message_encoding() -> String {
-        "protobuf".into()
-    }
-
-    fn encode(&self, buf: &mut impl bytes::BufMut) -> Result<(), Self::Error> {
-        Message::encode(self, buf)
-    }
-
-    fn encoded_len(&self) -> Option<usize> {
-        Some(Message::encoded_len(self))
-    }
-}
+encode_as_protobuf!(CollisionState);
 
 const RED: Color = Color { r: 0.92, g: 0.12, b: 0.12, a: 0.75 };
 const SCENE_GREY: Color = Color { r: 0.6, g: 0.6, b: 0.65, a: 0.6 };

@@ -7,6 +7,7 @@ mod foxglove_recorder;
 mod layout;
 pub mod live;
 mod out;
+mod protobuf_schema;
 mod robot_description;
 mod ros2_recorder;
 mod scene;

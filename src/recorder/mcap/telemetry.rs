@@ -5,8 +5,8 @@
 //! the file, so its Plot panel plots `/controller.torque[1]` as before.
 
 use prost::Message;
-use prost_types::field_descriptor_proto::{Label, Type};
-use prost_types::{DescriptorProto, FieldDescriptorProto, FileDescriptorProto, FileDescriptorSet};
+use super::protobuf_schema::{Field, encode_as_protobuf, file_descriptor_set as file_descriptor_set_of};
+use prost_types::field_descriptor_proto::Type;
 
 pub const SCHEMA_NAME: &str = "armscope.ControllerTelemetry";
 
@@ -136,67 +136,33 @@ impl ControllerTelemetry {
 /// The schema as MCAP's protobuf profile wants it: a serialized FileDescriptorSet. Kept next to
 /// the struct above; tests/recordings.rs decodes recorded messages through it (prost-reflect).
 pub fn file_descriptor_set() -> Vec<u8> {
-    let field = |name: &str, number: i32, repeated: bool, r#type: Type| FieldDescriptorProto {
-        name: Some(name.into()),
-        number: Some(number),
-        label: Some(if repeated { Label::Repeated } else { Label::Optional } as i32),
-        r#type: Some(r#type as i32),
-        json_name: Some(name.into()),
-        ..Default::default()
-    };
-    let message = DescriptorProto {
-        name: Some("ControllerTelemetry".into()),
-        field: vec![
-            field("time", 1, false, Type::Double),
-            field("target", 2, true, Type::Double),
-            field("error", 3, true, Type::Double),
-            field("torque", 4, true, Type::Double),
-            field("tau_g", 5, true, Type::Double),
-            field("saturated", 6, true, Type::Uint32),
-            field("chatter", 7, true, Type::Uint32),
-            field("tool_error", 8, false, Type::Double),
-            field("tool_position", 9, true, Type::Double),
-            field("torque_limit", 10, true, Type::Double),
-            field("load_angle", 11, true, Type::Double),
-            field("lost_steps", 12, true, Type::Int64),
-            field("motor_speed", 13, true, Type::Double),
-            field("friction", 14, true, Type::Double),
-            field("stuck", 15, true, Type::Uint32),
-            field("winding_temperature", 16, true, Type::Double),
-            field("duty", 17, true, Type::Double),
-            field("current", 18, true, Type::Double),
-            field("supply", 19, true, Type::Double),
-            field("measured_effort", 20, true, Type::Double),
-            field("observed_position", 21, true, Type::Double),
+    file_descriptor_set_of(
+        "controller_telemetry",
+        "ControllerTelemetry",
+        &[
+            Field("time", 1, false, Type::Double),
+            Field("target", 2, true, Type::Double),
+            Field("error", 3, true, Type::Double),
+            Field("torque", 4, true, Type::Double),
+            Field("tau_g", 5, true, Type::Double),
+            Field("saturated", 6, true, Type::Uint32),
+            Field("chatter", 7, true, Type::Uint32),
+            Field("tool_error", 8, false, Type::Double),
+            Field("tool_position", 9, true, Type::Double),
+            Field("torque_limit", 10, true, Type::Double),
+            Field("load_angle", 11, true, Type::Double),
+            Field("lost_steps", 12, true, Type::Int64),
+            Field("motor_speed", 13, true, Type::Double),
+            Field("friction", 14, true, Type::Double),
+            Field("stuck", 15, true, Type::Uint32),
+            Field("winding_temperature", 16, true, Type::Double),
+            Field("duty", 17, true, Type::Double),
+            Field("current", 18, true, Type::Double),
+            Field("supply", 19, true, Type::Double),
+            Field("measured_effort", 20, true, Type::Double),
+            Field("observed_position", 21, true, Type::Double),
         ],
-        ..Default::default()
-    };
-    let file = FileDescriptorProto {
-        name: Some("armscope/controller_telemetry.proto".into()),
-        package: Some("armscope".into()),
-        message_type: vec![message],
-        syntax: Some("proto3".into()),
-        ..Default::default()
-    };
-    FileDescriptorSet { file: vec![file] }.encode_to_vec()
+    )
 }
 
-impl foxglove::Encode for ControllerTelemetry {
-    type Error = prost::EncodeError;
-
-    fn get_schema() -> Option<foxglove::Schema> {
-        Some(foxglove::Schema::new(SCHEMA_NAME, "protobuf", file_descriptor_set()))
-    }
-
-    fn get_message_encoding() -> String {
-        "protobuf".into()
-    }
-
-    fn encode(&self, buf: &mut impl bytes::BufMut) -> Result<(), Self::Error> {
-        Message::encode(self, buf)
-    }
-
-    fn encoded_len(&self) -> Option<usize> {
-        Some(Message::encoded_len(self))
-    }
-}
+encode_as_protobuf!(ControllerTelemetry);
