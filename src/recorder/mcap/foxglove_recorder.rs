@@ -330,20 +330,9 @@ impl Recorder for McapRecorder {
             let axes: Vec<_> = run.torque_axes().iter().enumerate().map(|(i, axis)| axis.after_run(settled(i))).collect();
             write_layout(run, path, &axes)?;
         }
-        let mut meta = BTreeMap::new();
-        meta.insert("summary".into(), serde_json::to_string(summary).unwrap_or_default());
-        meta.insert("status".into(), serde_json::to_string(&summary.status).unwrap_or_default());
         self.channels = None;
-        if let Some(mut out) = self.out.take() {
-            out.close().map_err(|e| self.err(e))?;
-            out.write_metadata("armscope.summary", meta).map_err(|e| self.err(e))?;
-            let sinks = out.sinks();
-            if let Some(file) = &mut sinks.file {
-                file.finish().map_err(|e| self.err(e))?;
-            }
-            if let Some(live) = &mut sinks.live {
-                live.stop();
-            }
+        if let Some(out) = self.out.take() {
+            out.finish(summary).map_err(|e| self.err(e))?;
         }
         self.replaced = None;
         Ok(())

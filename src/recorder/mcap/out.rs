@@ -178,6 +178,24 @@ impl Out {
         self.send()?;
         self.join()
     }
+
+    /// Ends the recording: every batch written, the run's summary and status as the
+    /// `armscope.summary` metadata, the file's summary section and footer, the live server stopped.
+    pub(super) fn finish(mut self, summary: &crate::summary::Summary) -> Result<(), String> {
+        let mut meta = BTreeMap::new();
+        meta.insert("summary".into(), serde_json::to_string(summary).unwrap_or_default());
+        meta.insert("status".into(), serde_json::to_string(&summary.status).unwrap_or_default());
+        self.close()?;
+        self.write_metadata("armscope.summary", meta).map_err(|e| e.to_string())?;
+        let sinks = self.sinks();
+        if let Some(file) = &mut sinks.file {
+            file.finish().map_err(|e| e.to_string())?;
+        }
+        if let Some(live) = &mut sinks.live {
+            live.stop();
+        }
+        Ok(())
+    }
 }
 
 /// zstd's fast level −3, with `--compress`: compressing was ~2/3 of this recorder's work at level

@@ -456,20 +456,9 @@ impl Recorder for Ros2McapRecorder {
     }
 
     fn finish(&mut self, _run: &RunInfo, summary: &Summary) -> Result<(), Error> {
-        let mut meta = BTreeMap::new();
-        meta.insert("summary".into(), serde_json::to_string(summary).unwrap_or_default());
-        meta.insert("status".into(), serde_json::to_string(&summary.status).unwrap_or_default());
         self.channels = None;
-        if let Some(mut out) = self.out.take() {
-            out.close().map_err(|e| self.err(e))?;
-            out.write_metadata("armscope.summary", meta).map_err(|e| self.err(e))?;
-            let sinks = out.sinks();
-            if let Some(file) = &mut sinks.file {
-                file.finish().map_err(|e| self.err(e))?;
-            }
-            if let Some(live) = &mut sinks.live {
-                live.stop();
-            }
+        if let Some(out) = self.out.take() {
+            out.finish(summary).map_err(|e| self.err(e))?;
         }
         self.replaced = None;
         Ok(())

@@ -213,34 +213,12 @@ pub(super) fn scene_from_model(model: &Model) -> Result<SceneUpdate, (PathBuf, s
         let mut entity = SceneEntity { frame_id: frame.name.clone(), id: frame.name.clone(), frame_locked: true, ..Default::default() };
         for v in &frame.visuals {
             let c = color(v.rgba.unwrap_or([0.67, 0.67, 0.7, 1.0]));
-            let pose = Some(fox_pose(&v.origin));
             match &v.geometry {
-                Geometry::Box { size } => entity.cubes.push(CubePrimitive { pose, size: Some(Vector3 { x: size[0], y: size[1], z: size[2] }), color: Some(c) }),
-                Geometry::Cylinder { radius, length } => entity.cylinders.push(CylinderPrimitive {
-                    pose,
-                    size: Some(Vector3 { x: 2.0 * radius, y: 2.0 * radius, z: *length }),
-                    bottom_scale: 1.0,
-                    top_scale: 1.0,
-                    color: Some(c),
-                }),
-                Geometry::Capsule { radius, length } => {
-                    entity.cylinders.push(CylinderPrimitive {
-                        pose,
-                        size: Some(Vector3 { x: 2.0 * radius, y: 2.0 * radius, z: *length }),
-                        bottom_scale: 1.0,
-                        top_scale: 1.0,
-                        color: Some(c),
-                    });
-                    for end in [-0.5, 0.5] {
-                        let cap = v.origin.compose(&Pose::new(nalgebra::Matrix3::identity(), nalgebra::Vector3::new(0.0, 0.0, end * length)));
-                        entity.spheres.push(SpherePrimitive { pose: Some(fox_pose(&cap)), size: Some(Vector3 { x: 2.0 * radius, y: 2.0 * radius, z: 2.0 * radius }), color: Some(c) });
-                    }
-                }
-                Geometry::Sphere { radius } => entity.spheres.push(SpherePrimitive { pose, size: Some(Vector3 { x: 2.0 * radius, y: 2.0 * radius, z: 2.0 * radius }), color: Some(c) }),
+                // the mesh file itself, for the viewer to draw (a collision highlight draws its box)
                 Geometry::Mesh { path, scale } => {
                     let data = std::fs::read(path).map_err(|e| (path.clone(), e))?;
                     entity.models.push(ModelPrimitive {
-                        pose,
+                        pose: Some(fox_pose(&v.origin)),
                         scale: Some(Vector3 { x: scale[0], y: scale[1], z: scale[2] }),
                         color: Some(c),
                         override_color: v.rgba.is_some(),
@@ -249,6 +227,7 @@ pub(super) fn scene_from_model(model: &Model) -> Result<SceneUpdate, (PathBuf, s
                         data: data.into(),
                     });
                 }
+                primitive => add_primitives(&mut entity, primitive, &v.origin, c, 0.0),
             }
         }
         entities.push(entity);
