@@ -1,6 +1,6 @@
 //! What both encodings of the MCAP draw: the arm's links in their parents (from the URDF's own
-//! origins), its visuals as one scene, the tool's path published piece by piece, and Foxglove's
-//! geometry types from armscope's.
+//! origins), its visuals as one scene, a motor file's table, the tool's path published piece by
+//! piece, and Foxglove's geometry types from armscope's.
 
 use crate::model::{Geometry, JointKind, Model};
 use crate::recorder::shared::floor_plate::{TABLE_SIDE, floor_plate};
