@@ -175,7 +175,7 @@ impl Experiment {
         match self.plant {
             PlantSpec::Discrete { time_step, substeps } => {
                 let plant = DiscretePlant::with_friction(&self.model, time_step, substeps, self.joint_friction());
-                match self.motors.as_ref().and_then(|m| m.floor) {
+                match self.floor_contact() {
                     Some(floor) => Box::new(plant.with_floor(floor, self.model.dof())),
                     None => Box::new(plant),
                 }
@@ -184,6 +184,12 @@ impl Experiment {
                 Box::new(ContinuousPlant::with_gears(&self.model, self.config.dt, Tolerances { rtol, atol }, &gears))
             }
         }
+    }
+
+    /// The floor under the arm's tool from the motor file's `[floor]` (not the collision checks'
+    /// `--floor`): the plant's contact, the recordings' table.
+    pub fn floor_contact(&self) -> Option<crate::plant::FloorContact> {
+        self.motors.as_ref().and_then(|m| m.floor)
     }
 
     /// Per coordinate, its motor's thermal data and gear ratio (`--motors`, where the catalogue

@@ -7,7 +7,7 @@
 
 use super::scene::add_primitives;
 use crate::recorder::shared::contacts::{Body, ContactTracker, pair_name};
-use crate::recorder::shared::floor_plate::{SCENE_FLOOR_SIDE, floor_plate};
+use crate::recorder::shared::floor_plate::drawn;
 use crate::collision::Collisions;
 use crate::model::Model;
 use foxglove::messages::{Color, SceneEntity, SceneEntityDeletion, SceneUpdate, Timestamp};
@@ -84,13 +84,8 @@ impl McapCollisions {
         let mut out = Vec::new();
         for shape in &self.collisions.world {
             let mut entity = SceneEntity { frame_id: "world".into(), id: format!("scene-{}", shape.name), frame_locked: true, ..Default::default() };
-            match &shape.drawn {
-                Some((g, p)) => add_primitives(&mut entity, g, p, SCENE_GREY, 0.0),
-                None => {
-                    let (plate, pose) = floor_plate(shape.pose.translation.z, SCENE_FLOOR_SIDE);
-                    add_primitives(&mut entity, &plate, &pose, SCENE_GREY, 0.0);
-                }
-            }
+            let (geometry, pose) = drawn(shape);
+            add_primitives(&mut entity, &geometry, &pose, SCENE_GREY, 0.0);
             out.push(entity);
         }
         if let Some((g, p)) = &self.collisions.payload {
@@ -149,13 +144,10 @@ impl McapCollisions {
                 Body::World(w) => {
                     let shape = &collisions.world[w];
                     let mut e = SceneEntity { timestamp: Some(timestamp), frame_id: "world".into(), id: format!("contact-scene-{}", shape.name), frame_locked: true, ..Default::default() };
-                    match &shape.drawn {
-                        Some((g, p)) => add_primitives(&mut e, g, p, RED, 0.002),
-                        None => {
-                            let (plate, pose) = floor_plate(shape.pose.translation.z, SCENE_FLOOR_SIDE);
-                            add_primitives(&mut e, &plate, &pose, RED, 0.001);
-                        }
-                    }
+                    let (geometry, pose) = drawn(shape);
+                    // the floor's thin plate grown less: a highlight, not a slab
+                    let grow = if shape.drawn.is_some() { 0.002 } else { 0.001 };
+                    add_primitives(&mut e, &geometry, &pose, RED, grow);
                     e
                 }
             };

@@ -223,7 +223,7 @@ impl Recorder for McapRecorder {
         };
         self.motors = e.motors.clone();
         self.scene = scene_from_model(model).map_err(|(path, err)| Error::output(&path, err))?;
-        if let Some(floor) = e.motors.as_ref().and_then(|m| m.floor) {
+        if let Some(floor) = e.floor_contact() {
             // the table the tool rests on (the motor file's [floor])
             self.scene.entities.push(table_entity(floor.height));
         }

@@ -366,7 +366,7 @@ impl Recorder for Ros2McapRecorder {
         self.motors = e.motors.clone();
         self.model = Some(e.model.clone());
         self.geometry = geometry_markers(model);
-        if let Some(floor) = e.motors.as_ref().and_then(|m| m.floor) {
+        if let Some(floor) = e.floor_contact() {
             // the table the tool rests on (the motor file's [floor])
             let table = foxglove::messages::SceneUpdate { deletions: vec![], entities: vec![table_entity(floor.height)] };
             self.geometry.markers.extend(markers_of(&table, stamp0).markers);

@@ -3,7 +3,7 @@
 //! piece, and Foxglove's geometry types from armscope's.
 
 use crate::model::{Geometry, JointKind, Model};
-use crate::recorder::shared::floor_plate::{TABLE_SIDE, floor_plate};
+use crate::recorder::shared::floor_plate::{TABLE_RGBA, TABLE_SIDE, floor_plate};
 use crate::recorder::shared::overview::Overview;
 use crate::spatial::{Pose, rotation_about_axis};
 use foxglove::messages::{Color, CubePrimitive, CylinderPrimitive, FrameTransform, LinePrimitive, ModelPrimitive, Point3, Quaternion, SceneEntity, SceneUpdate, SpherePrimitive, Timestamp, Vector3};
@@ -172,14 +172,11 @@ pub(super) fn add_primitives(entity: &mut SceneEntity, geometry: &Geometry, orig
     }
 }
 
-/// The colour of a motor file's table: a light grey, half transparent (the tool shows through).
-const TABLE_GREY: Color = Color { r: 0.6, g: 0.6, b: 0.6, a: 0.45 };
-
 /// The table a motor file's `[floor]` puts under the tool, in the world frame.
 pub(super) fn table_entity(height: f64) -> SceneEntity {
     let (plate, pose) = floor_plate(height, TABLE_SIDE);
     let mut entity = SceneEntity { frame_id: "world".into(), id: "floor".into(), frame_locked: true, ..Default::default() };
-    add_primitives(&mut entity, &plate, &pose, TABLE_GREY, 0.0);
+    add_primitives(&mut entity, &plate, &pose, color(TABLE_RGBA.map(|c| c as f32 / 255.0)), 0.0);
     entity
 }
 

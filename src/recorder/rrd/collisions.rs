@@ -5,7 +5,7 @@
 
 use super::TIMELINE;
 use super::geometry::{Recolour, log_colour, log_geometry, transform};
-use crate::recorder::shared::floor_plate::{SCENE_FLOOR_SIDE, floor_plate};
+use crate::recorder::shared::floor_plate::drawn;
 use crate::recorder::shared::contacts::{Body, ContactTracker, pair_name};
 use crate::collision::Collisions;
 use crate::model::{Geometry, Model};
@@ -64,10 +64,7 @@ impl RrdCollisions {
         let scale_of = |g: &Geometry| if let Geometry::Mesh { scale, .. } = g { Some(*scale) } else { None };
         for (w, shape) in self.collisions.world.iter().enumerate() {
             let path = format!("world/scene/{}", shape.name);
-            let (geometry, pose) = match &shape.drawn {
-                Some((g, p)) => (g.clone(), *p),
-                None => floor_plate(shape.pose.translation.z, SCENE_FLOOR_SIDE),
-            };
+            let (geometry, pose) = drawn(shape);
             rec.log_static(path.as_str(), &placed(&pose, scale_of(&geometry))).map_err(|e| e.to_string())?;
             let kind = log_geometry(rec, &path, &geometry, None)?;
             self.world_visuals[w].push(Recolour { path, kind, colour: SCENE_GREY });

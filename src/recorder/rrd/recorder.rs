@@ -10,7 +10,7 @@ use super::column_pool::ColumnPool;
 use super::columns::{Strips, float32_column, list_column, scalar_column, send_chunk_in_order, send_in_order};
 use super::file::{FOOTER_UP_TO_SECONDS, RrdFile};
 use super::geometry::{Recolour, log_geometry, quaternion_xyzw, transform};
-use crate::recorder::shared::floor_plate::{TABLE_SIDE, floor_plate};
+use crate::recorder::shared::floor_plate::{TABLE_RGBA, TABLE_SIDE, floor_plate};
 use super::markdown::{config_markdown, summary_markdown};
 use crate::dynamics::frame_pose_in;
 use crate::error::Error;
@@ -605,11 +605,11 @@ impl Recorder for RerunRecorder {
             send_blueprint(&rec, &layout, &torque_ranges).map_err(|x| self.err(x))?;
         }
         self.log_static_scene(&rec, model)?;
-        if let Some(floor) = e.motors.as_ref().and_then(|m| m.floor) {
+        if let Some(floor) = e.floor_contact() {
             // the table the tool rests on (the motor file's [floor])
             let (plate, pose) = floor_plate(floor.height, TABLE_SIDE);
             rec.log_static("world/floor", &transform(&pose)).map_err(|x| self.err(x))?;
-            log_geometry(&rec, "world/floor", &plate, Some(rerun::Color::from_unmultiplied_rgba(150, 150, 150, 120))).map_err(|x| self.err(x))?;
+            log_geometry(&rec, "world/floor", &plate, Some(rerun::Color::from_unmultiplied_rgba(TABLE_RGBA[0], TABLE_RGBA[1], TABLE_RGBA[2], TABLE_RGBA[3]))).map_err(|x| self.err(x))?;
         }
         self.log_series_styles(&rec, e.joint_has_friction().contains(&true))?;
         rec.log_static("config", &rerun::TextDocument::from_markdown(config_markdown(run))).map_err(|x| self.err(x))?;
