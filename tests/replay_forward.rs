@@ -287,3 +287,30 @@ fn a_payload_left_out_of_an_arm_holding_still_is_a_gap_made_at_rest_and_said_so(
     assert_eq!(lift.at_rest.seconds, 0.0, "{:?}", lift.at_rest);
     assert!(!armscope::replay::forward::text(&moving).contains("made at rest"));
 }
+
+#[test]
+fn a_joint_that_does_not_follow_is_held_in_the_model_where_the_real_one_stayed() {
+    // The follower's wrist roll is off: it stays where it started while its commands sweep ±0.6 rad.
+    // The "real" follower is the arm simulated with its roll held there. Replayed forward, the
+    // roll is named as not following and the model's roll is held where the real one stayed (it
+    // would otherwise sweep its commands), so the joints beside it are met as the same arm meets
+    // them: within the encoder's quantum and the commands' smoothing.
+    let dir = tempfile::tempdir().unwrap();
+    let commands = common::follower::so101_commands();
+    let mut stuck = commands.clone();
+    stuck[4] = Sines { center: commands[4].q(0.0), terms: Vec::new() };
+    let root = dir.path().join("so101_roll_off");
+    let observed = vec![follower(dir.path(), &stuck, PAYLOAD, &motors())];
+    Spec { fps: 30.0, frames: FRAMES, episodes: vec![commands], storage: so101_storage(), observed: Some(observed) }.write_v3(&root);
+    let replay = replay_forward(&root, dir.path(), PAYLOAD);
+    let roll = replay.joints.iter().position(|g| g.joint == "wrist_roll").unwrap();
+    assert!(!replay.joints[roll].follows && replay.joints[roll].commanded_sweep > 1.0, "{:?}", replay.joints[roll]);
+    let (lowest, highest) = replay.simulated[roll].iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &q| (lo.min(q), hi.max(q)));
+    // the encoder's quantum, 2π/4096 = 1.53 mrad
+    assert!(highest - lowest < 1.53e-3, "the model's roll swept {:.2} mrad", (highest - lowest) * 1e3);
+    for g in replay.joints.iter().filter(|g| g.joint != "wrist_roll" && g.joint != "gripper") {
+        assert!(g.follows && g.gap_mae < 2e-3, "{}: {:.2} mrad from the follower", g.joint, g.gap_mae * 1e3);
+    }
+    let text = armscope::replay::forward::text(&replay);
+    assert!(text.contains("wrist_roll       does not follow its commands") && text.contains("the model's held where the real one was"), "{text}");
+}
