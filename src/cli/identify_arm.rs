@@ -50,7 +50,8 @@ pub struct ArmArgs {
     #[arg(long, default_value_t = 0.5, requires = "fit_payload")]
     pub payload_max: f64,
     /// With --from: the servo parameters fitted, by BAM's names (default: kt, error_gain_ratio,
-    /// armature, the friction's base, load and viscous terms, command_delay).
+    /// armature, friction_base, friction_viscous, command_delay; the load-dependent frictions stay
+    /// the motor file's unless named).
     #[arg(long, value_delimiter = ',', num_args = 1, requires = "from")]
     pub fit_params: Option<Vec<String>>,
     /// With --from: fit each fitted joint's calibration offset too (the recording's zero against the
