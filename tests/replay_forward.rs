@@ -68,7 +68,7 @@ fn replay_forward_on(root: &Path, dir: &Path, payload: f64, motors: &Path) -> ar
     let commands = source.read(0, "action").unwrap();
     let map = JointMap::builtin(source.kind(), &model, &observed).expect("the SO-101's built-in map");
     let replayer = Replayer::new(model, &ReplayOptions { payload, motors: Some(motors.to_path_buf()), ..Default::default() }, map).unwrap();
-    let options = ForwardOptions { motors: motors.to_path_buf(), payload, tool: None, schedule: dir.join(format!("commands_{payload}.csv")), recordings: None, latency: None, trace: None };
+    let options = ForwardOptions { motors: motors.to_path_buf(), payload, tool: None, schedule: dir.join(format!("commands_{payload}.csv")), recordings: None, latency: None, trace: None, without_floor: false };
     forward(&replayer, &options, &commands, &observed).unwrap()
 }
 
@@ -313,4 +313,50 @@ fn a_joint_that_does_not_follow_is_held_in_the_model_where_the_real_one_stayed()
     }
     let text = armscope::replay::forward::text(&replay);
     assert!(text.contains("wrist_roll       does not follow its commands") && text.contains("the model's held where the real one was"), "{text}");
+}
+
+#[test]
+fn a_motor_files_floor_the_recorded_tool_went_through_is_left_out_and_said_so() {
+    // The same arm's follower swinging freely, replayed with a motor file whose [floor] (another
+    // set-up's table) lies 10 mm above the lowest its tool went: that floor is not this recording's
+    // table, and the replay leaves it out, saying so in one notice; the follower is then met as the
+    // same arm meets it. A floor the tool stayed above is kept.
+    let dir = tempfile::tempdir().unwrap();
+    let motion = common::follower::so101_commands();
+    let root = dataset_of(dir.path(), "so101_swing", &motion, PAYLOAD, &motors());
+    let model = load_urdf(&so101()).unwrap();
+    let tool = model.frames.iter().position(|f| f.name == "gripper_frame_link").unwrap();
+    let mut data = armscope::dynamics::Data::new(&model);
+    let lowest = follower(dir.path(), &motion, PAYLOAD, &motors())
+        .iter()
+        .map(|q| {
+            armscope::dynamics::forward_kinematics(&model, &mut data, q);
+            armscope::dynamics::frame_pose(&model, &data, tool).translation.z
+        })
+        .fold(f64::INFINITY, f64::min);
+    let replay = |name: &str, height: f64| {
+        let file = dir.path().join(format!("{name}.toml"));
+        std::fs::write(&file, std::fs::read_to_string(motors()).unwrap() + &format!("\n[floor]\nheight = {height:?}\nlink = \"gripper_frame_link\"\n")).unwrap();
+        let json = dir.path().join(format!("{name}.json"));
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_armscope"))
+            .args(["replay", root.to_str().unwrap(), "--urdf", so101().to_str().unwrap(), "--motors", file.to_str().unwrap(), "--payload", "0.2", "--units", "degrees", "--forward", "--no-rrd", "--no-mcap", "--summary-json", json.to_str().unwrap()])
+            .current_dir(dir.path())
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let doc: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+        let widest = doc["episodes"][0]["joints"].as_array().unwrap()[..5].iter().map(|j| j["gap_mae"].as_f64().unwrap()).fold(0.0, f64::max);
+        (String::from_utf8_lossy(&out.stderr).to_string(), widest)
+    };
+    let (stderr, widest) = replay("another_table", lowest + 0.01);
+    let notices: Vec<&str> = stderr.lines().filter(|l| l.contains("[floor]")).collect();
+    assert!(notices.len() == 1 && notices[0].contains("is not this recording's table: the real tool ('gripper_frame_link') goes ") && notices[0].ends_with(" mm below it in episode 0; replayed without it"), "{stderr}");
+    // 10 mm, read through the encoder's quanta (1.53 mrad a joint: under 1 mm at the tool's reach)
+    let depth: f64 = notices[0].split(" goes ").nth(1).unwrap().split(' ').next().unwrap().parse().unwrap();
+    assert!((depth - 10.0).abs() < 1.0, "{depth} mm");
+    assert!(widest < 2e-3, "the follower missed by {:.2} mrad with the floor left out", widest * 1e3);
+    // 1 mm under the lowest the tool went: its table, kept (never touched)
+    let (stderr, widest) = replay("its_table", lowest - 0.001);
+    assert!(stderr.contains("rests on a floor at z =") && !stderr.contains("not this recording's table"), "{stderr}");
+    assert!(widest < 2e-3, "{:.2} mrad", widest * 1e3);
 }

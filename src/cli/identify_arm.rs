@@ -194,7 +194,7 @@ pub fn identify_arm(args: &IdentifyArgs, dataset: &Path) -> Result<i32, Error> {
     let compared: Vec<usize> = train_cases[0].compared().to_vec();
     let name = |j: usize| model.joints[j].name.clone();
     let payload_now = arm.payload;
-    let before: Vec<ForwardReplay> = train_cases.iter().map(|c| follow(&model, c, &Drives::File(motors), &FollowSetup { payload: payload_now, tool: arm.tool.as_deref(), offsets: None }, None)).collect::<Result<_, _>>()?;
+    let before: Vec<ForwardReplay> = train_cases.iter().map(|c| follow(&model, c, &Drives::File(motors), &FollowSetup { payload: payload_now, tool: arm.tool.as_deref(), offsets: None, without_floor: false }, None)).collect::<Result<_, _>>()?;
     let still: Vec<usize> = compared.iter().copied().filter(|&j| before.iter().any(|r| r.joints.iter().any(|g| g.joint == name(j) && !g.follows))).collect();
     let mut left_out: Vec<(String, String)> = Vec::new();
     let fitted: Vec<usize> = match &arm.fit_joints {
@@ -296,7 +296,7 @@ pub fn identify_arm(args: &IdentifyArgs, dataset: &Path) -> Result<i32, Error> {
     let servo_files = write_motor_file(&args.out, motors, &model, &start_set, &space, dataset, &train, &found, floor)?;
     // the file as written, replayed: what `replay --forward --motors FILE` will give
     let payload = if arm.fit_payload { found.payload } else { arm.payload };
-    let replay_with = |cases: &[ForwardCase]| -> Result<Vec<ForwardReplay>, Error> { cases.iter().map(|c| follow(&model, c, &Drives::File(&args.out), &FollowSetup { payload, tool: arm.tool.as_deref(), offsets: arm.fit_offsets.then_some(found.offsets.as_slice()) }, None)).collect() };
+    let replay_with = |cases: &[ForwardCase]| -> Result<Vec<ForwardReplay>, Error> { cases.iter().map(|c| follow(&model, c, &Drives::File(&args.out), &FollowSetup { payload, tool: arm.tool.as_deref(), offsets: arm.fit_offsets.then_some(found.offsets.as_slice()), without_floor: false }, None)).collect() };
     let trained = replay_with(&train_cases)?;
     let validated = replay_with(&validate_cases)?;
     let fitted_names: Vec<String> = fitted.iter().map(|&j| name(j)).collect();

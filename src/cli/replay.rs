@@ -156,8 +156,25 @@ fn forward(args: &ReplayArgs, replayer: &Replayer, source: &crate::motion::Sourc
     if let Some(latency) = args.latency {
         crate::replay::forward::check_latency(latency)?;
     }
+    // a motor file's floor is the table its arm stood on: a recording whose tool went through it
+    // stood on another, and is replayed without it
+    let mut without_floor = false;
     if let Some(floor) = replayer.motors.as_ref().and_then(|m| m.floor) {
-        eprintln!("armscope: notice: {}: the simulated tool ('{}') rests on a floor at z = {:.4} m (its [floor]: a contact without friction; the arm's own links pass through it)", motors.display(), replayer.base_model.frames[floor.frame].name, floor.height);
+        let tool = &replayer.base_model.frames[floor.frame].name;
+        match crate::replay::tool_height::through_floor(replayer, source, episodes, &args.recorded.feature, floor)? {
+            Some(through) => {
+                without_floor = true;
+                let others = if through.episodes > 1 { format!(" (and {} more)", through.episodes - 1) } else { String::new() };
+                eprintln!(
+                    "armscope: notice: {}: its [floor] at z = {:.4} m is not this recording's table: the real tool ('{tool}') goes {:.1} mm below it in episode {}{others}; replayed without it",
+                    motors.display(),
+                    floor.height,
+                    through.depth * 1e3,
+                    through.episode
+                );
+            }
+            None => eprintln!("armscope: notice: {}: the simulated tool ('{tool}') rests on a floor at z = {:.4} m (its [floor]: a contact without friction; the arm's own links pass through it)", motors.display(), floor.height),
+        }
     }
     // the command schedules go where the recordings go
     let dir = args.files.folder();
@@ -188,6 +205,7 @@ fn forward(args: &ReplayArgs, replayer: &Replayer, source: &crate::motion::Sourc
             None => Some(Latency::given(0.0, "a controller's set point, acted on when recorded")),
         },
         trace: args.trace.as_ref().map(|path| if several { trace_path(path, index) } else { path.clone() }),
+        without_floor,
     };
     let wrote = |options: &ForwardOptions| {
         for path in options.recordings.iter().flat_map(|r| r.rrd.iter().chain(&r.mcap)) {

@@ -235,7 +235,7 @@ impl ArmObjective<'_> {
     pub fn loss(&self, u: &[f64], cutoff: f64) -> f64 {
         let (params, payload, offsets) = self.space.decode(u);
         let make = || self.motors(&params);
-        let setup = FollowSetup { payload, tool: self.tool, offsets: (!self.space.offsets.is_empty()).then_some(offsets.as_slice()) };
+        let setup = FollowSetup { payload, tool: self.tool, offsets: (!self.space.offsets.is_empty()).then_some(offsets.as_slice()), without_floor: false };
         let samples = self.samples().max(1) as f64;
         let budget = if cutoff.is_finite() { cutoff * samples } else { f64::INFINITY };
         let mut sum = 0.0;

@@ -6,9 +6,9 @@
 //! origin, and a calibration's errors move the computed tool. Fitting the height instead let the
 //! fit prop the arm up on the table and weaken its servos: worse on held-out episodes.)
 
-use crate::dynamics::{Data, forward_kinematics, frame_pose};
 use crate::model::Model;
 use crate::replay::forward::ForwardCase;
+use crate::replay::tool_height::recorded_heights;
 
 /// How near its lowest the real tool must be to rest there, m: a few encoder ticks at the tool
 /// (1.5 mrad a tick of a 12-bit encoder, 0.3 m of arm: 0.5 mm a tick).
@@ -36,20 +36,8 @@ pub struct Touch {
 
 /// The floor the real tool rested on in `cases` (its origin `frame`), if the episodes show one.
 pub fn touched(model: &Model, frame: usize, cases: &[ForwardCase]) -> Option<Touch> {
-    let mut data = Data::new(model);
-    let mut heights = |motion: &crate::replay::Motion| -> Vec<f64> {
-        let mut q = vec![0.0; model.dof()];
-        (0..motion.len())
-            .map(|k| {
-                // the positions as recorded: smoothing rounds the corner where the tool lands
-                for ((qj, smoothed), recorded) in q.iter_mut().zip(&motion.q).zip(&motion.recorded) {
-                    *qj = recorded.as_ref().map_or(smoothed[k], |r| r[k]);
-                }
-                forward_kinematics(model, &mut data, &q);
-                frame_pose(model, &data, frame).translation.z
-            })
-            .collect()
-    };
+    // the positions as recorded: smoothing rounds the corner where the tool lands
+    let heights = |motion: &crate::replay::Motion| recorded_heights(model, frame, motion);
     let (mut frames, mut height, mut highest, mut commanded_lowest) = (0, f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY);
     for case in cases {
         let (real, asked) = (heights(case.real()), heights(case.commanded()));

@@ -78,6 +78,8 @@ pub struct ForwardOptions {
     pub latency: Option<Latency>,
     /// Where to write the frames compared, command, real and simulated (None: nowhere).
     pub trace: Option<PathBuf>,
+    /// The motor file's floor left out (a recording whose tool went through it: not its table).
+    pub without_floor: bool,
 }
 
 /// The longest command latency accepted, s: a teleop loop slower than this is not one.
@@ -109,7 +111,7 @@ impl Latency {
 /// `observed`.
 pub fn forward(replayer: &Replayer, options: &ForwardOptions, commands: &Episode, observed: &Episode) -> Result<ForwardReplay, Error> {
     let case = ForwardCase::prepare(replayer, commands, observed, &options.schedule, options.latency.clone())?;
-    let setup = FollowSetup { payload: options.payload, tool: options.tool.as_deref(), offsets: None };
+    let setup = FollowSetup { payload: options.payload, tool: options.tool.as_deref(), offsets: None, without_floor: options.without_floor };
     let replay = follow(&replayer.base_model, &case, &Drives::File(&options.motors), &setup, options.recordings.as_ref())?;
     if let Some(path) = &options.trace {
         super::trace::write_forward(path, &replay)?;
@@ -212,6 +214,8 @@ pub struct FollowSetup<'a> {
     pub payload: f64,
     pub tool: Option<&'a str>,
     pub offsets: Option<&'a [f64]>,
+    /// The motor file's floor left out.
+    pub without_floor: bool,
 }
 
 impl FollowSetup<'_> {
@@ -245,10 +249,14 @@ fn follower_experiment(model: &crate::model::Model, case: &ForwardCase, drives: 
         ..RunConfig::default()
     };
     let experiment_from = |start: &[f64]| -> Result<Experiment, Error> {
-        let mut experiment = match drives {
-            Drives::File(_) => Experiment::with_model(config_from(start), model.clone())?,
-            Drives::Made { make, .. } => Experiment::with_motors(config_from(start), model.clone(), Some(make()?))?,
+        let mut motors = match drives {
+            Drives::File(file) => crate::actuator::load_motor_file(file, model)?,
+            Drives::Made { make, .. } => make()?,
         };
+        if setup.without_floor {
+            motors.floor = None;
+        }
+        let mut experiment = Experiment::with_motors(config_from(start), model.clone(), Some(motors))?;
         if let Some(offsets) = setup.offsets {
             let inner = std::mem::replace(&mut experiment.trajectory, Box::new(crate::control::trajectory::Hold));
             experiment.trajectory = Box::new(crate::control::trajectory::Shifted { inner, offsets: offsets.to_vec() });

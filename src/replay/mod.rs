@@ -4,7 +4,8 @@
 //! config (URDF, payload, tool, motors) → [`Replayer`] (the model built once) → per episode:
 //! [`smoothing`] → [`inverse`] → [`verdict`] → [`report`] (text, JSON) and [`trace`] (CSV);
 //! forward, the commands followed by the simulated arm and held against the real follower
-//! ([`forward`]; the part of its gap made at rest: [`at_rest`]).
+//! ([`forward`]; the part of its gap made at rest: [`at_rest`]; where its tool went:
+//! [`tool_height`]).
 
 pub mod at_rest;
 pub mod forward;
@@ -13,6 +14,7 @@ pub mod recording;
 pub mod report;
 pub mod schedule;
 pub mod smoothing;
+pub mod tool_height;
 pub mod trace;
 pub mod verdict;
 
