@@ -238,6 +238,11 @@ fn a_follower_whose_commands_arrive_late_is_met_once_the_replay_is_told_the_late
     let (text, one_frame) = replay(None);
     assert!(text.contains("commands reach the model's servos 33.3 ms after their frame (one frame; --latency sets another)"), "{text}");
     assert!((one_frame["latency_s"].as_f64().unwrap() - 1.0 / 30.0).abs() < 1e-6);
+    // the servos' own delay after it, the catalogue's STS3215's (34.9 ms, from bench logs), said too
+    assert!(text.contains("(one frame; --latency sets another), the servos act on them 34.9 ms later (their command_delay)"), "{text}");
+    let catalogue = armscope::actuator::Catalogue::load(Path::new(armscope::actuator::catalogue::DEFAULT_CATALOGUE)).unwrap();
+    let delay = catalogue.servo_params("STS3215-C018").unwrap().unwrap().command_delay;
+    assert_eq!(one_frame["servo_command_delay_s"]["elbow_flex"].as_f64(), Some(delay));
     let (text, told) = replay(Some("0.1"));
     assert!(text.contains("100.0 ms after their frame (--latency)"), "{text}");
     let gap = |doc: &serde_json::Value, j: usize| doc["joints"][j]["gap_mae"].as_f64().unwrap();

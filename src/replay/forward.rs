@@ -62,6 +62,9 @@ pub struct ForwardReplay {
     pub uncommanded: Vec<String>,
     /// The command latency the model was given.
     pub latency: Latency,
+    /// Per compared joint driven by a bus servo, its firmware's own command delay (the bus's and the
+    /// firmware's, from the motor file), s: it adds to the latency.
+    pub servo_delays: Vec<(String, f64)>,
 }
 
 /// What the run needs beyond the replayer: the motor file (required: the joints' servos), payload and
@@ -327,7 +330,11 @@ pub fn follow(model: &crate::model::Model, case: &ForwardCase, drives: &Drives, 
     }
     let protection_trips = summary.servos.iter().enumerate().filter_map(|(j, s)| Some((model.joints[j].name.clone(), s.as_ref()?.protection_trip?))).collect();
     let uncommanded = case.uncommanded.iter().map(|&j| model.joints[j].name.clone()).collect();
-    Ok(ForwardReplay { label: case.label.clone(), time, commanded, observed, simulated, joints, protection_trips, uncommanded, latency: case.latency.clone() })
+    let servo_delays = match &experiment.motors {
+        Some(motors) => case.mapped.iter().filter_map(|&j| Some((model.joints[j].name.clone(), motors.joints[j].as_ref()?.servo.as_ref()?.command_delay))).collect(),
+        None => Vec::new(),
+    };
+    Ok(ForwardReplay { label: case.label.clone(), time, commanded, observed, simulated, joints, protection_trips, uncommanded, latency: case.latency.clone(), servo_delays })
 }
 
 /// A joint whose commands sweep at least this far (rad, 5°) is expected to move: an STS3215 at
@@ -467,7 +474,7 @@ impl Recorder for GapWatch<'_> {
 pub fn text(replay: &ForwardReplay) -> String {
     let mut out = format!("{}: the simulated arm following its commands, against the real follower (mrad)\n", replay.label);
     let from = if replay.latency.from == "--latency" { "--latency".to_string() } else { format!("{}; --latency sets another", replay.latency.from) };
-    out += &format!("  commands reach the model's servos {:.1} ms after their frame ({from}); tracking measured against the commands as recorded\n", replay.latency.seconds * 1e3);
+    out += &format!("  commands reach the model's servos {:.1} ms after their frame ({from}){}; tracking measured against the commands as recorded\n", replay.latency.seconds * 1e3, servo_delays_text(&replay.servo_delays));
     out += &format!("  {:<16} {:>18} {:>18} {:>22}  {}\n", "joint", "real tracking", "model tracking", "gap model − real", "parts (gap > 50 mrad)");
     out += &format!("  {:<16} {:>18} {:>18} {:>22}\n", "", "mean / max", "mean / max", "mean / max (at)");
     for g in &replay.joints {
@@ -509,6 +516,19 @@ pub fn text(replay: &ForwardReplay) -> String {
     out
 }
 
+/// The servos' own command delay after the latency, as the report's first line says it ("" where
+/// no compared joint is a bus servo's).
+fn servo_delays_text(delays: &[(String, f64)]) -> String {
+    let (lowest, highest) = delays.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), (_, d)| (lo.min(*d), hi.max(*d)));
+    if delays.is_empty() {
+        String::new()
+    } else if highest - lowest < 5e-5 {
+        format!(", the servos act on them {:.1} ms later (their command_delay)", highest * 1e3)
+    } else {
+        format!(", the servos act on them {:.1}–{:.1} ms later (their command_delay)", lowest * 1e3, highest * 1e3)
+    }
+}
+
 /// One episode's forward replay as a batch keeps it: its findings, not its frames.
 #[derive(Clone, Debug)]
 pub struct ForwardSummary {
@@ -526,7 +546,8 @@ pub struct ForwardSummary {
 impl ForwardSummary {
     pub fn of(index: i64, replay: &ForwardReplay, notices: Vec<String>) -> Self {
         let trips: Vec<serde_json::Value> = replay.protection_trips.iter().map(|(joint, trip)| serde_json::json!({ "joint": joint, "trip": trip })).collect();
-        let document = serde_json::json!({ "episode": index, "latency_s": replay.latency.seconds, "latency_from": replay.latency.from, "joints": replay.joints, "protection_trips": trips, "uncommanded": replay.uncommanded });
+        let servo_delays: serde_json::Map<String, serde_json::Value> = replay.servo_delays.iter().map(|(joint, d)| (joint.clone(), serde_json::json!(d))).collect();
+        let document = serde_json::json!({ "episode": index, "latency_s": replay.latency.seconds, "latency_from": replay.latency.from, "servo_command_delay_s": servo_delays, "joints": replay.joints, "protection_trips": trips, "uncommanded": replay.uncommanded });
         let widest_gap = replay.joints.iter().filter(|g| g.follows).map(|g| g.gap_mae).fold(0.0, f64::max);
         Self { index, widest_gap, text: text(replay), document, notices }
     }
