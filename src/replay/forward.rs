@@ -209,9 +209,10 @@ pub enum Drives<'a> {
     Made { file: &'a Path, make: &'a (dyn Fn() -> Result<crate::actuator::MotorSet, Error> + Sync) },
 }
 
-/// What a follower is run with beyond its drives: the payload (kg) at the tool, and per coordinate
-/// the offset of the recording's angles from the arm's (None: none) — the arm runs at the
-/// recording's poses plus their offset, and is compared with the recording less it.
+/// What a follower is run with beyond its drives: the payload (kg) at the tool, per coordinate the
+/// offset of the recording's angles from the arm's (None: none) — the arm runs at the recording's
+/// poses plus their offset, and is compared with the recording less it — and whether the motor
+/// file's floor is left out.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct FollowSetup<'a> {
     pub payload: f64,

@@ -7,6 +7,7 @@ use crate::dynamics::{Data, forward_kinematics, frame_pose};
 use crate::error::Error;
 use crate::model::Model;
 use crate::motion::Source;
+use crate::motion::commands::CommandSource;
 use crate::plant::FloorContact;
 
 /// The height of `frame`'s origin at each frame of `motion`, m: its positions as recorded where it
@@ -40,12 +41,13 @@ pub struct Through {
     pub episodes: usize,
 }
 
-/// Whether the follower recorded as `feature` in `episodes` of `source` took its tool (`floor`'s
-/// frame) more than [`THROUGH_FLOOR`] below `floor` (None: never).
-pub fn through_floor(replayer: &Replayer, source: &Source, episodes: &[i64], feature: &str, floor: FloorContact) -> Result<Option<Through>, Error> {
+/// Whether the follower a forward replay of `episodes` of `source` follows (recorded as `feature`;
+/// a bag's joint states beside `commands`) took its tool (`floor`'s frame) more than
+/// [`THROUGH_FLOOR`] below `floor` (None: never).
+pub fn through_floor(replayer: &Replayer, source: &Source, episodes: &[i64], feature: &str, commands: &CommandSource, floor: FloorContact) -> Result<Option<Through>, Error> {
     let mut through: Option<Through> = None;
     for &index in episodes {
-        let observed = source.read(index, feature)?;
+        let (_, observed) = source.read_forward(index, feature, commands)?;
         let motion = inverse_replay(&replayer.model, &replayer.map, &observed, &replayer.hold)?;
         let lowest = recorded_heights(&replayer.base_model, floor.frame, &motion).into_iter().fold(f64::INFINITY, f64::min);
         let depth = floor.height - lowest;
