@@ -156,13 +156,14 @@ fn forward(args: &ReplayArgs, replayer: &Replayer, source: &crate::motion::Sourc
     if let Some(latency) = args.latency {
         crate::replay::forward::check_latency(latency)?;
     }
+    let jobs = args.jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
     let commands = crate::motion::commands::CommandSource { topic: args.command_topic.clone(), joints: args.command_joints.clone() };
     // a motor file's floor is the table its arm stood on: a recording whose tool went through it
     // stood on another, and is replayed without it
     let mut without_floor = false;
     if let Some(floor) = replayer.motors.as_ref().and_then(|m| m.floor) {
         let tool = &replayer.base_model.frames[floor.frame].name;
-        match crate::replay::tool_height::through_floor(replayer, source, episodes, &args.recorded.feature, &commands, floor)? {
+        match crate::replay::tool_height::through_floor(replayer, source, episodes, &args.recorded.feature, &commands, floor, jobs)? {
             Some(through) => {
                 without_floor = true;
                 let others = if through.episodes > 1 { format!(" (and {} more)", through.episodes - 1) } else { String::new() };
@@ -213,7 +214,6 @@ fn forward(args: &ReplayArgs, replayer: &Replayer, source: &crate::motion::Sourc
             eprintln!("armscope: wrote {}", path.display());
         }
     };
-    let jobs = args.jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
     let summaries = forward_episodes(replayer, source, episodes, &args.recorded.feature, &commands, jobs, &|index| options(index, !several))?;
     for s in &summaries {
         for notice in &s.notices {

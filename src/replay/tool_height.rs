@@ -43,21 +43,15 @@ pub struct Through {
 
 /// Whether the follower a forward replay of `episodes` of `source` follows (recorded as `feature`;
 /// a bag's joint states beside `commands`) took its tool (`floor`'s frame) more than
-/// [`THROUGH_FLOOR`] below `floor` (None: never).
-pub fn through_floor(replayer: &Replayer, source: &Source, episodes: &[i64], feature: &str, commands: &CommandSource, floor: FloorContact) -> Result<Option<Through>, Error> {
-    let mut through: Option<Through> = None;
-    for &index in episodes {
+/// [`THROUGH_FLOOR`] below `floor` (None: never); the episodes read on `jobs` threads.
+pub fn through_floor(replayer: &Replayer, source: &Source, episodes: &[i64], feature: &str, commands: &CommandSource, floor: FloorContact, jobs: usize) -> Result<Option<Through>, Error> {
+    let depths = super::over_episodes(episodes, jobs, |index| {
         let (_, observed) = source.read_forward(index, feature, commands)?;
         let motion = inverse_replay(&replayer.model, &replayer.map, &observed, &replayer.hold)?;
         let lowest = recorded_heights(&replayer.base_model, floor.frame, &motion).into_iter().fold(f64::INFINITY, f64::min);
-        let depth = floor.height - lowest;
-        if depth > THROUGH_FLOOR {
-            through = Some(match through {
-                Some(t) if t.depth >= depth => Through { episodes: t.episodes + 1, ..t },
-                Some(t) => Through { episode: index, depth, episodes: t.episodes + 1 },
-                None => Through { episode: index, depth, episodes: 1 },
-            });
-        }
-    }
-    Ok(through)
+        Ok((index, floor.height - lowest))
+    })?;
+    let through: Vec<(i64, f64)> = depths.into_iter().filter(|&(_, depth)| depth > THROUGH_FLOOR).collect();
+    let deepest = through.iter().copied().max_by(|a, b| a.1.total_cmp(&b.1));
+    Ok(deepest.map(|(episode, depth)| Through { episode, depth, episodes: through.len() }))
 }
