@@ -193,9 +193,7 @@ pub fn identify_arm(args: &IdentifyArgs, dataset: &Path) -> Result<i32, Error> {
     // the joints fitted: every compared one but a gripper's and one that does not follow
     let compared: Vec<usize> = train_cases[0].compared().to_vec();
     let name = |j: usize| model.joints[j].name.clone();
-    let payload_now = arm.payload;
-    let before: Vec<ForwardReplay> = train_cases.iter().map(|c| follow(&model, c, &Drives::File(motors), &FollowSetup { payload: payload_now, tool: arm.tool.as_deref(), offsets: None, without_floor: false }, None)).collect::<Result<_, _>>()?;
-    let still: Vec<usize> = compared.iter().copied().filter(|&j| before.iter().any(|r| r.joints.iter().any(|g| g.joint == name(j) && !g.follows))).collect();
+    let still: Vec<usize> = compared.iter().copied().filter(|&j| train_cases.iter().any(|c| c.not_following().contains(&j))).collect();
     let mut left_out: Vec<(String, String)> = Vec::new();
     let fitted: Vec<usize> = match &arm.fit_joints {
         Some(list) => {

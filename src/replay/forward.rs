@@ -134,6 +134,8 @@ pub struct ForwardCase {
     /// real joint was).
     mapped: Vec<usize>,
     uncommanded: Vec<usize>,
+    /// The compared joints that do not follow their commands, sent where the real joint was.
+    held: Vec<usize>,
     latency: Latency,
     schedule: PathBuf,
 }
@@ -161,24 +163,31 @@ impl ForwardCase {
         // a joint whose real follower stayed put while its commands swept (a servo off, a cable
         // loose) is sent where the real joint was, as one no command names: the joints beside it then
         // carry it where the real arm did (it is still held against its commands, as not following)
-        for &j in &mapped {
-            if let (Some(c), Some(o)) = (&command.recorded[j], &reality.recorded[j])
-                && !follows(c, o)
-            {
-                command.q[j] = reality.q[j].clone();
-            }
+        let held: Vec<usize> = mapped
+            .iter()
+            .copied()
+            .filter(|&j| matches!((&command.recorded[j], &reality.recorded[j]), (Some(c), Some(o)) if !follows(sweep(c), sweep(o))))
+            .collect();
+        for &j in &held {
+            command.q[j] = reality.q[j].clone();
         }
         // LeRobot's loop reads the follower, then the leader, then sends the action: frame t's command
         // reaches the servos after observation t, the bus and the firmware add theirs (the servos' own
         // command_delay)
         let latency = latency.unwrap_or_else(|| Latency::given(schedule::frame_period(&command), "one frame"));
         schedule::write_delayed(schedule, &command, latency.seconds)?;
-        Ok(Self { label: commands.label.clone(), command, reality, mapped, uncommanded, latency, schedule: schedule.to_path_buf() })
+        Ok(Self { label: commands.label.clone(), command, reality, mapped, uncommanded, held, latency, schedule: schedule.to_path_buf() })
     }
 
     /// The compared joints (the model's coordinates).
     pub fn compared(&self) -> &[usize] {
         &self.mapped
+    }
+
+    /// The compared joints that do not follow their commands (the real joint stayed put while they
+    /// swept): the model holds them where the real one was.
+    pub fn not_following(&self) -> &[usize] {
+        &self.held
     }
 
     /// The commands as the model's joint positions (per coordinate, per frame).
@@ -346,9 +355,9 @@ const SWEEP_EXPECTED: f64 = 0.087;
 /// off, a cable loose): a real follower lags and sags, but covers most of the way.
 const FOLLOWS_FRACTION: f64 = 0.1;
 
-/// Whether a joint recorded at `observed` followed its commands `commanded` at all.
-fn follows(commanded: &[f64], observed: &[f64]) -> bool {
-    let (commanded_sweep, observed_sweep) = (sweep(commanded), sweep(observed));
+/// Whether a joint that swept `observed_sweep` followed its commands, which swept
+/// `commanded_sweep`, at all.
+fn follows(commanded_sweep: f64, observed_sweep: f64) -> bool {
     !(commanded_sweep >= SWEEP_EXPECTED && observed_sweep < FOLLOWS_FRACTION * commanded_sweep)
 }
 
@@ -382,7 +391,7 @@ impl JointGap {
             gap_max,
             gap_max_at: time[at],
             parts_at,
-            follows: follows(c, o),
+            follows: follows(commanded_sweep, observed_sweep),
             commanded_sweep,
             observed_sweep,
             at_rest: AtRest::of(time, c, o, s),
