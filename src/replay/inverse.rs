@@ -105,6 +105,13 @@ fn follow_to_limits(model: &Model, episode: &Episode, mut mapped: Vec<Option<Vec
     Ok(mapped)
 }
 
+/// An episode's positions per coordinate of the model (None where the map leaves the joint out),
+/// followed to each joint's limit where they pass it (said in `notices`) — as recorded, before
+/// smoothing.
+pub fn mapped_positions(model: &Model, map: &JointMap, episode: &Episode, notices: &mut Vec<String>) -> Result<Vec<Option<Vec<f64>>>, Error> {
+    follow_to_limits(model, episode, map.apply(model, episode)?, notices)
+}
+
 /// Smooth an episode mapped onto the model's coordinates and work out the torques it needed.
 /// Joints the map leaves out are held at their start pose `hold` (zero speed).
 pub fn inverse_replay(model: &Model, map: &JointMap, episode: &Episode, hold: &[f64]) -> Result<Motion, Error> {
@@ -114,7 +121,7 @@ pub fn inverse_replay(model: &Model, map: &JointMap, episode: &Episode, hold: &[
         return Err(Error::flag(episode.label.clone(), format!("{samples} samples: a replay needs at least {MIN_SAMPLES}")));
     }
     let mut notices = episode.notices.clone();
-    let mapped = follow_to_limits(model, episode, map.apply(model, episode)?, &mut notices)?;
+    let mapped = mapped_positions(model, map, episode, &mut notices)?;
     let mut smoother = Smoother::new(&episode.time);
     let mut q = Vec::with_capacity(n);
     let mut qd = Vec::with_capacity(n);
