@@ -104,6 +104,44 @@ fn v21_dataset_needed_torques_match_the_true_motions_inverse_dynamics() {
 }
 
 #[test]
+fn v3_dataset_in_one_row_group_needed_torques_match_the_true_motions_inverse_dynamics() {
+    check_layout(Spec::write_v3_one_row_group);
+}
+
+/// A v3 file whose episodes share one row group (decoded once for all of them) reads every episode
+/// as the file with a row group per episode does, to the bit, in any order and from several
+/// threads at once.
+#[test]
+fn episodes_sharing_a_row_group_read_as_episodes_in_their_own() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = load_urdf(&so101()).unwrap();
+    let spec = spec(4, 3.0, &model);
+    let (own, shared) = (dir.path().join("own"), dir.path().join("shared"));
+    spec.write_v3(&own);
+    spec.write_v3_one_row_group(&shared);
+    let (own, shared) = (Source::open(&own, None).unwrap(), Source::open(&shared, None).unwrap());
+    let read = |source: &Source, e: i64, feature: &str| {
+        let episode = source.read(e, feature).unwrap();
+        (episode.time, episode.columns.into_iter().map(|c| (c.name, c.values)).collect::<Vec<_>>())
+    };
+    let orders: [Vec<i64>; 2] = [vec![3, 1, 0, 2], vec![2, 0, 3, 1]];
+    std::thread::scope(|scope| {
+        for order in &orders {
+            let (own, shared) = (&own, &shared);
+            scope.spawn(move || {
+                for &e in order {
+                    for feature in ["observation.state", "action"] {
+                        let expected = read(own, e, feature);
+                        assert_eq!(expected.0.len(), 3 * 30 + 1);
+                        assert_eq!(read(shared, e, feature), expected, "episode {e}, {feature}");
+                    }
+                }
+            });
+        }
+    });
+}
+
+#[test]
 fn the_intervals_shoulder_lift_needs_over_2_9_nm_are_found_to_a_frame() {
     let dir = tempfile::tempdir().unwrap();
     let model = load_urdf(&so101()).unwrap();

@@ -161,6 +161,16 @@ impl Spec {
 
     /// v3.0: every episode in `data/chunk-000/file-000.parquet`, one row group each.
     pub fn write_v3(&self, root: &Path) {
+        self.write_v3_grouped(root, true);
+    }
+
+    /// v3.0 as a conversion or an aggregation writes it: every episode in one row group of
+    /// `data/chunk-000/file-000.parquet`.
+    pub fn write_v3_one_row_group(&self, root: &Path) {
+        self.write_v3_grouped(root, false);
+    }
+
+    fn write_v3_grouped(&self, root: &Path, group_per_episode: bool) {
         std::fs::create_dir_all(root.join("meta/episodes/chunk-000")).unwrap();
         std::fs::create_dir_all(root.join("data/chunk-000")).unwrap();
         std::fs::write(root.join("meta/info.json"), self.info("v3.0", "data/chunk-{chunk_index:03d}/file-{file_index:03d}.parquet")).unwrap();
@@ -168,7 +178,9 @@ impl Spec {
         let mut writer = ArrowWriter::try_new(file, schema(), None).unwrap();
         for e in 0..self.episodes.len() {
             writer.write(&self.batch(e, (e * self.frames) as i64)).unwrap();
-            writer.flush().unwrap();
+            if group_per_episode {
+                writer.flush().unwrap();
+            }
         }
         writer.close().unwrap();
         let count = self.episodes.len() as i64;

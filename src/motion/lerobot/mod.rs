@@ -3,13 +3,15 @@
 //! `meta/episodes/…parquet`): `meta/info.json` says which, its `data_path` template where the
 //! frames are, its `features` what the vector columns' entries are called.
 
+mod columns;
+mod row_groups;
+
 use super::{Column, Episode, check_increasing};
 use crate::error::Error;
-use arrow::array::{Array, AsArray, RecordBatch};
-use arrow::datatypes::{Float32Type, Float64Type, Int64Type};
+use columns::int_column;
 use parquet::arrow::ProjectionMask;
 use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
-use parquet::file::statistics::Statistics;
+use row_groups::DataFiles;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 
@@ -40,6 +42,8 @@ pub struct Dataset {
     data_path: String,
     features: serde_json::Map<String, Value>,
     episodes: Vec<EpisodeEntry>,
+    /// The data files' footers and the row groups of several episodes, read once for all of them.
+    files: DataFiles,
 }
 
 impl Dataset {
@@ -64,7 +68,7 @@ impl Dataset {
             Layout::FilePerEpisode => read_episodes_jsonl(root, chunks_size)?,
             Layout::SharedFiles => read_episodes_table(root)?,
         };
-        Ok(Self { root: root.to_path_buf(), version, layout, fps, robot_type, data_path, features, episodes })
+        Ok(Self { root: root.to_path_buf(), version, layout, fps, robot_type, data_path, features, episodes, files: DataFiles::default() })
     }
 
     pub fn episode_indices(&self) -> Vec<i64> {
@@ -98,7 +102,8 @@ impl Dataset {
 
     /// Read one episode's frames of `feature`, in frame order, timed by `frame_index / fps`.
     pub fn read_episode(&self, episode: i64, feature: &str) -> Result<Episode, Error> {
-        let entry = self.episodes.iter().find(|e| e.index == episode).ok_or_else(|| {
+        // the entries are sorted by episode (read_episodes_*)
+        let entry = self.episodes.binary_search_by_key(&episode, |e| e.index).ok().map(|k| &self.episodes[k]).ok_or_else(|| {
             let indices = self.episode_indices();
             let range = match (indices.iter().min(), indices.iter().max()) {
                 (Some(a), Some(b)) => format!("{} episodes, {a} to {b}", indices.len()),
@@ -109,49 +114,8 @@ impl Dataset {
         let names = self.feature_names(feature).ok_or_else(|| Error::flag("--feature", format!("no feature '{feature}' in {} (features: {})", self.root.join("meta/info.json").display(), self.vector_features().join(", "))))?;
         let path = self.data_file(entry);
         let fail = |m: String| Error::flag(path.display().to_string(), m);
-        let file = std::fs::File::open(&path).map_err(|e| fail(e.to_string()))?;
-        let builder = ParquetRecordBatchReaderBuilder::try_new(file).map_err(|e| fail(e.to_string()))?;
-        let arrow_schema = builder.schema().clone();
-        let root_index = |name: &str| arrow_schema.fields().iter().position(|f| f.name() == name);
-        let columns: Vec<&str> = arrow_schema.fields().iter().map(|f| f.name().as_str()).collect();
-        let feature_root = root_index(feature).ok_or_else(|| fail(format!("no column '{feature}' (columns: {})", columns.join(", "))))?;
-        let mut wanted = vec![feature_root];
-        let episode_root = root_index("episode_index");
-        let frame_root = root_index("frame_index");
-        let timestamp_root = root_index("timestamp");
-        if episode_root.is_none() && self.layout == Layout::SharedFiles {
-            return Err(fail(format!("no column 'episode_index' to tell its episodes apart (columns: {})", columns.join(", "))));
-        }
-        if frame_root.is_none() && timestamp_root.is_none() {
-            return Err(fail(format!("neither 'frame_index' nor 'timestamp' to time the frames (columns: {})", columns.join(", "))));
-        }
-        wanted.extend([episode_root, frame_root, timestamp_root].into_iter().flatten());
-        // only the row groups that can hold the episode (a v3 writer makes one per episode)
-        let metadata = builder.metadata().clone();
-        let episode_leaf = builder.parquet_schema().columns().iter().position(|c| c.path().parts() == ["episode_index"]);
-        let row_groups: Vec<usize> = (0..metadata.num_row_groups())
-            .filter(|&rg| {
-                let Some(leaf) = episode_leaf else { return true };
-                match metadata.row_group(rg).column(leaf).statistics() {
-                    Some(Statistics::Int64(s)) => match (s.min_opt(), s.max_opt()) {
-                        (Some(lo), Some(hi)) => *lo <= episode && episode <= *hi,
-                        _ => true,
-                    },
-                    _ => true,
-                }
-            })
-            .collect();
-        let mask = ProjectionMask::roots(builder.parquet_schema(), wanted);
-        let reader = builder.with_projection(mask).with_row_groups(row_groups).build().map_err(|e| fail(e.to_string()))?;
-        let width = names.len();
-        let mut frames: Vec<i64> = Vec::new();
-        let mut stamps: Vec<f64> = Vec::new();
-        let mut values: Vec<Vec<f64>> = vec![Vec::new(); width];
-        for batch in reader {
-            let batch = batch.map_err(|e| fail(e.to_string()))?;
-            read_batch(&batch, feature, episode, width, &mut frames, &mut stamps, &mut values).map_err(fail)?;
-        }
-        if frames.is_empty() && stamps.is_empty() || values[0].is_empty() {
+        let (mut frames, mut stamps, mut values) = self.files.episode(&path, feature, names.len(), episode, self.layout == Layout::SharedFiles).map_err(fail)?;
+        if frames.is_empty() && stamps.is_empty() || values.first().is_none_or(Vec::is_empty) {
             return Err(fail(format!("no frames of episode {episode}")));
         }
         let label = format!("episode {episode}");
@@ -186,121 +150,6 @@ impl Dataset {
     }
 }
 
-/// Append the rows of `episode` in one record batch.
-fn read_batch(batch: &RecordBatch, feature: &str, episode: i64, width: usize, frames: &mut Vec<i64>, stamps: &mut Vec<f64>, values: &mut [Vec<f64>]) -> Result<(), String> {
-    let rows = batch.num_rows();
-    let episode_of = batch.column_by_name("episode_index").map(|a| int_column(a, "episode_index")).transpose()?;
-    let frame_of = batch.column_by_name("frame_index").map(|a| int_column(a, "frame_index")).transpose()?;
-    let stamp_of = batch.column_by_name("timestamp").map(|a| float_scalars(a, "timestamp")).transpose()?;
-    let vectors = batch.column_by_name(feature).ok_or_else(|| format!("no column '{feature}'"))?;
-    let vectors = VectorColumn::new(vectors.as_ref(), feature, width)?;
-    for row in 0..rows {
-        if let Some(e) = &episode_of
-            && e[row] != episode
-        {
-            continue;
-        }
-        if let Some(f) = &frame_of {
-            frames.push(f[row]);
-        }
-        if let Some(s) = &stamp_of {
-            stamps.push(s[row]);
-        }
-        for (k, column) in values.iter_mut().enumerate() {
-            column.push(vectors.get(row, k));
-        }
-    }
-    Ok(())
-}
-
-fn int_column(array: &dyn Array, name: &str) -> Result<Vec<i64>, String> {
-    if let Some(a) = array.as_primitive_opt::<Int64Type>() {
-        return Ok(a.values().to_vec());
-    }
-    if let Some(a) = array.as_primitive_opt::<arrow::datatypes::Int32Type>() {
-        return Ok(a.values().iter().map(|&v| v as i64).collect());
-    }
-    Err(format!("column '{name}' is {}, not integers", array.data_type()))
-}
-
-fn float_scalars(array: &dyn Array, name: &str) -> Result<Vec<f64>, String> {
-    if let Some(a) = array.as_primitive_opt::<Float32Type>() {
-        return Ok(a.values().iter().map(|&v| v as f64).collect());
-    }
-    if let Some(a) = array.as_primitive_opt::<Float64Type>() {
-        return Ok(a.values().to_vec());
-    }
-    // some writers keep shape-[1] features as one-element lists
-    let column = VectorColumn::new(array, name, 1)?;
-    Ok((0..array.len()).map(|row| column.get(row, 0)).collect())
-}
-
-/// A column of fixed-width float vectors however it was written: FixedSizeList, List, LargeList
-/// of float32 or float64, or a plain float column (width 1).
-struct VectorColumn<'a> {
-    starts: Vec<usize>,
-    floats: Floats<'a>,
-}
-
-enum Floats<'a> {
-    F32(&'a [f32]),
-    F64(&'a [f64]),
-}
-
-impl<'a> VectorColumn<'a> {
-    fn new(array: &'a dyn Array, name: &str, width: usize) -> Result<Self, String> {
-        let rows = array.len();
-        let floats = |child: &'a dyn Array| -> Result<Floats<'a>, String> {
-            if let Some(a) = child.as_primitive_opt::<Float32Type>() {
-                Ok(Floats::F32(a.values()))
-            } else if let Some(a) = child.as_primitive_opt::<Float64Type>() {
-                Ok(Floats::F64(a.values()))
-            } else {
-                Err(format!("column '{name}' holds {}, not floats", child.data_type()))
-            }
-        };
-        let wrong_width = |row: usize, got: usize| format!("column '{name}' row {row} has {got} values, info.json's features say {width}");
-        if let Some(list) = array.as_fixed_size_list_opt() {
-            if list.value_length() as usize != width {
-                return Err(wrong_width(0, list.value_length() as usize));
-            }
-            let starts = (0..rows).map(|r| list.value_offset(r) as usize).collect();
-            return Ok(Self { starts, floats: floats(list.values().as_ref())? });
-        }
-        if let Some(list) = array.as_list_opt::<i32>() {
-            return Ok(Self { starts: list_starts(list.value_offsets(), width).map_err(|(r, got)| wrong_width(r, got))?, floats: floats(list.values().as_ref())? });
-        }
-        if let Some(list) = array.as_list_opt::<i64>() {
-            return Ok(Self { starts: list_starts(list.value_offsets(), width).map_err(|(r, got)| wrong_width(r, got))?, floats: floats(list.values().as_ref())? });
-        }
-        if width == 1 {
-            return Ok(Self { starts: (0..rows).collect(), floats: floats(array)? });
-        }
-        Err(format!("column '{name}' is {}, not a list of {width} floats", array.data_type()))
-    }
-
-    fn get(&self, row: usize, k: usize) -> f64 {
-        let i = self.starts[row] + k;
-        match self.floats {
-            Floats::F32(v) => v[i] as f64,
-            Floats::F64(v) => v[i],
-        }
-    }
-}
-
-/// Each row's first value in a List or LargeList column, if every row holds `width` values (else
-/// the first row that does not, and how many it holds).
-fn list_starts<O: arrow::array::OffsetSizeTrait>(offsets: &[O], width: usize) -> Result<Vec<usize>, (usize, usize)> {
-    offsets
-        .windows(2)
-        .enumerate()
-        .map(|(row, w)| {
-            let (start, end) = (w[0].as_usize(), w[1].as_usize());
-            if end - start == width { Ok(start) } else { Err((row, end - start)) }
-        })
-        .collect()
-}
-
 fn read_episodes_jsonl(root: &Path, chunks_size: i64) -> Result<Vec<EpisodeEntry>, Error> {
     let path = root.join("meta/episodes.jsonl");
     let fail = |m: String| Error::flag(path.display().to_string(), m);
@@ -312,6 +161,7 @@ fn read_episodes_jsonl(root: &Path, chunks_size: i64) -> Result<Vec<EpisodeEntry
         let length = row.get("length").and_then(Value::as_i64);
         entries.push(EpisodeEntry { index, length, chunk: index / chunks_size, file: 0 });
     }
+    entries.sort_by_key(|e| e.index);
     Ok(entries)
 }
 
