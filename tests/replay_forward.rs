@@ -68,7 +68,7 @@ fn replay_forward_on(root: &Path, dir: &Path, payload: f64, motors: &Path) -> ar
     let commands = source.read(0, "action").unwrap();
     let map = JointMap::builtin(source.kind(), &model, &observed).expect("the SO-101's built-in map");
     let replayer = Replayer::new(model, &ReplayOptions { payload, motors: Some(motors.to_path_buf()), ..Default::default() }, map).unwrap();
-    let options = ForwardOptions { motors: motors.to_path_buf(), payload, tool: None, schedule: dir.join(format!("commands_{payload}.csv")), recordings: None, latency: None, trace: None, without_floor: false };
+    let options = ForwardOptions { motors: motors.to_path_buf(), payload, tool: None, schedule: dir.join(format!("commands_{payload}.csv")), recordings: None, latency: None, trace: None, without_floor: false, off_elsewhere: Vec::new() };
     forward(&replayer, &options, &commands, &observed).unwrap()
 }
 
@@ -318,6 +318,57 @@ fn a_joint_that_does_not_follow_is_held_in_the_model_where_the_real_one_stayed()
     }
     let text = armscope::replay::forward::text(&replay);
     assert!(text.contains("wrist_roll       does not follow its commands") && text.contains("the model's held where the real one was"), "{text}");
+}
+
+#[test]
+fn a_joint_off_in_one_episode_is_taken_as_off_where_another_does_not_sweep_it() {
+    // The follower's wrist roll is off in both episodes of a recording: in episode 0 its commands
+    // sweep ±0.6 rad, in episode 1 ±0.025 (under 5°: too little to tell from that episode alone).
+    // Replayed together, episode 1's roll is taken as not following too (said in one notice) and
+    // held where the real one stayed; replayed alone, episode 1's roll is taken as following, and
+    // the model's roll moves with its commands away from the real one.
+    let dir = tempfile::tempdir().unwrap();
+    let wide = common::follower::so101_commands();
+    let mut small = wide.clone();
+    small[4] = Sines { center: 0.0, terms: vec![(0.025, 1.1, 0.3)] };
+    let stuck = |commands: &[Sines]| {
+        let mut stuck = commands.to_vec();
+        stuck[4] = Sines { center: commands[4].q(0.0), terms: Vec::new() };
+        stuck
+    };
+    let followers = vec![follower(dir.path(), &stuck(&wide), PAYLOAD, &motors()), follower(dir.path(), &stuck(&small), PAYLOAD, &motors())];
+    let both = dir.path().join("so101_roll_off_twice");
+    Spec { fps: 30.0, frames: FRAMES, episodes: vec![wide, small.clone()], storage: so101_storage(), observed: Some(followers.clone()) }.write_v3(&both);
+    let alone = dir.path().join("so101_roll_small_alone");
+    Spec { fps: 30.0, frames: FRAMES, episodes: vec![small], storage: so101_storage(), observed: Some(vec![followers[1].clone()]) }.write_v3(&alone);
+    let run = |root: &Path, name: &str| {
+        let json = dir.path().join(format!("{name}.json"));
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_armscope"))
+            .args(["replay", root.to_str().unwrap(), "--urdf", so101().to_str().unwrap(), "--motors", motors().to_str().unwrap(), "--payload", "0.2", "--units", "degrees", "--forward", "--no-rrd", "--no-mcap", "--summary-json", json.to_str().unwrap()])
+            .current_dir(dir.path())
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let doc: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+        (String::from_utf8_lossy(&out.stderr).to_string(), doc)
+    };
+    let roll_of = |doc: &serde_json::Value, episode: i64| -> serde_json::Value {
+        let episode = doc["episodes"].as_array().unwrap().iter().find(|e| e["episode"] == episode).unwrap();
+        episode["joints"].as_array().unwrap().iter().find(|j| j["joint"] == "wrist_roll").unwrap().clone()
+    };
+    let (stderr, doc) = run(&both, "both");
+    let notices: Vec<&str> = stderr.lines().filter(|l| l.contains("taken as not following there too")).collect();
+    assert_eq!(notices.len(), 1, "{stderr}");
+    assert!(notices[0].contains("wrist_roll does not follow its commands in episode 0; in episode 1 its commands sweep less than 5°"), "{stderr}");
+    let roll = roll_of(&doc, 1);
+    assert!(roll["follows"] == false && roll["commanded_sweep"].as_f64().unwrap() < 0.087, "{roll}");
+    // held where the real one stayed: within the encoder's quantum, 2π/4096 = 1.53 mrad
+    assert!(roll["gap_mae"].as_f64().unwrap() < 1.53e-3, "{roll}");
+    assert!(roll_of(&doc, 0)["follows"] == false);
+    let (stderr, doc) = run(&alone, "alone");
+    assert!(!stderr.contains("taken as not following"), "{stderr}");
+    let roll = roll_of(&doc, 0);
+    assert!(roll["follows"] == true && roll["gap_mae"].as_f64().unwrap() > 5e-3, "{roll}");
 }
 
 #[test]

@@ -152,7 +152,7 @@ fn replay_forward(bag: &Path, dir: &Path, payload: f64, from: &CommandSource) ->
     let (commands, observed) = source.read_forward(0, "observation.state", from).unwrap();
     let map = JointMap::builtin(source.kind(), &model, &observed).expect("a bag's columns are named by joint");
     let replayer = Replayer::new(model, &ReplayOptions { payload, motors: Some(motors()), ..Default::default() }, map).unwrap();
-    let options = ForwardOptions { motors: motors(), payload, tool: None, schedule: dir.join(format!("commands_{payload}.csv")), recordings: None, latency: Some(armscope::replay::forward::Latency::given(0.0, "a controller's set point")), trace: None, without_floor: false };
+    let options = ForwardOptions { motors: motors(), payload, tool: None, schedule: dir.join(format!("commands_{payload}.csv")), recordings: None, latency: Some(armscope::replay::forward::Latency::given(0.0, "a controller's set point")), trace: None, without_floor: false, off_elsewhere: Vec::new() };
     (forward(&replayer, &options, &commands, &observed).unwrap(), commands.notices)
 }
 

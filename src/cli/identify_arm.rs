@@ -181,7 +181,7 @@ pub fn identify_arm(args: &IdentifyArgs, dataset: &Path) -> Result<i32, Error> {
     let latency = arm.latency.map(|s| Latency::given(s, "--latency"));
     let prepare = |index: i64| -> Result<ForwardCase, Error> {
         let (commands, observed) = opened.source.read_forward(index, &arm.feature, &Default::default())?;
-        let case = ForwardCase::prepare(&replayer, &commands, &observed, &scratch.path().join(format!("episode_{index}.csv")), latency.clone())?;
+        let case = ForwardCase::prepare(&replayer, &commands, &observed, &scratch.path().join(format!("episode_{index}.csv")), latency.clone(), &[])?;
         if case.duration() < SHORTEST_EPISODE {
             return Err(Error::flag(commands.label.clone(), format!("{:.2} s long: too short to identify from (at least {SHORTEST_EPISODE} s of motion)", case.duration())));
         }

@@ -158,12 +158,26 @@ fn forward(args: &ReplayArgs, replayer: &Replayer, source: &crate::motion::Sourc
     }
     let jobs = args.jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
     let commands = crate::motion::commands::CommandSource { topic: args.command_topic.clone(), joints: args.command_joints.clone() };
-    // a motor file's floor is the table its arm stood on: a recording whose tool went through it
-    // stood on another, and is replayed without it
+    // read once before the replay: the joints off in some episode (a servo off, a cable loose), and
+    // whether the real tool went through the motor file's floor — then the table its arm stood on
+    // was another, and the recording is replayed without it
+    let floor = replayer.motors.as_ref().and_then(|m| m.floor);
+    let survey = crate::replay::survey::survey(replayer, source, episodes, &args.recorded.feature, &commands, floor, jobs)?;
+    for off in survey.off.iter().filter(|o| !o.taken_off_in.is_empty()) {
+        eprintln!(
+            "armscope: notice: {} does not follow its commands in {}; in {} its commands sweep less than {:.0}° and it stayed within {:.1}°: taken as not following there too (held where the real one was, left out of the ranking)",
+            replayer.base_model.joints[off.joint].name,
+            episode_list(&off.off_in),
+            episode_list(&off.taken_off_in),
+            crate::replay::following::SWEEP_EXPECTED.to_degrees(),
+            (crate::replay::following::FOLLOWS_FRACTION * crate::replay::following::SWEEP_EXPECTED).to_degrees()
+        );
+    }
+    let off_joints = survey.off_joints();
     let mut without_floor = false;
-    if let Some(floor) = replayer.motors.as_ref().and_then(|m| m.floor) {
+    if let Some(floor) = floor {
         let tool = &replayer.base_model.frames[floor.frame].name;
-        match crate::replay::tool_height::through_floor(replayer, source, episodes, &args.recorded.feature, &commands, floor, jobs)? {
+        match survey.through_floor {
             Some(through) => {
                 without_floor = true;
                 let others = if through.episodes > 1 { format!(" (and {} more)", through.episodes - 1) } else { String::new() };
@@ -208,6 +222,7 @@ fn forward(args: &ReplayArgs, replayer: &Replayer, source: &crate::motion::Sourc
         },
         trace: args.trace.as_ref().map(|path| if several { trace_path(path, index) } else { path.clone() }),
         without_floor,
+        off_elsewhere: off_joints.clone(),
     };
     let wrote = |options: &ForwardOptions| {
         for path in options.recordings.iter().flat_map(|r| r.rrd.iter().chain(&r.mcap)) {
@@ -249,6 +264,18 @@ fn forward(args: &ReplayArgs, replayer: &Replayer, source: &crate::motion::Sourc
 /// The one-line error when no joint map is known for a recording (its template printed above it).
 pub fn needs_map(source: &std::path::Path, urdf: &std::path::Path) -> Error {
     Error::flag("--joint-map", format!("needed: armscope knows no map from {}'s columns to {}'s joints; a template is printed above", source.display(), urdf.display()))
+}
+
+/// "episode 3", "episodes 3, 5 and 7", "episodes 3, 5, 7, 9, 11, 13 and 20 more".
+fn episode_list(episodes: &[i64]) -> String {
+    const NAMED: usize = 6;
+    let named: Vec<String> = episodes.iter().take(NAMED).map(|e| e.to_string()).collect();
+    match episodes.len() {
+        0 => "no episode".into(),
+        1 => format!("episode {}", named[0]),
+        n if n <= NAMED => format!("episodes {} and {}", named[..n - 1].join(", "), named[n - 1]),
+        n => format!("episodes {} and {} more", named.join(", "), n - NAMED),
+    }
 }
 
 /// `trace.csv` → `trace_episode_7.csv`.

@@ -4,7 +4,7 @@
 //! (`observation.state`, the bag's joint states): the sim-to-real gap of the whole arm, per joint.
 
 use super::at_rest::{AtRest, REST_BAND};
-use super::{Replayer, inverse_replay, schedule};
+use super::{Replayer, following, inverse_replay, schedule};
 use crate::config::RunConfig;
 use crate::error::Error;
 use crate::experiment::Experiment;
@@ -83,6 +83,10 @@ pub struct ForwardOptions {
     pub trace: Option<PathBuf>,
     /// The motor file's floor left out (a recording whose tool went through it: not its table).
     pub without_floor: bool,
+    /// The joints (the model's coordinates) that do not follow their commands in another episode of
+    /// the recording: taken as off in this one too where its commands do not sweep far enough to
+    /// tell and the real joint stayed put.
+    pub off_elsewhere: Vec<usize>,
 }
 
 /// The longest command latency accepted, s: a teleop loop slower than this is not one.
@@ -113,7 +117,7 @@ impl Latency {
 /// Follow `commands` on the simulated arm from where the real follower starts, and compare with
 /// `observed`.
 pub fn forward(replayer: &Replayer, options: &ForwardOptions, commands: &Episode, observed: &Episode) -> Result<ForwardReplay, Error> {
-    let case = ForwardCase::prepare(replayer, commands, observed, &options.schedule, options.latency.clone())?;
+    let case = ForwardCase::prepare(replayer, commands, observed, &options.schedule, options.latency.clone(), &options.off_elsewhere)?;
     let setup = FollowSetup { payload: options.payload, tool: options.tool.as_deref(), offsets: None, without_floor: options.without_floor };
     let replay = follow(&replayer.base_model, &case, &Drives::File(&options.motors), &setup, options.recordings.as_ref())?;
     if let Some(path) = &options.trace {
@@ -142,8 +146,9 @@ pub struct ForwardCase {
 
 impl ForwardCase {
     /// Map and smooth the episode's commands and observations, and write the schedule the simulated
-    /// servos follow (`latency` after each frame; None: one frame) to `schedule`.
-    pub fn prepare(replayer: &Replayer, commands: &Episode, observed: &Episode, schedule: &Path, latency: Option<Latency>) -> Result<Self, Error> {
+    /// servos follow (`latency` after each frame; None: one frame) to `schedule`; `off_elsewhere`:
+    /// the joints that do not follow in another episode of the recording.
+    pub fn prepare(replayer: &Replayer, commands: &Episode, observed: &Episode, schedule: &Path, latency: Option<Latency>, off_elsewhere: &[usize]) -> Result<Self, Error> {
         let model = &replayer.base_model;
         let mut command = inverse_replay(&replayer.model, &replayer.map.only_columns_of(commands), commands, &replayer.hold)?;
         let reality = inverse_replay(&replayer.model, &replayer.map, observed, &replayer.hold)?;
@@ -166,7 +171,7 @@ impl ForwardCase {
         let held: Vec<usize> = mapped
             .iter()
             .copied()
-            .filter(|&j| matches!((&command.recorded[j], &reality.recorded[j]), (Some(c), Some(o)) if !follows(sweep(c), sweep(o))))
+            .filter(|&j| matches!((&command.recorded[j], &reality.recorded[j]), (Some(c), Some(o)) if !following::follows(following::sweep(c), following::sweep(o), off_elsewhere.contains(&j))))
             .collect();
         for &j in &held {
             command.q[j] = reality.q[j].clone();
@@ -333,7 +338,7 @@ pub fn follow(model: &crate::model::Model, case: &ForwardCase, drives: &Drives, 
         let c: Vec<f64> = command.recorded[j].clone().unwrap_or_default();
         let o: Vec<f64> = reality.recorded[j].clone().unwrap_or_default();
         let s: Vec<f64> = simulated_at.iter().map(|q| q[j] - setup.offset(j)).collect();
-        joints.push(JointGap::of(&model.joints[j].name, &time, &c, &o, &s));
+        joints.push(JointGap::of(&model.joints[j].name, &time, &c, &o, &s, !case.held.contains(&j)));
         commanded.push(c);
         observed.push(o);
         simulated.push(s);
@@ -347,23 +352,9 @@ pub fn follow(model: &crate::model::Model, case: &ForwardCase, drives: &Drives, 
     Ok(ForwardReplay { label: case.label.clone(), time, commanded, observed, simulated, joints, protection_trips, uncommanded, latency: case.latency.clone(), servo_delays })
 }
 
-/// A joint whose commands sweep at least this far (rad, 5°) is expected to move: an STS3215 at
-/// LeRobot's P gain of 16 pushes 5° from its goal with several times its gearbox's static friction,
-/// even at the 0.37 of the catalogue's stiffness found on the weaker real SO-101.
-const SWEEP_EXPECTED: f64 = 0.087;
-/// A joint that moves less than this fraction of its commands' sweep does not follow them (a servo
-/// off, a cable loose): a real follower lags and sags, but covers most of the way.
-const FOLLOWS_FRACTION: f64 = 0.1;
-
-/// Whether a joint that swept `observed_sweep` followed its commands, which swept
-/// `commanded_sweep`, at all.
-fn follows(commanded_sweep: f64, observed_sweep: f64) -> bool {
-    !(commanded_sweep >= SWEEP_EXPECTED && observed_sweep < FOLLOWS_FRACTION * commanded_sweep)
-}
-
 impl JointGap {
     /// The figures of one joint from its commanded, observed and simulated positions at `time`.
-    fn of(joint: &str, time: &[f64], c: &[f64], o: &[f64], s: &[f64]) -> Self {
+    fn of(joint: &str, time: &[f64], c: &[f64], o: &[f64], s: &[f64], follows: bool) -> Self {
         let stats = |a: &[f64], b: &[f64]| -> (f64, f64, usize) {
             let mut worst = (0.0f64, 0usize);
             let mut sum = 0.0;
@@ -380,7 +371,7 @@ impl JointGap {
         let (sim_mae, sim_max, _) = stats(s, c);
         let (gap_mae, gap_max, at) = stats(s, o);
         let parts_at = (0..time.len()).find(|&k| (s[k] - o[k]).abs() > PARTS_ABOVE).map(|k| time[k]);
-        let (commanded_sweep, observed_sweep) = (sweep(c), sweep(o));
+        let (commanded_sweep, observed_sweep) = (following::sweep(c), following::sweep(o));
         JointGap {
             joint: joint.to_string(),
             real_tracking_mae: real_mae,
@@ -391,18 +382,12 @@ impl JointGap {
             gap_max,
             gap_max_at: time[at],
             parts_at,
-            follows: follows(commanded_sweep, observed_sweep),
+            follows,
             commanded_sweep,
             observed_sweep,
             at_rest: AtRest::of(time, c, o, s),
         }
     }
-}
-
-/// How far a series spans, max − min.
-fn sweep(x: &[f64]) -> f64 {
-    let (lo, hi) = x.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| (lo.min(v), hi.max(v)));
-    if hi >= lo { hi - lo } else { 0.0 }
 }
 
 /// The run's joint positions at the control steps nearest the episode's frames (only those: memory

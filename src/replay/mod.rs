@@ -8,12 +8,14 @@
 //! [`tool_height`]).
 
 pub mod at_rest;
+pub mod following;
 pub mod forward;
 pub mod inverse;
 pub mod recording;
 pub mod report;
 pub mod schedule;
 pub mod smoothing;
+pub mod survey;
 pub mod tool_height;
 pub mod trace;
 pub mod verdict;

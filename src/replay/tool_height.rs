@@ -2,13 +2,9 @@
 //! episode, from the positions as recorded — and whether a recording's tool went through a motor
 //! file's floor, which is then not the table that recording's arm stood on.
 
-use super::inverse::mapped_positions;
 use super::{Motion, Replayer};
 use crate::dynamics::{Data, forward_kinematics, frame_pose};
-use crate::error::Error;
 use crate::model::Model;
-use crate::motion::Source;
-use crate::motion::commands::CommandSource;
 use crate::plant::FloorContact;
 
 /// The height of `frame`'s origin at each frame of `motion`, m: its positions as recorded where it
@@ -48,20 +44,20 @@ pub struct Through {
     pub episodes: usize,
 }
 
-/// Whether the follower a forward replay of `episodes` of `source` follows (recorded as `feature`;
-/// a bag's joint states beside `commands`) took its tool (`floor`'s frame) more than
-/// [`THROUGH_FLOOR`] below `floor` (None: never); the episodes read on `jobs` threads.
-pub fn through_floor(replayer: &Replayer, source: &Source, episodes: &[i64], feature: &str, commands: &CommandSource, floor: FloorContact, jobs: usize) -> Result<Option<Through>, Error> {
-    let depths = super::over_episodes(episodes, jobs, |index| {
-        let (_, observed) = source.read_forward(index, feature, commands)?;
-        // the positions as the replay maps them, a joint the map leaves out where the replay holds it
-        // (the smoothing and the torques a replay works out are not needed for the tool's heights)
-        let positions = mapped_positions(&replayer.model, &replayer.map, &observed, &mut Vec::new())?;
-        let position_at = |j: usize, k: usize| positions[j].as_ref().map_or(replayer.hold[j], |p| p[k]);
-        let lowest = heights(&replayer.base_model, floor.frame, observed.time.len(), position_at).into_iter().fold(f64::INFINITY, f64::min);
-        Ok((index, floor.height - lowest))
-    })?;
-    let through: Vec<(i64, f64)> = depths.into_iter().filter(|&(_, depth)| depth > THROUGH_FLOOR).collect();
-    let deepest = through.iter().copied().max_by(|a, b| a.1.total_cmp(&b.1));
-    Ok(deepest.map(|(episode, depth)| Through { episode, depth, episodes: through.len() }))
+/// How far the recorded tool went below `floor` in one episode of `frames` frames, m (negative:
+/// it stayed above), the arm at the episode's mapped `positions` (per coordinate; None: a joint
+/// the map leaves out, at the replay's hold).
+pub fn depth_below(replayer: &Replayer, floor: FloorContact, positions: &[Option<Vec<f64>>], frames: usize) -> f64 {
+    let position_at = |j: usize, k: usize| positions[j].as_ref().map_or(replayer.hold[j], |p| p[k]);
+    let lowest = heights(&replayer.base_model, floor.frame, frames, position_at).into_iter().fold(f64::INFINITY, f64::min);
+    floor.height - lowest
+}
+
+impl Through {
+    /// Of each episode's depth below a floor, those more than [`THROUGH_FLOOR`] (None: none).
+    pub fn deepest(depths: &[(i64, f64)]) -> Option<Self> {
+        let through: Vec<(i64, f64)> = depths.iter().copied().filter(|&(_, depth)| depth > THROUGH_FLOOR).collect();
+        let deepest = through.iter().copied().max_by(|a, b| a.1.total_cmp(&b.1));
+        deepest.map(|(episode, depth)| Self { episode, depth, episodes: through.len() })
+    }
 }
