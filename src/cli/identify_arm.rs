@@ -179,9 +179,18 @@ pub fn identify_arm(args: &IdentifyArgs, dataset: &Path) -> Result<i32, Error> {
     let replayer = Replayer::new(model.clone(), &ReplayOptions { payload: 0.0, tool: arm.tool.clone(), motors: Some(motors.clone()) }, opened.map)?;
     let scratch = tempfile::Builder::new().prefix("armscope-identify-").tempdir().map_err(|e| Error::output(&std::env::temp_dir(), e))?;
     let latency = arm.latency.map(|s| Latency::given(s, "--latency"));
+    let jobs = arm.jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get())).max(1);
+    // a joint off in one episode is taken as off in another that does not sweep it, as replay
+    // --forward takes it
+    let surveyed: Vec<i64> = train.iter().chain(&arm.validate_episodes).copied().collect();
+    let survey = crate::replay::survey::survey(&replayer, &opened.source, &surveyed, &arm.feature, &Default::default(), None, jobs)?;
+    for notice in survey.off.iter().filter_map(|o| o.notice(&model)) {
+        eprintln!("armscope: notice: {notice}");
+    }
+    let off_joints = survey.off_joints();
     let prepare = |index: i64| -> Result<ForwardCase, Error> {
         let (commands, observed) = opened.source.read_forward(index, &arm.feature, &Default::default())?;
-        let case = ForwardCase::prepare(&replayer, &commands, &observed, &scratch.path().join(format!("episode_{index}.csv")), latency.clone(), &[])?;
+        let case = ForwardCase::prepare(&replayer, &commands, &observed, &scratch.path().join(format!("episode_{index}.csv")), latency.clone(), &off_joints)?;
         if case.duration() < SHORTEST_EPISODE {
             return Err(Error::flag(commands.label.clone(), format!("{:.2} s long: too short to identify from (at least {SHORTEST_EPISODE} s of motion)", case.duration())));
         }
@@ -280,7 +289,6 @@ pub fn identify_arm(args: &IdentifyArgs, dataset: &Path) -> Result<i32, Error> {
     }
     let search_cases: Vec<ForwardCase> = chosen.iter().map(|&i| train_cases[i].clone()).collect();
     let objective = ArmObjective { model: &model, motor_file: motors, tool: arm.tool.as_deref(), space: &space, cases: &search_cases, fitted: is_fitted.clone(), floor };
-    let jobs = arm.jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get())).max(1);
     let options = ArmFitOptions { population: args.population, generations, seed: args.seed, jobs, ..ArmFitOptions::default() };
     let bar = super::identify::generations_bar(generations as u64, args.quiet);
     let progress = |generation: usize, best: f64| {

@@ -163,15 +163,8 @@ fn forward(args: &ReplayArgs, replayer: &Replayer, source: &crate::motion::Sourc
     // was another, and the recording is replayed without it
     let floor = replayer.motors.as_ref().and_then(|m| m.floor);
     let survey = crate::replay::survey::survey(replayer, source, episodes, &args.recorded.feature, &commands, floor, jobs)?;
-    for off in survey.off.iter().filter(|o| !o.taken_off_in.is_empty()) {
-        eprintln!(
-            "armscope: notice: {} does not follow its commands in {}; in {} its commands sweep less than {:.0}° and it stayed within {:.1}°: taken as not following there too (held where the real one was, left out of the ranking)",
-            replayer.base_model.joints[off.joint].name,
-            episode_list(&off.off_in),
-            episode_list(&off.taken_off_in),
-            crate::replay::following::SWEEP_EXPECTED.to_degrees(),
-            (crate::replay::following::FOLLOWS_FRACTION * crate::replay::following::SWEEP_EXPECTED).to_degrees()
-        );
+    for notice in survey.off.iter().filter_map(|o| o.notice(&replayer.base_model)) {
+        eprintln!("armscope: notice: {notice}");
     }
     let off_joints = survey.off_joints();
     let mut without_floor = false;
@@ -264,18 +257,6 @@ fn forward(args: &ReplayArgs, replayer: &Replayer, source: &crate::motion::Sourc
 /// The one-line error when no joint map is known for a recording (its template printed above it).
 pub fn needs_map(source: &std::path::Path, urdf: &std::path::Path) -> Error {
     Error::flag("--joint-map", format!("needed: armscope knows no map from {}'s columns to {}'s joints; a template is printed above", source.display(), urdf.display()))
-}
-
-/// "episode 3", "episodes 3, 5 and 7", "episodes 3, 5, 7, 9, 11, 13 and 20 more".
-fn episode_list(episodes: &[i64]) -> String {
-    const NAMED: usize = 6;
-    let named: Vec<String> = episodes.iter().take(NAMED).map(|e| e.to_string()).collect();
-    match episodes.len() {
-        0 => "no episode".into(),
-        1 => format!("episode {}", named[0]),
-        n if n <= NAMED => format!("episodes {} and {}", named[..n - 1].join(", "), named[n - 1]),
-        n => format!("episodes {} and {} more", named.join(", "), n - NAMED),
-    }
 }
 
 /// `trace.csv` → `trace_episode_7.csv`.

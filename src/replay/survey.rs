@@ -29,6 +29,36 @@ pub struct Survey {
     pub through_floor: Option<Through>,
 }
 
+impl OffJoint {
+    /// The one notice of the episodes where the joint is taken as off without their telling (None:
+    /// none).
+    pub fn notice(&self, model: &crate::model::Model) -> Option<String> {
+        if self.taken_off_in.is_empty() {
+            return None;
+        }
+        Some(format!(
+            "{} does not follow its commands in {}; in {} its commands sweep less than {:.0}° and it stayed within {:.1}°: taken as not following there too (held where the real one was, left out of the ranking)",
+            model.joints[self.joint].name,
+            episode_list(&self.off_in),
+            episode_list(&self.taken_off_in),
+            following::SWEEP_EXPECTED.to_degrees(),
+            (following::FOLLOWS_FRACTION * following::SWEEP_EXPECTED).to_degrees()
+        ))
+    }
+}
+
+/// "episode 3", "episodes 3, 5 and 7", "episodes 3, 5, 7, 9, 11, 13 and 20 more".
+fn episode_list(episodes: &[i64]) -> String {
+    const NAMED: usize = 6;
+    let named: Vec<String> = episodes.iter().take(NAMED).map(|e| e.to_string()).collect();
+    match episodes.len() {
+        0 => "no episode".into(),
+        1 => format!("episode {}", named[0]),
+        n if n <= NAMED => format!("episodes {} and {}", named[..n - 1].join(", "), named[n - 1]),
+        n => format!("episodes {} and {} more", named.join(", "), n - NAMED),
+    }
+}
+
 impl Survey {
     /// The joints that do not follow their commands in at least one episode.
     pub fn off_joints(&self) -> Vec<usize> {
