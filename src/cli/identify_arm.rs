@@ -183,7 +183,7 @@ pub fn identify_arm(args: &IdentifyArgs, dataset: &Path) -> Result<i32, Error> {
     // a joint off in one episode is taken as off in another that does not sweep it, as replay
     // --forward takes it
     let surveyed: Vec<i64> = train.iter().chain(&arm.validate_episodes).copied().collect();
-    let survey = crate::replay::survey::survey(&replayer, &opened.source, &surveyed, &arm.feature, &Default::default(), None, jobs)?;
+    let survey = if surveyed.len() > 1 { crate::replay::survey::survey(&replayer, &opened.source, &surveyed, &arm.feature, &Default::default(), None, jobs)? } else { Default::default() };
     for notice in survey.off.iter().filter_map(|o| o.notice(&model)) {
         eprintln!("armscope: notice: {notice}");
     }

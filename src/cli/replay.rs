@@ -162,7 +162,8 @@ fn forward(args: &ReplayArgs, replayer: &Replayer, source: &crate::motion::Sourc
     // whether the real tool went through the motor file's floor — then the table its arm stood on
     // was another, and the recording is replayed without it
     let floor = replayer.motors.as_ref().and_then(|m| m.floor);
-    let survey = crate::replay::survey::survey(replayer, source, episodes, &args.recorded.feature, &commands, floor, jobs)?;
+    // (a lone episode without a floor has nothing to survey: a bag is read once)
+    let survey = if episodes.len() > 1 || floor.is_some() { crate::replay::survey::survey(replayer, source, episodes, &args.recorded.feature, &commands, floor, jobs)? } else { Default::default() };
     for notice in survey.off.iter().filter_map(|o| o.notice(&replayer.base_model)) {
         eprintln!("armscope: notice: {notice}");
     }
