@@ -38,11 +38,67 @@ pub fn sweeps(commanded: &[Option<Vec<f64>>], observed: &[Option<Vec<f64>>]) -> 
     commanded.iter().zip(observed).map(|(c, o)| Some((sweep(c.as_ref()?), sweep(o.as_ref()?)))).collect()
 }
 
-/// The coordinates that do not follow their commands in at least one of a recording's episodes,
-/// each episode given by its [`sweeps`].
-pub fn off_somewhere(episodes: &[Vec<Option<(f64, f64)>>]) -> Vec<usize> {
-    let n = episodes.iter().map(Vec::len).max().unwrap_or(0);
-    (0..n).filter(|&j| episodes.iter().any(|e| matches!(e.get(j), Some(Some((c, o))) if !follows(*c, *o, false)))).collect()
+/// A joint that does not follow its commands in some of a recording's episodes.
+#[derive(Clone, Debug, PartialEq)]
+pub struct OffJoint {
+    /// The model's coordinate.
+    pub joint: usize,
+    /// The episodes where it does not follow its commands (they swept at least 5°).
+    pub off_in: Vec<i64>,
+    /// The episodes where its commands swept less and it stayed put: taken as off there too.
+    pub taken_off_in: Vec<i64>,
+}
+
+/// The joints that do not follow their commands in at least one of a recording's episodes, each
+/// episode given by its index and its [`sweeps`].
+pub fn off_joints(episodes: &[(i64, Vec<Option<(f64, f64)>>)]) -> Vec<OffJoint> {
+    let n = episodes.iter().map(|(_, s)| s.len()).max().unwrap_or(0);
+    (0..n)
+        .filter_map(|joint| {
+            let (mut off_in, mut taken_off_in) = (Vec::new(), Vec::new());
+            for (index, sweeps) in episodes {
+                if let Some(Some((c, o))) = sweeps.get(joint) {
+                    if !follows(*c, *o, false) {
+                        off_in.push(*index);
+                    } else if !follows(*c, *o, true) {
+                        taken_off_in.push(*index);
+                    }
+                }
+            }
+            // taken as off only where another episode shows it off
+            (!off_in.is_empty()).then_some(OffJoint { joint, off_in, taken_off_in })
+        })
+        .collect()
+}
+
+impl OffJoint {
+    /// The one notice of the episodes where the joint is taken as off without their telling (None:
+    /// none).
+    pub fn notice(&self, model: &crate::model::Model) -> Option<String> {
+        if self.taken_off_in.is_empty() {
+            return None;
+        }
+        Some(format!(
+            "{} does not follow its commands in {}; in {} its commands sweep less than {:.0}° and it stayed within {:.1}°: taken as not following there too (held where the real one was, left out of the ranking)",
+            model.joints[self.joint].name,
+            episode_list(&self.off_in),
+            episode_list(&self.taken_off_in),
+            SWEEP_EXPECTED.to_degrees(),
+            STAYED_PUT.to_degrees()
+        ))
+    }
+}
+
+/// "episode 3", "episodes 3, 5 and 7", "episodes 3, 5, 7, 9, 11, 13 and 20 more".
+fn episode_list(episodes: &[i64]) -> String {
+    const NAMED: usize = 6;
+    let named: Vec<String> = episodes.iter().take(NAMED).map(|e| e.to_string()).collect();
+    match episodes.len() {
+        0 => "no episode".into(),
+        1 => format!("episode {}", named[0]),
+        n if n <= NAMED => format!("episodes {} and {}", named[..n - 1].join(", "), named[n - 1]),
+        n => format!("episodes {} and {} more", named.join(", "), n - NAMED),
+    }
 }
 
 #[cfg(test)]
@@ -60,7 +116,7 @@ mod tests {
         assert!(follows(0.05, 0.01, true));
         // tested and following: off elsewhere does not matter (the cable put back)
         assert!(follows(0.5, 0.4, true));
-        let episodes = vec![vec![Some((0.5, 0.4)), Some((0.5, 0.0)), None], vec![Some((0.5, 0.45)), Some((0.02, 0.0)), Some((1.0, 0.9))]];
-        assert_eq!(off_somewhere(&episodes), vec![1]);
+        let episodes = vec![(0, vec![Some((0.5, 0.4)), Some((0.5, 0.0)), None]), (1, vec![Some((0.5, 0.45)), Some((0.02, 0.0)), Some((1.0, 0.9))])];
+        assert_eq!(off_joints(&episodes), vec![OffJoint { joint: 1, off_in: vec![0], taken_off_in: vec![1] }]);
     }
 }

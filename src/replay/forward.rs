@@ -168,11 +168,8 @@ impl ForwardCase {
         // a joint whose real follower stayed put while its commands swept (a servo off, a cable
         // loose) is sent where the real joint was, as one no command names: the joints beside it then
         // carry it where the real arm did (it is still held against its commands, as not following)
-        let held: Vec<usize> = mapped
-            .iter()
-            .copied()
-            .filter(|&j| matches!((&command.recorded[j], &reality.recorded[j]), (Some(c), Some(o)) if !following::follows(following::sweep(c), following::sweep(o), off_elsewhere.contains(&j))))
-            .collect();
+        let sweeps = following::sweeps(&command.recorded, &reality.recorded);
+        let held: Vec<usize> = mapped.iter().copied().filter(|&j| matches!(sweeps[j], Some((c, o)) if !following::follows(c, o, off_elsewhere.contains(&j)))).collect();
         for &j in &held {
             command.q[j] = reality.q[j].clone();
         }

@@ -2,24 +2,14 @@
 //! positions, as the replay maps them, read once for the joints that do not follow their commands
 //! in some episode and for how far the real tool went below a motor file's floor.
 
+use super::Replayer;
+use super::following::{self, OffJoint};
 use super::inverse::mapped_positions;
 use super::tool_height::{Through, depth_below};
-use super::{Replayer, following};
 use crate::error::Error;
 use crate::motion::Source;
 use crate::motion::commands::CommandSource;
 use crate::plant::FloorContact;
-
-/// A joint that does not follow its commands in some of a recording's episodes.
-#[derive(Clone, Debug, PartialEq)]
-pub struct OffJoint {
-    /// The model's coordinate.
-    pub joint: usize,
-    /// The episodes where it does not follow its commands (they swept at least 5°).
-    pub off_in: Vec<i64>,
-    /// The episodes where its commands swept less and it stayed put: taken as off there too.
-    pub taken_off_in: Vec<i64>,
-}
 
 /// A recording surveyed.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -27,36 +17,6 @@ pub struct Survey {
     pub off: Vec<OffJoint>,
     /// Where the real tool went through the floor asked about (None: nowhere, or no floor asked).
     pub through_floor: Option<Through>,
-}
-
-impl OffJoint {
-    /// The one notice of the episodes where the joint is taken as off without their telling (None:
-    /// none).
-    pub fn notice(&self, model: &crate::model::Model) -> Option<String> {
-        if self.taken_off_in.is_empty() {
-            return None;
-        }
-        Some(format!(
-            "{} does not follow its commands in {}; in {} its commands sweep less than {:.0}° and it stayed within {:.1}°: taken as not following there too (held where the real one was, left out of the ranking)",
-            model.joints[self.joint].name,
-            episode_list(&self.off_in),
-            episode_list(&self.taken_off_in),
-            following::SWEEP_EXPECTED.to_degrees(),
-            (following::FOLLOWS_FRACTION * following::SWEEP_EXPECTED).to_degrees()
-        ))
-    }
-}
-
-/// "episode 3", "episodes 3, 5 and 7", "episodes 3, 5, 7, 9, 11, 13 and 20 more".
-fn episode_list(episodes: &[i64]) -> String {
-    const NAMED: usize = 6;
-    let named: Vec<String> = episodes.iter().take(NAMED).map(|e| e.to_string()).collect();
-    match episodes.len() {
-        0 => "no episode".into(),
-        1 => format!("episode {}", named[0]),
-        n if n <= NAMED => format!("episodes {} and {}", named[..n - 1].join(", "), named[n - 1]),
-        n => format!("episodes {} and {} more", named.join(", "), n - NAMED),
-    }
 }
 
 impl Survey {
@@ -78,23 +38,10 @@ pub fn survey(replayer: &Replayer, source: &Source, episodes: &[i64], feature: &
         let depth = floor.map(|f| depth_below(replayer, f, &observed_at, observed.time.len()));
         Ok((index, following::sweeps(&commanded_at, &observed_at), depth))
     })?;
-    let sweeps: Vec<_> = surveyed.iter().map(|(_, s, _)| s.clone()).collect();
-    let off = following::off_somewhere(&sweeps)
-        .into_iter()
-        .map(|joint| {
-            let (mut off_in, mut taken_off_in) = (Vec::new(), Vec::new());
-            for (index, sweeps, _) in &surveyed {
-                if let Some(Some((c, o))) = sweeps.get(joint) {
-                    if !following::follows(*c, *o, false) {
-                        off_in.push(*index);
-                    } else if !following::follows(*c, *o, true) {
-                        taken_off_in.push(*index);
-                    }
-                }
-            }
-            OffJoint { joint, off_in, taken_off_in }
-        })
-        .collect();
-    let depths: Vec<(i64, f64)> = surveyed.iter().filter_map(|&(index, _, depth)| Some((index, depth?))).collect();
-    Ok(Survey { off, through_floor: Through::deepest(&depths) })
+    let (mut sweeps, mut depths) = (Vec::new(), Vec::new());
+    for (index, episode_sweeps, depth) in surveyed {
+        sweeps.push((index, episode_sweeps));
+        depths.extend(depth.map(|d| (index, d)));
+    }
+    Ok(Survey { off: following::off_joints(&sweeps), through_floor: Through::deepest(&depths) })
 }
