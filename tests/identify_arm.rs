@@ -204,6 +204,13 @@ fn a_simulated_so101_is_identified_back_and_its_held_out_episode_predicted() {
     let against = doc["servos"][0]["against_start"]["holding_stiffness"].as_f64().unwrap();
     assert!((against - stiffness(fitted) / (start.kt * start.error_gain_ratio)).abs() < 1e-12, "holding stiffness ×{against}");
     assert!(stdout.contains(&format!("holding stiffness ×{against:.2}")) && !stdout.contains("the real servos hold"), "{stdout}");
+    // and says the supply on which the catalogue's STS3215s hold as stiff: the 12 V C018 itself on
+    // ×against of its 12 V (the same servo, the stiffness linear in the supply)
+    let on = doc["servos"][0]["as_stiff_on"].as_array().unwrap();
+    let c018 = on.iter().find(|s| s["servo"] == "STS3215-C018").unwrap()["supply_v"].as_f64().unwrap();
+    assert!((c018 - 12.0 * against).abs() < 1e-9, "{on:?}");
+    assert!(on.iter().any(|s| s["servo"] == "STS3215-C001"), "{on:?}");
+    assert!(stdout.contains(&format!("STS3215-C018 on {c018:.1} V")), "{stdout}");
     // the payload within 40 g of 150 (measured 129): on swings of ±0.4 rad it trades with the
     // loop's stiffness (a lighter payload on a softer loop sags the same)
     let payload = doc["payload_kg"].as_f64().unwrap();

@@ -692,6 +692,30 @@ fn floor_contact(t: &toml::Table, path: &Path, model: &Model) -> Result<crate::p
     Ok(crate::plant::FloorContact { frame, height })
 }
 
+/// The catalogue the motor file (`table`, read from `path`) draws on: the built-in one or its own
+/// `catalogue` file on top of it, and the motors the file defines itself.
+fn catalogue_of(path: &Path, table: &toml::Table) -> Result<Catalogue, Error> {
+    let mut catalogue = match table.get("catalogue") {
+        Some(Value::String(file)) => Catalogue::with_user_file(&path.parent().unwrap_or(Path::new(".")).join(file))?,
+        Some(_) => return Err(fail(path, "field 'catalogue' must be a file name".into())),
+        None => Catalogue::load(Path::new(DEFAULT_CATALOGUE))?,
+    };
+    // motors defined in the file itself
+    if let Some(motors) = table.get("motors") {
+        let text = toml::to_string(motors).unwrap_or_default();
+        let own = Catalogue::parse(&text, path)?;
+        catalogue.extend(own);
+    }
+    Ok(catalogue)
+}
+
+/// The catalogue the motor file at `path` draws on (see [`load_motor_file`]).
+pub fn motor_file_catalogue(path: &Path) -> Result<Catalogue, Error> {
+    let text = crate::builtin::read_to_string(path).map_err(|e| fail(path, format!("cannot read: {e}")))?;
+    let table: toml::Table = text.parse().map_err(|e: toml::de::Error| fail(path, e.message().to_string()))?;
+    catalogue_of(path, &table)
+}
+
 /// A motor file for `model`: the drive train of each joint it names (the others keep the URDF's
 /// constant effort limit).
 pub fn load_motor_file(path: &Path, model: &Model) -> Result<MotorSet, Error> {
@@ -705,17 +729,7 @@ pub fn load_motor_file(path: &Path, model: &Model) -> Result<MotorSet, Error> {
         Some(Value::Boolean(b)) => *b,
         Some(_) => return Err(fail(path, "field 'in_urdf' must be true or false".into())),
     };
-    let mut catalogue = match table.get("catalogue") {
-        Some(Value::String(file)) => Catalogue::with_user_file(&path.parent().unwrap_or(Path::new(".")).join(file))?,
-        Some(_) => return Err(fail(path, "field 'catalogue' must be a file name".into())),
-        None => Catalogue::load(Path::new(DEFAULT_CATALOGUE))?,
-    };
-    // motors defined in the file itself
-    if let Some(motors) = table.get("motors") {
-        let text = toml::to_string(motors).unwrap_or_default();
-        let own = Catalogue::parse(&text, path)?;
-        catalogue.extend(own);
-    }
+    let catalogue = catalogue_of(path, &table)?;
     let joints = match table.get("joints") {
         Some(Value::Table(t)) => t,
         _ => return Err(fail(path, "no [joints.NAME] tables".into())),

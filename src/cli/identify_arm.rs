@@ -250,6 +250,12 @@ pub fn identify_arm(args: &IdentifyArgs, dataset: &Path) -> Result<i32, Error> {
         None => crate::identify::arm::ARM_KEYS.to_vec(),
     };
     let joint_names: Vec<String> = model.joints.iter().map(|j| j.name.clone()).collect();
+    let catalogue = crate::actuator::catalogue::motor_file_catalogue(motors)?;
+    // the supply on which each of the catalogue's servos of the kind's family holds as stiff
+    let as_stiff_on = |kind: &crate::identify::arm::ServoKind, stiffness: f64| match start_set.joints[kind.joints[0]].as_ref().and_then(|d| d.servo.as_ref()) {
+        Some(servo) => crate::identify::equivalent_supply::equivalent_supplies(&catalogue, &servo.name, servo.supply, stiffness),
+        None => Vec::new(),
+    };
     let space = ArmSpace::new(&start_set, &fitted, &keys, arm.fit_payload.then_some(arm.payload_max), arm.fit_offsets, arm.per_joint.then_some(joint_names.as_slice()));
     // the table the real tool rested on, where the episodes show one
     // (the replayer's model has --tool's frame, checked when it was built)
@@ -339,6 +345,10 @@ pub fn identify_arm(args: &IdentifyArgs, dataset: &Path) -> Result<i32, Error> {
                 strength.stall_torque,
                 strength.verdict().map_or(String::new(), |v| format!(": {v}"))
             );
+            let supplies = as_stiff_on(kind, strength.holding_stiffness);
+            if !supplies.is_empty() {
+                println!("    that stiffness from the catalogue's servos at the same firmware gain (by their datasheets' stall torque per volt): {}", crate::identify::equivalent_supply::text(&supplies));
+            }
         }
         if arm.fit_payload {
             println!("  payload {:.3} kg", found.payload);
@@ -359,7 +369,7 @@ pub fn identify_arm(args: &IdentifyArgs, dataset: &Path) -> Result<i32, Error> {
         println!("wrote {} ({})", args.out.display(), servo_files.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", "));
     }
     if let Some(path) = &args.summary_json {
-        let kinds: Vec<serde_json::Value> = space.kinds.iter().zip(&found.params).map(|(k, p)| serde_json::json!({ "servo": k.name, "joints": k.joints.iter().map(|&j| name(j)).collect::<Vec<_>>(), "params": p.to_json(), "against_start": crate::identify::arm::Strength::of(p, &k.start) })).collect();
+        let kinds: Vec<serde_json::Value> = space.kinds.iter().zip(&found.params).map(|(k, p)| serde_json::json!({ "servo": k.name, "joints": k.joints.iter().map(|&j| name(j)).collect::<Vec<_>>(), "params": p.to_json(), "against_start": crate::identify::arm::Strength::of(p, &k.start), "as_stiff_on": as_stiff_on(k, crate::identify::arm::Strength::of(p, &k.start).holding_stiffness) })).collect();
         let documents = |replays: &[ForwardReplay], episodes: &[i64]| -> Vec<serde_json::Value> { replays.iter().zip(episodes).map(|(r, &e)| ForwardSummary::of(e, r, Vec::new()).document).collect() };
         let doc = serde_json::json!({
             "from": dataset.display().to_string(),
