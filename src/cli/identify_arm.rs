@@ -369,7 +369,11 @@ pub fn identify_arm(args: &IdentifyArgs, dataset: &Path) -> Result<i32, Error> {
         println!("wrote {} ({})", args.out.display(), servo_files.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", "));
     }
     if let Some(path) = &args.summary_json {
-        let kinds: Vec<serde_json::Value> = space.kinds.iter().zip(&found.params).map(|(k, p)| serde_json::json!({ "servo": k.name, "joints": k.joints.iter().map(|&j| name(j)).collect::<Vec<_>>(), "params": p.to_json(), "against_start": crate::identify::arm::Strength::of(p, &k.start), "as_stiff_on": as_stiff_on(k, crate::identify::arm::Strength::of(p, &k.start).holding_stiffness) })).collect();
+        let kinds: Vec<serde_json::Value> = space.kinds.iter().zip(&found.params).map(|(k, p)| {
+                let strength = crate::identify::arm::Strength::of(p, &k.start);
+                serde_json::json!({ "servo": k.name, "joints": k.joints.iter().map(|&j| name(j)).collect::<Vec<_>>(), "params": p.to_json(), "against_start": strength, "as_stiff_on": as_stiff_on(k, strength.holding_stiffness) })
+            })
+            .collect();
         let documents = |replays: &[ForwardReplay], episodes: &[i64]| -> Vec<serde_json::Value> { replays.iter().zip(episodes).map(|(r, &e)| ForwardSummary::of(e, r, Vec::new()).document).collect() };
         let doc = serde_json::json!({
             "from": dataset.display().to_string(),
