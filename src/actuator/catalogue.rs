@@ -213,13 +213,18 @@ impl Catalogue {
 
     /// The motor's mass in kg, if the catalogue gives it.
     pub fn mass(&self, name: &str) -> Option<f64> {
-        self.entries.get(name)?.get("mass").and_then(|v| v.as_float().or(v.as_integer().map(|i| i as f64)))
+        number(self.entries.get(name)?, "mass")
     }
 
     /// The catalogue's motor names, for messages.
     pub fn names(&self) -> String {
         self.entries.keys().cloned().collect::<Vec<_>>().join(", ")
     }
+}
+
+/// An entry's number `field` (a float or an integer), unchecked: None where it has none.
+pub(crate) fn number(t: &toml::Table, field: &str) -> Option<f64> {
+    t.get(field).and_then(|v| v.as_float().or(v.as_integer().map(|i| i as f64)))
 }
 
 /// A catalogue entry as a motor behind its own gearbox; errors name `source`, the motor and the field.

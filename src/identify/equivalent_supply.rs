@@ -6,6 +6,7 @@
 //! V_B = s·V_A·(τ_A/V_A,rated)/(τ_B/V_B,rated).
 
 use crate::actuator::Catalogue;
+use crate::actuator::catalogue::number;
 
 /// One catalogue servo and the supply on which it would hold as the fitted servo does, V.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
@@ -21,8 +22,7 @@ fn torque_per_volt(entry: &toml::Table) -> Option<(&str, f64)> {
         return None;
     }
     let family = entry.get("firmware")?.as_table()?.get("family")?.as_str()?;
-    let number = |key: &str| entry.get(key).and_then(|v| v.as_float().or(v.as_integer().map(|i| i as f64)));
-    let (stall, volts) = (number("stall_torque")?, number("voltage")?);
+    let (stall, volts) = (number(entry, "stall_torque")?, number(entry, "voltage")?);
     (stall > 0.0 && volts > 0.0).then_some((family, stall / volts))
 }
 

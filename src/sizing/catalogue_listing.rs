@@ -2,6 +2,7 @@
 //! read, and what each entry lacks and what that means for sizing.
 
 use crate::actuator::Catalogue;
+use crate::actuator::catalogue::number;
 use serde::Serialize;
 use toml::Value;
 
@@ -43,10 +44,6 @@ pub struct Listing {
     pub file: String,
     pub motors: Vec<MotorRow>,
     pub reductions: Vec<ReductionRow>,
-}
-
-fn number(t: &toml::Table, field: &str) -> Option<f64> {
-    t.get(field).and_then(|v| v.as_float().or(v.as_integer().map(|i| i as f64)))
 }
 
 impl Catalogue {
