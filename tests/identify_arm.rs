@@ -88,7 +88,7 @@ fn a_followers_command_delay_is_identified_to_within_a_control_step() {
     let (out, summary) = (dir.path().join("fit.toml"), dir.path().join("fit.json"));
     let (code, _, stderr) = identify(&[
         "--from", root.to_str().unwrap(), "--urdf", so101().to_str().unwrap(), "--motors", common::follower::so101_motors().to_str().unwrap(), "--units", "degrees",
-        "--fit-params", "command_delay", "--out", out.to_str().unwrap(), "--summary-json", summary.to_str().unwrap(), "--quiet",
+        "--fit-params", "command_delay", "--payload", "0", "--out", out.to_str().unwrap(), "--summary-json", summary.to_str().unwrap(), "--quiet",
     ]);
     assert_eq!(code, 0, "{stderr}");
     let doc = read_json(&summary);
@@ -134,7 +134,7 @@ fn a_follower_resting_on_a_table_has_the_table_found_and_followed() {
     let (urdf, motors) = (so101(), common::follower::so101_motors());
     let fit = |name: &str, extra: &[&str]| {
         let (out, summary) = (dir.path().join(format!("{name}.toml")), dir.path().join(format!("{name}.json")));
-        let mut args = vec!["--from", root.to_str().unwrap(), "--urdf", urdf.to_str().unwrap(), "--motors", motors.to_str().unwrap(), "--units", "degrees", "--fit-params", "command_delay", "--out", out.to_str().unwrap(), "--summary-json", summary.to_str().unwrap(), "--quiet"];
+        let mut args = vec!["--from", root.to_str().unwrap(), "--urdf", urdf.to_str().unwrap(), "--motors", motors.to_str().unwrap(), "--units", "degrees", "--fit-params", "command_delay", "--payload", "0", "--out", out.to_str().unwrap(), "--summary-json", summary.to_str().unwrap(), "--quiet"];
         args.extend_from_slice(extra);
         let (code, _, stderr) = identify(&args);
         assert_eq!(code, 0, "{stderr}");
@@ -177,7 +177,7 @@ fn a_simulated_so101_is_identified_back_and_its_held_out_episode_predicted() {
     let (out, summary) = (dir.path().join("fit.toml"), dir.path().join("fit.json"));
     let (code, stdout, stderr) = identify(&[
         "--from", root.to_str().unwrap(), "--urdf", so101().to_str().unwrap(), "--motors", common::follower::so101_motors().to_str().unwrap(), "--units", "degrees",
-        "--validate-episodes", "2", "--fit-payload", "--generations", "150", "--out", out.to_str().unwrap(), "--summary-json", summary.to_str().unwrap(),
+        "--validate-episodes", "2", "--generations", "150", "--out", out.to_str().unwrap(), "--summary-json", summary.to_str().unwrap(),
     ]);
     assert_eq!(code, 0, "{stderr}");
     let doc = read_json(&summary);
@@ -242,7 +242,7 @@ fn per_joint_finds_the_one_servo_that_differs_from_the_others() {
         let (out, summary) = (dir.path().join(format!("fit{per_joint}.toml")), dir.path().join(format!("fit{per_joint}.json")));
         let mut args = vec![
             "--from", root.to_str().unwrap(), "--urdf", urdf.to_str().unwrap(), "--motors", start.to_str().unwrap(), "--units", "degrees",
-            "--fit-params", "kt", "--validate-episodes", "2", "--generations", "40", "--out", out.to_str().unwrap(), "--summary-json", summary.to_str().unwrap(), "--quiet",
+            "--fit-params", "kt", "--payload", "0", "--validate-episodes", "2", "--generations", "40", "--out", out.to_str().unwrap(), "--summary-json", summary.to_str().unwrap(), "--quiet",
         ];
         if per_joint {
             args.push("--per-joint");

@@ -40,14 +40,12 @@ pub struct ArmArgs {
     /// With --from: the follower's LeRobot calibration file (see `replay --calibration`).
     #[arg(long, value_name = "FILE", requires = "from")]
     pub calibration: Option<PathBuf>,
-    /// With --from: a payload known to be at the tool, kg.
-    #[arg(long, default_value_t = 0.0)]
-    pub payload: f64,
-    /// With --from: fit the payload at the tool too (0 to --payload-max kg).
-    #[arg(long, requires = "from", conflicts_with = "payload")]
-    pub fit_payload: bool,
-    /// With --fit-payload: the heaviest payload searched, kg.
-    #[arg(long, default_value_t = 0.5, requires = "fit_payload")]
+    /// With --from: the payload known to be at the tool, kg (0: none); by default it is fitted (0 to
+    /// --payload-max kg).
+    #[arg(long, value_name = "KG", requires = "from")]
+    pub payload: Option<f64>,
+    /// With --from: the heaviest payload searched, kg.
+    #[arg(long, value_name = "KG", default_value_t = 0.5, conflicts_with = "payload")]
     pub payload_max: f64,
     /// With --from: the servo parameters fitted, by BAM's names (default: kt, error_gain_ratio,
     /// armature, friction_base, friction_viscous, command_delay; the load-dependent frictions stay
@@ -88,6 +86,15 @@ const SHORTEST_EPISODE: f64 = 2.0;
 /// Default of `--generations` with --from.
 const GENERATIONS: usize = 60;
 
+/// Searches run when the payload is fitted, each from the motor file's parameters with its own
+/// seed. A load at the tool trades against the servos' holding stiffness along a ridge an arm's
+/// episodes leave nearly flat: on the real SO-101's two shared episodes, seven seeds ended between
+/// no payload at ×0.37 the catalogue's stiffness and 75 g at ×0.52, their gaps within 0.22 mrad of
+/// each other (the readings' own error there: 0.38 mrad), and one search lands on either end. Of
+/// three, the one nearest the catalogue's servo is kept (`fit_arm`); three searches take three
+/// times one's time (12 s each on those 25 s of episodes, on two cores).
+const SEARCHES_WITH_PAYLOAD: usize = 3;
+
 /// The motion the search runs on at most, s: whole episodes, spread over the training ones, up to
 /// this long (the fit's cost grows with the motion each candidate replays: 30 s take ~35 s on two
 /// cores; the fit is then reported on every training episode).
@@ -124,9 +131,10 @@ pub fn identify_arm(args: &IdentifyArgs, dataset: &Path) -> Result<i32, Error> {
     let arm = &args.arm;
     let urdf = arm.urdf.as_ref().ok_or_else(|| Error::flag("--from", "needs --urdf: the arm's URDF"))?;
     let motors = arm.motors.as_ref().ok_or_else(|| Error::flag("--from", "needs --motors: the motor file to start from"))?;
-    if !(arm.payload.is_finite() && arm.payload >= 0.0) {
+    if arm.payload.is_some_and(|m| !(m.is_finite() && m >= 0.0)) {
         return Err(Error::flag("--payload", "must be a mass of 0 kg or more"));
     }
+    let fit_payload = arm.payload.is_none();
     if !(arm.payload_max.is_finite() && arm.payload_max > 0.0) {
         return Err(Error::flag("--payload-max", "must be a positive mass, kg"));
     }
@@ -256,7 +264,7 @@ pub fn identify_arm(args: &IdentifyArgs, dataset: &Path) -> Result<i32, Error> {
         Some(servo) => crate::identify::equivalent_supply::equivalent_supplies(&catalogue, &servo.name, servo.supply, stiffness),
         None => Vec::new(),
     };
-    let space = ArmSpace::new(&start_set, &fitted, &keys, arm.fit_payload.then_some(arm.payload_max), arm.fit_offsets, arm.per_joint.then_some(joint_names.as_slice()));
+    let space = ArmSpace::new(&start_set, &fitted, &keys, fit_payload.then_some(arm.payload_max), arm.fit_offsets, arm.per_joint.then_some(joint_names.as_slice()));
     // the table the real tool rested on, where the episodes show one
     // (the replayer's model has --tool's frame, checked when it was built)
     let tool_frame = replayer.model.tool_frame;
@@ -294,9 +302,17 @@ pub fn identify_arm(args: &IdentifyArgs, dataset: &Path) -> Result<i32, Error> {
         );
     }
     let search_cases: Vec<ForwardCase> = chosen.iter().map(|&i| train_cases[i].clone()).collect();
-    let objective = ArmObjective { model: &model, motor_file: motors, tool: arm.tool.as_deref(), space: &space, cases: &search_cases, fitted: is_fitted.clone(), floor };
-    let options = ArmFitOptions { population: args.population, generations, seed: args.seed, jobs, ..ArmFitOptions::default() };
-    let bar = super::identify::generations_bar(generations as u64, args.quiet);
+    let objective = ArmObjective { model: &model, motor_file: motors, tool: arm.tool.as_deref(), known_payload: arm.payload.unwrap_or(0.0), space: &space, cases: &search_cases, fitted: is_fitted.clone(), floor };
+    let searches = if fit_payload { SEARCHES_WITH_PAYLOAD } else { 1 };
+    let reading_error = crate::identify::arm::reading_error(&search_cases, &is_fitted);
+    let options = ArmFitOptions { population: args.population, generations, seed: args.seed, searches, indistinct: reading_error, jobs, ..ArmFitOptions::default() };
+    if fit_payload {
+        eprintln!(
+            "armscope: notice: the payload at the tool is fitted too (0 to {} kg; --payload KG for a known one), in {searches} searches: the one nearest the motor file's servos is kept of those whose gaps the recording cannot tell apart",
+            arm.payload_max
+        );
+    }
+    let bar = super::identify::generations_bar((searches * generations) as u64, args.quiet);
     let progress = |generation: usize, best: f64| {
         bar.set_position(generation as u64);
         bar.set_message(format!("best {:.2} mrad", 1e3 * best));
@@ -307,7 +323,7 @@ pub fn identify_arm(args: &IdentifyArgs, dataset: &Path) -> Result<i32, Error> {
 
     let servo_files = write_motor_file(&args.out, motors, &model, &start_set, &space, dataset, &train, &found, floor)?;
     // the file as written, replayed: what `replay --forward --motors FILE` will give
-    let payload = if arm.fit_payload { found.payload } else { arm.payload };
+    let payload = arm.payload.unwrap_or(found.payload);
     let replay_with = |cases: &[ForwardCase]| -> Result<Vec<ForwardReplay>, Error> { cases.iter().map(|c| follow(&model, c, &Drives::File(&args.out), &FollowSetup { payload, tool: arm.tool.as_deref(), offsets: arm.fit_offsets.then_some(found.offsets.as_slice()), without_floor: false }, None)).collect() };
     let trained = replay_with(&train_cases)?;
     let validated = replay_with(&validate_cases)?;
@@ -350,8 +366,17 @@ pub fn identify_arm(args: &IdentifyArgs, dataset: &Path) -> Result<i32, Error> {
                 println!("    that stiffness from the catalogue's servos at the same firmware gain (by their datasheets' stall torque per volt): {}", crate::identify::equivalent_supply::text(&supplies));
             }
         }
-        if arm.fit_payload {
+        if fit_payload {
             println!("  payload {:.3} kg", found.payload);
+        }
+        if found.searches.len() > 1 {
+            println!(
+                "  {} searches ended at {}; gaps within the recording's reading error ({:.2} mrad) are not told apart: kept the one whose servos hold nearest the motor file's (search {})",
+                found.searches.len(),
+                found.searches.iter().map(|s| format!("{:.2} mrad ({:.0} g, ×{})", 1e3 * s.loss, 1e3 * s.payload, s.holding_stiffness.iter().map(|h| format!("{h:.2}")).collect::<Vec<_>>().join("/"))).collect::<Vec<_>>().join(", "),
+                1e3 * reading_error,
+                found.kept + 1
+            );
         }
         if let Some(floor) = floor {
             println!("  a floor under '{}' at z = {:.4} m (where the real tool rested at its lowest)", model.frames[floor.frame].name, floor.height);
@@ -383,7 +408,10 @@ pub fn identify_arm(args: &IdentifyArgs, dataset: &Path) -> Result<i32, Error> {
             "fitted_joints": fitted_names,
             "left_out": left_out.iter().map(|(j, why)| serde_json::json!({ "joint": j, "why": why })).collect::<Vec<_>>(),
             "payload_kg": payload,
-            "payload_fitted": arm.fit_payload,
+            "payload_fitted": fit_payload,
+            "searches": found.searches,
+            "kept_search": found.kept,
+            "reading_error_rad": reading_error,
             "floor": touch.map(|t| serde_json::json!({ "link": model.frames[tool_frame].name, "height_m": t.height, "highest_rest_m": t.highest, "resting_frames": t.frames, "commanded_lowest_m": t.commanded_lowest })),
             "offsets_rad": arm.fit_offsets.then(|| fitted.iter().map(|&j| (name(j), found.offsets[j])).collect::<std::collections::BTreeMap<_, _>>()),
             "servos": kinds,

@@ -84,7 +84,7 @@ impl Strength {
     /// (None within it: the catalogue's servo, as far as these episodes tell).
     pub fn verdict(&self) -> Option<&'static str> {
         if self.holding_stiffness < 0.75 {
-            Some("the real servos hold weaker than the motor file's: a lower supply, a weaker variant of the servo, or a load at the tool the URDF lacks (--fit-payload)")
+            Some("the real servos hold weaker than the motor file's: a lower supply, a weaker variant of the servo, or a load at the tool the URDF lacks (fitted unless --payload is given)")
         } else if self.holding_stiffness > 4.0 / 3.0 {
             Some("the real servos hold stiffer than the motor file's: a higher supply, a stronger variant of the servo, or a higher P gain than the motor file's kp")
         } else {
@@ -199,6 +199,8 @@ pub struct ArmObjective<'a> {
     pub model: &'a Model,
     pub motor_file: &'a Path,
     pub tool: Option<&'a str>,
+    /// The payload known to be at the tool, kg, where the space does not fit one.
+    pub known_payload: f64,
     pub space: &'a ArmSpace,
     pub cases: &'a [ForwardCase],
     /// Per model coordinate: in the loss.
@@ -233,7 +235,8 @@ impl ArmObjective<'_> {
     /// candidate whose mean passes `cutoff` is stopped there, its loss then the part it had reached
     /// (past the cutoff: a lower bound, enough to rank it last).
     pub fn loss(&self, u: &[f64], cutoff: f64) -> f64 {
-        let (params, payload, offsets) = self.space.decode(u);
+        let (params, fitted_payload, offsets) = self.space.decode(u);
+        let payload = if self.space.payload.is_some() { fitted_payload } else { self.known_payload };
         let make = || self.motors(&params);
         let setup = FollowSetup { payload, tool: self.tool, offsets: (!self.space.offsets.is_empty()).then_some(offsets.as_slice()), without_floor: false };
         let samples = self.samples().max(1) as f64;
@@ -259,20 +262,49 @@ impl ArmObjective<'_> {
 pub struct ArmFitOptions {
     /// Candidates a generation (0: CMA-ES's default for the dimension, rounded up to the cores).
     pub population: usize,
+    /// Generations a search.
     pub generations: usize,
     /// The first step, on the unit cube.
     pub sigma: f64,
+    /// The first search's seed (search k uses seed + k).
     pub seed: u64,
+    /// Searches from the start, each with its own seed.
+    pub searches: usize,
+    /// Losses closer than this to the best are not told apart (rad): of the searches that end
+    /// within it, the one whose servos hold nearest their start is kept.
+    pub indistinct: f64,
     pub jobs: usize,
 }
 
 impl Default for ArmFitOptions {
     fn default() -> Self {
-        Self { population: 0, generations: 60, sigma: 0.1, seed: 1, jobs: 1 }
+        Self { population: 0, generations: 60, sigma: 0.1, seed: 1, searches: 1, indistinct: 0.0, jobs: 1 }
     }
 }
 
-/// The fit: the point found, its loss, the start's, and how many candidates were run.
+/// Where one search ended.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct SearchEnd {
+    pub seed: u64,
+    #[serde(rename = "gap_rad")]
+    pub loss: f64,
+    #[serde(rename = "payload_kg")]
+    pub payload: f64,
+    /// Per servo kind, its holding stiffness against its start.
+    pub holding_stiffness: Vec<f64>,
+    #[serde(skip)]
+    point: Vec<f64>,
+}
+
+impl SearchEnd {
+    /// How far its servos hold from their starts: Σ |ln stiffness| over the kinds.
+    fn from_start(&self) -> f64 {
+        self.holding_stiffness.iter().map(|s| s.ln().abs()).sum()
+    }
+}
+
+/// The fit: the point kept, its loss, the start's, every search's end, and how many candidates
+/// were run.
 #[derive(Clone, Debug)]
 pub struct ArmFit {
     pub point: Vec<f64>,
@@ -282,23 +314,71 @@ pub struct ArmFit {
     pub offsets: Vec<f64>,
     pub loss: f64,
     pub start_loss: f64,
+    pub searches: Vec<SearchEnd>,
+    /// The search kept (an index of `searches`).
+    pub kept: usize,
     pub evaluations: usize,
 }
 
-/// Minimise `objective` from its space's start; `progress` sees (generation, best loss so far).
+/// The readings' own error, rad: the mean |error| of the real follower's recorded positions on the
+/// fitted joints (an encoder's quantum δ rounds by δ/4 on average; noise σ by σ·√(2/π)). A gap
+/// between two fits smaller than this is below what the recording resolves.
+pub fn reading_error(cases: &[ForwardCase], fitted: &[bool]) -> f64 {
+    let errors: Vec<f64> = cases
+        .iter()
+        .flat_map(|c| c.compared().iter().filter(|&&j| fitted[j]).filter_map(|&j| c.real().smoothing[j].as_ref()))
+        .map(|s| s.quantum.map_or(s.noise * std::f64::consts::FRAC_2_PI.sqrt(), |q| q / 4.0))
+        .collect();
+    if errors.is_empty() { 0.0 } else { errors.iter().sum::<f64>() / errors.len() as f64 }
+}
+
+/// Minimise `objective` from its space's start, `options.searches` times with successive seeds,
+/// and keep, of the searches ending within `options.indistinct` of the best, the one whose servos
+/// hold nearest their start: an arm's episodes can leave a ridge (the servos' stiffness against a
+/// load at the tool) flat to well below their readings' resolution, and along it the motor file's
+/// servo (the catalogue's bench identification) is what is known. `progress` sees (generation
+/// counted over the searches, best loss so far).
 pub fn fit_arm(objective: &ArmObjective, options: &ArmFitOptions, progress: &(dyn Fn(usize, f64) + Sync)) -> Result<ArmFit, Error> {
-    use rayon::prelude::*;
     let pool = rayon::ThreadPoolBuilder::new().num_threads(options.jobs.max(1)).build().map_err(|e| Error::flag("--jobs", e.to_string()))?;
     let start = objective.space.start();
     let start_loss = objective.loss(&start, f64::INFINITY);
-    let (mut best, mut best_loss) = (start.clone(), start_loss);
     let jobs = options.jobs.max(1);
     let population = if options.population >= 2 { options.population } else { (4 + (3.0 * (start.len() as f64).ln()).floor() as usize).div_ceil(jobs) * jobs };
-    let mut search = Cmaes::new(&start, options.sigma, population, options.seed);
     let mut evaluations = 1;
+    let mut searches = Vec::new();
+    for k in 0..options.searches.max(1) {
+        let seed = options.seed + k as u64;
+        let (done, before) = (k * options.generations, searches.iter().map(|s: &SearchEnd| s.loss).fold(start_loss, f64::min));
+        let (point, loss, runs) = search(objective, &pool, &start, start_loss, options, population, seed, &|g, l| progress(done + g, before.min(l)));
+        evaluations += runs;
+        let (params, payload, _) = objective.space.decode(&point);
+        let holding_stiffness = objective.space.kinds.iter().zip(&params).map(|(kind, p)| Strength::of(p, &kind.start).holding_stiffness).collect();
+        searches.push(SearchEnd { seed, loss, payload, holding_stiffness, point });
+    }
+    let kept = nearest_start_of_the_best(&searches, options.indistinct);
+    let point = searches[kept].point.clone();
+    let (params, payload, offsets) = objective.space.decode(&point);
+    Ok(ArmFit { point, params, payload, offsets, loss: searches[kept].loss, start_loss, searches, kept, evaluations })
+}
+
+/// Of the searches ending within `indistinct` of the best loss, the one whose servos hold nearest
+/// their starts.
+fn nearest_start_of_the_best(searches: &[SearchEnd], indistinct: f64) -> usize {
+    let best = searches.iter().map(|s| s.loss).fold(f64::INFINITY, f64::min);
+    (0..searches.len()).filter(|&i| searches[i].loss <= best + indistinct).min_by(|&a, &b| searches[a].from_start().total_cmp(&searches[b].from_start())).unwrap_or(0)
+}
+
+/// One CMA-ES search from `start` (whose loss is `start_loss`): the best point it ran, its loss, and
+/// the candidates run.
+#[allow(clippy::too_many_arguments)]
+fn search(objective: &ArmObjective, pool: &rayon::ThreadPool, start: &[f64], start_loss: f64, options: &ArmFitOptions, population: usize, seed: u64, progress: &dyn Fn(usize, f64)) -> (Vec<f64>, f64, usize) {
+    use rayon::prelude::*;
+    let (mut best, mut best_loss) = (start.to_vec(), start_loss);
+    let mut es = Cmaes::new(start, options.sigma, population, seed);
+    let mut evaluations = 0;
     for generation in 0..options.generations {
-        let candidates = search.ask();
-        let cutoff = search.cutoff();
+        let candidates = es.ask();
+        let cutoff = es.cutoff();
         let losses: Vec<f64> = pool.install(|| candidates.points.par_iter().map(|u| objective.loss(u, cutoff)).collect());
         evaluations += losses.len();
         for (u, &l) in candidates.points.iter().zip(&losses) {
@@ -307,16 +387,30 @@ pub fn fit_arm(objective: &ArmObjective, options: &ArmFitOptions, progress: &(dy
                 (best, best_loss) = (u.clone(), l);
             }
         }
-        search.tell(candidates, &losses);
+        es.tell(candidates, &losses);
         progress(generation + 1, best_loss);
     }
-    let (params, payload, offsets) = objective.space.decode(&best);
-    Ok(ArmFit { point: best, params, payload, offsets, loss: best_loss, start_loss, evaluations })
+    (best, best_loss, evaluations)
 }
 
 #[cfg(test)]
 mod tests {
-    use super::Strength;
+    use super::{SearchEnd, Strength, nearest_start_of_the_best};
+
+    #[test]
+    fn of_the_searches_the_recording_cannot_tell_apart_the_one_nearest_the_start_is_kept() {
+        let end = |loss: f64, stiffness: f64| SearchEnd { seed: 0, loss, payload: 0.0, holding_stiffness: vec![stiffness], point: Vec::new() };
+        // the real SO-101's three searches (seeds 1–3): 8.51, 8.73 and 8.68 mrad at ×0.37, ×0.45, ×0.48
+        let ridge = [end(8.51e-3, 0.37), end(8.73e-3, 0.45), end(8.68e-3, 0.48)];
+        // its readings' error, 0.38 mrad: the three are one, the stiffest (nearest ×1) kept
+        assert_eq!(nearest_start_of_the_best(&ridge, 0.38e-3), 2);
+        // a finer recording tells them apart: the best kept
+        assert_eq!(nearest_start_of_the_best(&ridge, 0.1e-3), 0);
+        // nearness is by ratio, either way: ×1.6 is nearer ×1 than ×0.5
+        assert_eq!(nearest_start_of_the_best(&[end(1e-3, 0.5), end(1e-3, 1.6)], 1e-4), 1);
+        // a search far worse is never kept, however near its start
+        assert_eq!(nearest_start_of_the_best(&[end(8.51e-3, 0.37), end(9.87e-3, 1.0)], 0.38e-3), 0);
+    }
 
     #[test]
     fn strength_is_held_against_the_start_at_the_same_gain_and_supply() {
