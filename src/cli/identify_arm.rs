@@ -367,7 +367,7 @@ pub fn identify_arm(args: &IdentifyArgs, dataset: &Path) -> Result<i32, Error> {
             }
         }
         if fit_payload {
-            println!("  payload {:.3} kg", found.payload);
+            println!("  payload {:.3} kg at the tool (not in the motor file, which holds the servos and the floor: `replay --forward --payload {:.3}` replays these episodes as fitted)", found.payload, found.payload);
         }
         if found.searches.len() > 1 {
             println!(
