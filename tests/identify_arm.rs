@@ -108,6 +108,33 @@ fn a_followers_command_delay_is_identified_to_within_a_control_step() {
 }
 
 #[test]
+fn a_known_payload_is_carried_in_the_search() {
+    // the catalogue's follower carrying 0.15 kg at its tool: told the payload, the search finds the
+    // catalogue's delay and follows within the encoder's quantum; told none, the missing weight is
+    // not the delay's to make up
+    let dir = tempfile::tempdir().unwrap();
+    let root = dataset(dir.path(), "loaded", &common::follower::so101_motors(), 0.15, &motions()[..2]);
+    let fit = |payload: &str| {
+        let (out, summary) = (dir.path().join(format!("fit{payload}.toml")), dir.path().join(format!("fit{payload}.json")));
+        let (code, _, stderr) = identify(&[
+            "--from", root.to_str().unwrap(), "--urdf", so101().to_str().unwrap(), "--motors", common::follower::so101_motors().to_str().unwrap(), "--units", "degrees",
+            "--fit-params", "command_delay", "--payload", payload, "--generations", "20", "--out", out.to_str().unwrap(), "--summary-json", summary.to_str().unwrap(), "--quiet",
+        ]);
+        assert_eq!(code, 0, "{stderr}");
+        assert!(!stderr.contains("the payload at the tool is fitted"), "{stderr}");
+        read_json(&summary)
+    };
+    let (told, untold) = (fit("0.15"), fit("0"));
+    let gap = |doc: &Value| doc["gap_rad"].as_f64().unwrap();
+    assert_eq!(told["payload_kg"], 0.15);
+    assert_eq!(told["payload_fitted"], false);
+    assert_eq!(told["searches"].as_array().unwrap().len(), 1);
+    let delay = told["servos"][0]["params"]["command_delay"].as_f64().unwrap();
+    assert!((delay - catalogue_servo().command_delay).abs() < 1e-3, "delay {:.2} ms", delay * 1e3);
+    assert!(gap(&told) < 1.53e-3 && gap(&untold) > 2.0 * gap(&told), "told {:.2} mrad, untold {:.2}", 1e3 * gap(&told), 1e3 * gap(&untold));
+}
+
+#[test]
 fn a_follower_resting_on_a_table_has_the_table_found_and_followed() {
     // the catalogue's follower with a table under its tool, a centimetre under where the episodes
     // start at most: the commands ask the tool below it in a good part of their frames, and the
