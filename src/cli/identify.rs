@@ -77,7 +77,10 @@ pub struct IdentifyArgs {
     /// 0: 36 000 log replays' worth, 600 to 1000).
     #[arg(long, default_value_t = FitOptions::default().polish_iterations)]
     pub polish_iterations: usize,
-    /// Independent searches of the first stage, from different starts; the best is refined.
+    /// Independent searches of the first stage, from different starts; the best is refined. With
+    /// --from: searches from the motor file's parameters, each with its own seed (0: three where the
+    /// payload is fitted, else one), the one whose servos hold nearest its kept of those ending within
+    /// the recording's reading error of the best.
     #[arg(long, default_value_t = FitOptions::default().searches)]
     pub searches: usize,
     /// The random seed of the global search (the same seed, logs and flags give the same fit).

@@ -86,7 +86,7 @@ const SHORTEST_EPISODE: f64 = 2.0;
 /// Default of `--generations` with --from.
 const GENERATIONS: usize = 60;
 
-/// Searches run when the payload is fitted, each from the motor file's parameters with its own
+/// Searches run by default when the payload is fitted, each from the motor file's parameters with its own
 /// seed. A load at the tool trades against the servos' holding stiffness along a ridge an arm's
 /// episodes leave nearly flat: on the real SO-101's two shared episodes, seven seeds ended between
 /// no payload at ×0.37 the catalogue's stiffness and 75 g at ×0.52, their gaps within 0.22 mrad of
@@ -303,13 +303,18 @@ pub fn identify_arm(args: &IdentifyArgs, dataset: &Path) -> Result<i32, Error> {
     }
     let search_cases: Vec<ForwardCase> = chosen.iter().map(|&i| train_cases[i].clone()).collect();
     let objective = ArmObjective { model: &model, motor_file: motors, tool: arm.tool.as_deref(), known_payload: arm.payload.unwrap_or(0.0), space: &space, cases: &search_cases, fitted: is_fitted.clone(), floor };
-    let searches = if fit_payload { SEARCHES_WITH_PAYLOAD } else { 1 };
+    let searches = match args.searches {
+        0 if fit_payload => SEARCHES_WITH_PAYLOAD,
+        0 => 1,
+        n => n,
+    };
     let reading_error = crate::identify::arm::reading_error(&search_cases, &is_fitted);
     let options = ArmFitOptions { population: args.population, generations, seed: args.seed, searches, indistinct: reading_error, jobs, ..ArmFitOptions::default() };
     if fit_payload {
         eprintln!(
-            "armscope: notice: the payload at the tool is fitted too (0 to {} kg; --payload KG for a known one), in {searches} searches: the one nearest the motor file's servos is kept of those whose gaps the recording cannot tell apart",
-            arm.payload_max
+            "armscope: notice: the payload at the tool is fitted too (0 to {} kg; --payload KG for a known one){}",
+            arm.payload_max,
+            if searches > 1 { format!(", in {searches} searches: of those whose gaps the recording cannot tell apart, the one nearest the motor file's servos is kept") } else { String::new() }
         );
     }
     let bar = super::identify::generations_bar((searches * generations) as u64, args.quiet);
