@@ -108,6 +108,27 @@ fn a_followers_command_delay_is_identified_to_within_a_control_step() {
 }
 
 #[test]
+fn a_seed_gives_the_same_fit_on_any_number_of_cores() {
+    // three parameters: CMA-ES's default λ is 7, which one and three cores would share unevenly
+    let dir = tempfile::tempdir().unwrap();
+    let root = dataset(dir.path(), "cores", &common::follower::so101_motors(), 0.0, &motions()[..1]);
+    let fit = |jobs: &str| {
+        let summary = dir.path().join(format!("fit{jobs}.json"));
+        let (code, _, stderr) = identify(&[
+            "--from", root.to_str().unwrap(), "--urdf", so101().to_str().unwrap(), "--motors", common::follower::so101_motors().to_str().unwrap(), "--units", "degrees",
+            "--fit-params", "kt,armature,command_delay", "--payload", "0", "--generations", "3", "--jobs", jobs,
+            "--out", dir.path().join(format!("fit{jobs}.toml")).to_str().unwrap(), "--summary-json", summary.to_str().unwrap(), "--quiet",
+        ]);
+        assert_eq!(code, 0, "{stderr}");
+        read_json(&summary)
+    };
+    let (one, three) = (fit("1"), fit("3"));
+    assert_eq!(one["evaluations"], three["evaluations"]);
+    assert_eq!(one["gap_rad"], three["gap_rad"]);
+    assert_eq!(one["servos"][0]["params"], three["servos"][0]["params"]);
+}
+
+#[test]
 fn a_known_payload_is_carried_in_the_search() {
     // the catalogue's follower carrying 0.15 kg at its tool: told the payload, the search finds the
     // catalogue's delay and follows within the encoder's quantum; told none, the missing weight is

@@ -63,7 +63,8 @@ pub struct IdentifyArgs {
     #[arg(long, value_name = "SECONDS", default_value_t = crate::testbench::log::DEFAULT_DT)]
     pub dt: f64,
     /// Candidates a generation of the search (CMA-ES's λ; 0: its default for the number of
-    /// parameters, rounded up to a multiple of the cores).
+    /// parameters, 4 + ⌊3 ln n⌋, rounded up to an even number: the same on any machine, so that a
+    /// seed gives the same fit on any number of cores).
     #[arg(long, default_value_t = FitOptions::default().population)]
     pub population: usize,
     /// Generations at most of each search on the windowed replay (the first stage; default 200);

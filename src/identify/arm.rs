@@ -260,7 +260,7 @@ impl ArmObjective<'_> {
 /// How the search runs.
 #[derive(Clone, Debug)]
 pub struct ArmFitOptions {
-    /// Candidates a generation (0: CMA-ES's default for the dimension, rounded up to the cores).
+    /// Candidates a generation (0: [`super::cmaes::default_population`]).
     pub population: usize,
     /// Generations a search.
     pub generations: usize,
@@ -342,8 +342,7 @@ pub fn fit_arm(objective: &ArmObjective, options: &ArmFitOptions, progress: &(dy
     let pool = rayon::ThreadPoolBuilder::new().num_threads(options.jobs.max(1)).build().map_err(|e| Error::flag("--jobs", e.to_string()))?;
     let start = objective.space.start();
     let start_loss = objective.loss(&start, f64::INFINITY);
-    let jobs = options.jobs.max(1);
-    let population = if options.population >= 2 { options.population } else { (4 + (3.0 * (start.len() as f64).ln()).floor() as usize).div_ceil(jobs) * jobs };
+    let population = if options.population >= 2 { options.population } else { super::cmaes::default_population(start.len()) };
     let mut evaluations = 1;
     let mut searches = Vec::new();
     for k in 0..options.searches.max(1) {

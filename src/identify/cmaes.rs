@@ -12,6 +12,15 @@ use rand::SeedableRng;
 use rand::rngs::StdRng;
 use rand_distr::{Distribution, StandardNormal};
 
+/// The λ a fit runs with by default for `dimension` parameters: CMA-ES's 4 + ⌊3 ln n⌋, rounded up to
+/// an even number so that two cores share a generation evenly. It does not depend on the machine's
+/// cores: a seed gives the same fit on any machine (rounded up to the cores, λ and with it every
+/// generation would differ from one to the next).
+pub fn default_population(dimension: usize) -> usize {
+    let lambda = 4 + (3.0 * (dimension.max(1) as f64).ln()).floor() as usize;
+    lambda.next_multiple_of(2)
+}
+
 /// The strategy's state.
 pub struct Cmaes {
     dimension: usize,

@@ -22,8 +22,7 @@ pub struct FitOptions {
     /// on to the second. The first starts at `start` (or the cube's centre), the others at random.
     /// 0: 120 / the logs' count, 2 to 6 (few logs are cheap to search more).
     pub searches: usize,
-    /// Candidates a generation, λ (0: CMA-ES's default for the dimension, 4 + ⌊3 ln n⌋, rounded up
-    /// to a multiple of the cores).
+    /// Candidates a generation, λ (0: [`super::cmaes::default_population`]).
     pub population: usize,
     /// Generations of each first-stage search, at most.
     pub generations: usize,
@@ -167,11 +166,7 @@ pub fn fit(space: &Space, logs: &[BenchLog], replay: ReplayOptions, options: &Fi
     let free = Objective::new(space, logs, ReplayOptions { reset_rows: None, ..replay });
     let n = space.len();
     let population = match options.population {
-        0 => {
-            let cores = rayon::current_num_threads().max(1);
-            let default = 4 + (3.0 * (n as f64).ln()).floor() as usize;
-            default.div_ceil(cores) * cores
-        }
+        0 => super::cmaes::default_population(n),
         p => p.max(2),
     };
     // logs are cheap when few: more first-stage searches then (2 for 60 logs, 6 for 8 or fewer)
