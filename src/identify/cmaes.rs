@@ -17,8 +17,12 @@ use rand_distr::{Distribution, StandardNormal};
 /// cores: a seed gives the same fit on any machine (rounded up to the cores, λ and with it every
 /// generation would differ from one to the next).
 pub fn default_population(dimension: usize) -> usize {
-    let lambda = 4 + (3.0 * (dimension.max(1) as f64).ln()).floor() as usize;
-    lambda.next_multiple_of(2)
+    tutorial_population(dimension).next_multiple_of(2)
+}
+
+/// The tutorial's default λ = 4 + ⌊3 ln n⌋.
+fn tutorial_population(dimension: usize) -> usize {
+    4 + (3.0 * (dimension.max(1) as f64).ln()).floor() as usize
 }
 
 /// The strategy's state.
@@ -61,7 +65,7 @@ impl Cmaes {
     pub fn new(start: &[f64], sigma: f64, population: usize, seed: u64) -> Self {
         let n = start.len();
         let nf = n as f64;
-        let lambda = if population >= 2 { population } else { 4 + (3.0 * nf.ln()).floor() as usize };
+        let lambda = if population >= 2 { population } else { tutorial_population(n) };
         let mu = lambda / 2;
         let raw: Vec<f64> = (0..mu).map(|i| ((lambda as f64 + 1.0) / 2.0).ln() - ((i + 1) as f64).ln()).collect();
         let total: f64 = raw.iter().sum();
