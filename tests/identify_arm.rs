@@ -404,6 +404,8 @@ fn bad_input_is_refused_in_one_line_naming_the_episode_or_flag() {
         ([base(&root), vec!["--validate-episodes".into(), "7".into()]].concat(), "--validate-episodes: episode 7: not in"),
         ([base(&root), vec!["--episode".into(), "0".into(), "--validate-episodes".into(), "0".into()]].concat(), "episode 0 is also fitted to"),
         ([base(&root), vec!["--latency=-1".into()]].concat(), "--latency"),
+        ([base(&root), vec!["--payload".into(), "-0.2".into()]].concat(), "--payload: must be a mass of 0 kg or more"),
+        ([base(&root), vec!["--payload".into(), "0.1".into(), "--payload-max".into(), "0.3".into()]].concat(), "'--payload <KG>' cannot be used with '--payload-max <KG>'"),
     ];
     for (args, expected) in cases {
         let args: Vec<&str> = args.iter().map(String::as_str).collect();

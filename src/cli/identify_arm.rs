@@ -42,7 +42,7 @@ pub struct ArmArgs {
     pub calibration: Option<PathBuf>,
     /// With --from: the payload known to be at the tool, kg (0: none); by default it is fitted (0 to
     /// --payload-max kg).
-    #[arg(long, value_name = "KG", requires = "from")]
+    #[arg(long, value_name = "KG", requires = "from", allow_negative_numbers = true)]
     pub payload: Option<f64>,
     /// With --from: the heaviest payload searched, kg.
     #[arg(long, value_name = "KG", default_value_t = 0.5, conflicts_with = "payload")]
