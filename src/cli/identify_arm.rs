@@ -3,7 +3,7 @@
 
 use super::*;
 use std::path::Path;
-use crate::identify::arm::{ArmFitOptions, ArmObjective, ArmSpace, fit_arm};
+use crate::identify::arm::{ArmFitOptions, ArmObjective, ArmSpace, Payload, fit_arm};
 use crate::motion::{Mapped, open_mapped};
 use crate::replay::forward::{Drives, FollowSetup, ForwardCase, ForwardReplay, ForwardSummary, Latency, follow};
 use crate::replay::{ReplayOptions, Replayer};
@@ -264,7 +264,8 @@ pub fn identify_arm(args: &IdentifyArgs, dataset: &Path) -> Result<i32, Error> {
         Some(servo) => crate::identify::equivalent_supply::equivalent_supplies(&catalogue, &servo.name, servo.supply, stiffness),
         None => Vec::new(),
     };
-    let space = ArmSpace::new(&start_set, &fitted, &keys, fit_payload.then_some(arm.payload_max), arm.fit_offsets, arm.per_joint.then_some(joint_names.as_slice()));
+    let searched_payload = arm.payload.map_or(Payload::Fitted { most: arm.payload_max }, Payload::Known);
+    let space = ArmSpace::new(&start_set, &fitted, &keys, searched_payload, arm.fit_offsets, arm.per_joint.then_some(joint_names.as_slice()));
     // the table the real tool rested on, where the episodes show one
     // (the replayer's model has --tool's frame, checked when it was built)
     let tool_frame = replayer.model.tool_frame;
@@ -302,7 +303,7 @@ pub fn identify_arm(args: &IdentifyArgs, dataset: &Path) -> Result<i32, Error> {
         );
     }
     let search_cases: Vec<ForwardCase> = chosen.iter().map(|&i| train_cases[i].clone()).collect();
-    let objective = ArmObjective { model: &model, motor_file: motors, tool: arm.tool.as_deref(), known_payload: arm.payload.unwrap_or(0.0), space: &space, cases: &search_cases, fitted: is_fitted.clone(), floor };
+    let objective = ArmObjective { model: &model, motor_file: motors, tool: arm.tool.as_deref(), space: &space, cases: &search_cases, fitted: is_fitted.clone(), floor };
     let searches = match args.searches {
         0 if fit_payload => SEARCHES_WITH_PAYLOAD,
         0 => 1,
@@ -328,7 +329,7 @@ pub fn identify_arm(args: &IdentifyArgs, dataset: &Path) -> Result<i32, Error> {
 
     let servo_files = write_motor_file(&args.out, motors, &model, &start_set, &space, dataset, &train, &found, floor)?;
     // the file as written, replayed: what `replay --forward --motors FILE` will give
-    let payload = arm.payload.unwrap_or(found.payload);
+    let payload = found.payload;
     let replay_with = |cases: &[ForwardCase]| -> Result<Vec<ForwardReplay>, Error> { cases.iter().map(|c| follow(&model, c, &Drives::File(&args.out), &FollowSetup { payload, tool: arm.tool.as_deref(), offsets: arm.fit_offsets.then_some(found.offsets.as_slice()), without_floor: false }, None)).collect() };
     let trained = replay_with(&train_cases)?;
     let validated = replay_with(&validate_cases)?;

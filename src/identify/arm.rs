@@ -120,23 +120,29 @@ impl ServoKind {
 /// degrees; more is a wrong map, not an offset).
 pub const OFFSET_RANGE: f64 = 0.15;
 
+/// The payload at the tool: searched from 0 to `most` kg, or known, kg.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Payload {
+    Fitted { most: f64 },
+    Known(f64),
+}
+
 /// What is searched: each kind's parameters, then the payload (kg, 0 to its bound) where fitted,
 /// then a calibration offset per joint of `offsets` (model coordinates) where fitted.
 #[derive(Clone, Debug)]
 pub struct ArmSpace {
     pub kinds: Vec<ServoKind>,
-    pub payload: Option<f64>,
+    pub payload: Payload,
     pub offsets: Vec<usize>,
     pub dof: usize,
 }
 
 impl ArmSpace {
     /// The servo kinds of `motors` on the joints `fitted` (model coordinates) with their parameters
-    /// `keys` (those their family has), the payload up to `payload` kg where given, and the fitted
-    /// joints' offsets where asked.
+    /// `keys` (those their family has), the `payload`, and the fitted joints' offsets where asked.
     /// With `per_joint` each fitted joint's servo is a kind of its own, named "SERVO JOINT"
     /// (`joint_names` by coordinate).
-    pub fn new(motors: &MotorSet, fitted: &[usize], keys: &[&str], payload: Option<f64>, offsets: bool, per_joint: Option<&[String]>) -> Self {
+    pub fn new(motors: &MotorSet, fitted: &[usize], keys: &[&str], payload: Payload, offsets: bool, per_joint: Option<&[String]>) -> Self {
         let mut kinds: Vec<ServoKind> = Vec::new();
         for &j in fitted {
             let Some(servo) = motors.joints[j].as_ref().and_then(|d| d.servo.as_ref()) else { continue };
@@ -155,7 +161,11 @@ impl ArmSpace {
     }
 
     pub fn len(&self) -> usize {
-        self.kinds.iter().map(|k| k.space.len()).sum::<usize>() + usize::from(self.payload.is_some()) + self.offsets.len()
+        self.kinds.iter().map(|k| k.space.len()).sum::<usize>() + usize::from(self.fits_payload()) + self.offsets.len()
+    }
+
+    pub fn fits_payload(&self) -> bool {
+        matches!(self.payload, Payload::Fitted { .. })
     }
 
     pub fn is_empty(&self) -> bool {
@@ -165,7 +175,7 @@ impl ArmSpace {
     /// The start: each kind's own parameters, no payload.
     pub fn start(&self) -> Vec<f64> {
         let mut u: Vec<f64> = self.kinds.iter().flat_map(|k| k.space.point(&k.start)).collect();
-        if self.payload.is_some() {
+        if self.fits_payload() {
             u.push(0.0);
         }
         u.extend(self.offsets.iter().map(|_| 0.5));
@@ -184,8 +194,11 @@ impl ArmSpace {
                 p
             })
             .collect();
-        let payload = self.payload.map_or(0.0, |most| most * u[at].clamp(0.0, 1.0));
-        at += usize::from(self.payload.is_some());
+        let payload = match self.payload {
+            Payload::Fitted { most } => most * u[at].clamp(0.0, 1.0),
+            Payload::Known(kg) => kg,
+        };
+        at += usize::from(self.fits_payload());
         let mut offsets = vec![0.0; self.dof];
         for (k, &j) in self.offsets.iter().enumerate() {
             offsets[j] = OFFSET_RANGE * (2.0 * u[at + k].clamp(0.0, 1.0) - 1.0);
@@ -199,8 +212,6 @@ pub struct ArmObjective<'a> {
     pub model: &'a Model,
     pub motor_file: &'a Path,
     pub tool: Option<&'a str>,
-    /// The payload known to be at the tool, kg, where the space does not fit one.
-    pub known_payload: f64,
     pub space: &'a ArmSpace,
     pub cases: &'a [ForwardCase],
     /// Per model coordinate: in the loss.
@@ -235,8 +246,7 @@ impl ArmObjective<'_> {
     /// candidate whose mean passes `cutoff` is stopped there, its loss then the part it had reached
     /// (past the cutoff: a lower bound, enough to rank it last).
     pub fn loss(&self, u: &[f64], cutoff: f64) -> f64 {
-        let (params, fitted_payload, offsets) = self.space.decode(u);
-        let payload = if self.space.payload.is_some() { fitted_payload } else { self.known_payload };
+        let (params, payload, offsets) = self.space.decode(u);
         let make = || self.motors(&params);
         let setup = FollowSetup { payload, tool: self.tool, offsets: (!self.space.offsets.is_empty()).then_some(offsets.as_slice()), without_floor: false };
         let samples = self.samples().max(1) as f64;
