@@ -29,12 +29,16 @@ fn motions() -> Vec<Sines> {
 }
 
 fn write(dir: &Path, name: &str, body: impl Fn(usize) -> Storage, motion: Vec<Sines>) -> PathBuf {
+    write_episodes(dir, name, body, vec![motion])
+}
+
+fn write_episodes(dir: &Path, name: &str, body: impl Fn(usize) -> Storage, episodes: Vec<Vec<Sines>>) -> PathBuf {
     let model = load_urdf(&so101()).unwrap();
     let gripper = &model.joints[model.joint_index("gripper").unwrap()];
     let mut storage: Vec<Storage> = (0..5).map(body).collect();
     storage.push(Storage::Range0To100 { lower: gripper.lower, upper: gripper.upper });
     let root = dir.join(name);
-    Spec { fps: 30.0, frames: 121, episodes: vec![motion], storage, observed: None }.write_v3(&root);
+    Spec { fps: 30.0, frames: 121, episodes, storage, observed: None }.write_v3(&root);
     root
 }
 
@@ -158,6 +162,24 @@ fn poses_past_a_urdf_limit_are_followed_to_it_and_impossible_ones_refused() {
     let by: f64 = notice.split("elbow_flex by up to ").nth(1).and_then(|r| r.split('°').next()).and_then(|x| x.parse().ok()).unwrap_or_else(|| panic!("{notice}"));
     assert!((2.8..=3.1).contains(&by) && notice.contains("episode 0"), "{notice}");
     assert!(trace_q(&trace).iter().all(|row| row[2] <= limit + 1e-12));
+    // two episodes, 3° and 1° past it: one notice for the recording, its largest excess and where,
+    // from either replay (forward: of the commands and the follower alike); the forward replay starts
+    let mut less = past.clone();
+    less[2].terms[0].0 = 0.3 + 1f64.to_radians();
+    let root = write_episodes(dir.path(), "two", |_| Storage::Degrees { sign: 1.0, offset: 0.0 }, vec![less, past.clone()]);
+    let motors = common::repo().join("assets/motors/so101.toml");
+    for forward in [false, true] {
+        let mut args = vec!["replay", root.to_str().unwrap(), "--urdf", urdf.to_str().unwrap(), "--no-rrd", "--no-mcap"];
+        if forward {
+            args.extend(["--forward", "--motors", motors.to_str().unwrap()]);
+        }
+        let (code, _, stderr) = run(&args);
+        assert_eq!(code, 0, "{stderr}");
+        let notices: Vec<&str> = stderr.lines().filter(|l| l.contains("past the URDF's limits")).collect();
+        assert_eq!(notices.len(), 1, "{stderr}");
+        let by: f64 = notices[0].split("elbow_flex by up to ").nth(1).and_then(|r| r.split('°').next()).and_then(|x| x.parse().ok()).unwrap_or_else(|| panic!("{}", notices[0]));
+        assert!(notices[0].contains("in 2 of 2 episodes") && (2.8..=3.1).contains(&by) && notices[0].contains("(episode 1, frame"), "forward {forward}: {}", notices[0]);
+    }
     past[2].terms[0].0 = 0.3 + 25f64.to_radians();
     let root = write(dir.path(), "impossible", |_| Storage::Degrees { sign: 1.0, offset: 0.0 }, past);
     let (code, _, stderr) = run(&["replay", root.to_str().unwrap(), "--urdf", urdf.to_str().unwrap(), "--no-rrd", "--no-mcap"]);

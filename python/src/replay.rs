@@ -50,6 +50,7 @@ pub fn replay<'py>(
     }
     let replayer = Replayer::new(model, &ReplayOptions { payload, tool, motors }, opened.map).map_err(crate::error)?;
     let mut out = Vec::with_capacity(opened.episodes.len());
+    let mut past = Vec::with_capacity(opened.episodes.len());
     for &index in &opened.episodes {
         let replayed = py.detach(|| -> Result<_, armscope::Error> {
             let episode = opened.source.read(index, &feature)?;
@@ -60,6 +61,7 @@ pub fn replay<'py>(
             warnings.call_method1("warn", (format!("armscope: {notice}"),))?;
         }
         let m = &replayed.motion;
+        past.push(m.past_limits.clone());
         let d = PyDict::new(py);
         d.set_item("episode", index)?;
         d.set_item("t", m.time.clone().into_pyarray(py))?;
@@ -70,6 +72,9 @@ pub fn replay<'py>(
         d.set_item("available", table(&replayed.available).into_pyarray(py))?;
         d.set_item("verdicts_json", serde_json::to_string(&replayed.verdicts).map_err(crate::error)?)?;
         out.push(d);
+    }
+    if let Some(notice) = armscope::replay::past_limits::notice(&replayer.model, &past.iter().map(Vec::as_slice).collect::<Vec<_>>()) {
+        warnings.call_method1("warn", (format!("armscope: {notice}"),))?;
     }
     Ok(out)
 }

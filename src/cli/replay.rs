@@ -129,6 +129,10 @@ pub fn replay(args: &ReplayArgs) -> Result<i32, Error> {
             eprintln!("armscope: notice: {notice}");
         }
     }
+    let past: Vec<&[_]> = summaries.iter().map(|s| s.past_limits.as_slice()).collect();
+    if let Some(notice) = crate::replay::past_limits::notice(&replayer.model, &past) {
+        eprintln!("armscope: notice: {notice}");
+    }
     if several {
         print!("{}", report::ranking_text(&summaries));
         println!("\nthe most loaded:");
@@ -228,6 +232,10 @@ fn forward(args: &ReplayArgs, replayer: &Replayer, source: &crate::motion::Sourc
         for notice in &s.notices {
             eprintln!("armscope: notice: {notice}");
         }
+    }
+    let past: Vec<&[_]> = summaries.iter().map(|s| s.past_limits.as_slice()).collect();
+    if let Some(notice) = crate::replay::past_limits::notice(&replayer.model, &past) {
+        eprintln!("armscope: notice: {notice}");
     }
     if !several {
         wrote(&options(episodes[0], true));

@@ -249,18 +249,23 @@ fn recorded_motions(args: &SizeArgs, source: &std::path::Path, base: RunConfig) 
     std::fs::create_dir_all(&dir).map_err(|e| Error::output(&dir, e))?;
     let several = mapped.episodes.len() > 1 || mapped.source.kind() == crate::motion::SourceKind::LeRobot;
     let mut out = Vec::new();
+    let mut past = Vec::new();
     for index in mapped.episodes {
         // the smoothed motion alone: no motor is held against it here
         let motion = inverse_replay(&replayer.model, &replayer.map, &mapped.source.read(index, &recorded.feature)?, &replayer.hold)?;
         for notice in &motion.notices {
             eprintln!("armscope: notice: {notice}");
         }
+        past.push(motion.past_limits.clone());
         let path = dir.join(if several { format!("episode_{index}.csv") } else { "recording.csv".to_string() });
         schedule::write(&path, &motion)?;
         let (length, first_pose) = schedule::span(&motion);
         let q0 = first_pose.iter().map(|q| format!("{q:?}")).collect::<Vec<_>>().join(",");
         let name = if several { format!("episode {index}") } else { "recording".to_string() };
         out.push((name, RunConfig { trajectory: Some(path), duration: args.duration.unwrap_or(length), q0: Some(q0), ..base.clone() }));
+    }
+    if let Some(notice) = crate::replay::past_limits::notice(&replayer.model, &past.iter().map(Vec::as_slice).collect::<Vec<_>>()) {
+        eprintln!("armscope: notice: {notice}");
     }
     Ok(out)
 }

@@ -65,6 +65,8 @@ pub struct ForwardReplay {
     /// Per compared joint driven by a bus servo, its firmware's own command delay (the bus's and the
     /// firmware's, from the motor file), s: it adds to the latency.
     pub servo_delays: Vec<(String, f64)>,
+    /// Where the commands' and the follower's positions passed a joint's URDF limit.
+    pub past_limits: Vec<super::past_limits::PastLimit>,
 }
 
 /// What the run needs beyond the replayer: the motor file (required: the joints' servos), payload and
@@ -142,6 +144,8 @@ pub struct ForwardCase {
     held: Vec<usize>,
     latency: Latency,
     schedule: PathBuf,
+    /// Where the commands' and the follower's positions passed a joint's URDF limit.
+    past_limits: Vec<super::past_limits::PastLimit>,
 }
 
 impl ForwardCase {
@@ -178,7 +182,13 @@ impl ForwardCase {
         // command_delay)
         let latency = latency.unwrap_or_else(|| Latency::given(schedule::frame_period(&command), "one frame"));
         schedule::write_delayed(schedule, &command, latency.seconds)?;
-        Ok(Self { label: commands.label.clone(), command, reality, mapped, uncommanded, held, latency, schedule: schedule.to_path_buf() })
+        let past_limits = command.past_limits.iter().chain(&reality.past_limits).cloned().collect();
+        Ok(Self { label: commands.label.clone(), command, reality, mapped, uncommanded, held, latency, schedule: schedule.to_path_buf(), past_limits })
+    }
+
+    /// Where the commands' and the follower's positions passed a joint's URDF limit (followed to it).
+    pub fn past_limits(&self) -> &[super::past_limits::PastLimit] {
+        &self.past_limits
     }
 
     /// The compared joints (the model's coordinates).
@@ -346,7 +356,7 @@ pub fn follow(model: &crate::model::Model, case: &ForwardCase, drives: &Drives, 
         Some(motors) => case.mapped.iter().filter_map(|&j| Some((model.joints[j].name.clone(), motors.joints[j].as_ref()?.servo.as_ref()?.command_delay))).collect(),
         None => Vec::new(),
     };
-    Ok(ForwardReplay { label: case.label.clone(), time, commanded, observed, simulated, joints, protection_trips, uncommanded, latency: case.latency.clone(), servo_delays })
+    Ok(ForwardReplay { label: case.label.clone(), time, commanded, observed, simulated, joints, protection_trips, uncommanded, latency: case.latency.clone(), servo_delays, past_limits: case.past_limits.clone() })
 }
 
 impl JointGap {
@@ -533,6 +543,9 @@ pub struct ForwardSummary {
     pub document: serde_json::Value,
     /// What reading the episode assumed, one line each.
     pub notices: Vec<String>,
+    /// Where its commands' and its follower's positions passed a joint's URDF limit (said once for
+    /// the recording).
+    pub past_limits: Vec<super::past_limits::PastLimit>,
 }
 
 impl ForwardSummary {
@@ -541,7 +554,7 @@ impl ForwardSummary {
         let servo_delays: serde_json::Map<String, serde_json::Value> = replay.servo_delays.iter().map(|(joint, d)| (joint.clone(), serde_json::json!(d))).collect();
         let document = serde_json::json!({ "episode": index, "latency_s": replay.latency.seconds, "latency_from": replay.latency.from, "servo_command_delay_s": servo_delays, "joints": replay.joints, "protection_trips": trips, "uncommanded": replay.uncommanded });
         let widest_gap = replay.joints.iter().filter(|g| g.follows).map(|g| g.gap_mae).fold(0.0, f64::max);
-        Self { index, widest_gap, text: text(replay), document, notices }
+        Self { index, widest_gap, text: text(replay), document, notices, past_limits: replay.past_limits.clone() }
     }
 }
 

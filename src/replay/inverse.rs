@@ -2,6 +2,7 @@
 //! needed (RNEA on the model with its payload and the motors' reflected inertia, plus the URDF's
 //! joint damping and sliding friction).
 
+use super::past_limits::{PastLimit, follow_to_limits, range_of};
 use super::smoothing::{Smoothed, Smoother};
 use crate::dynamics::{Data, rnea};
 use crate::error::Error;
@@ -36,6 +37,9 @@ pub struct Motion {
     pub measured: Vec<Option<Vec<f64>>>,
     pub smoothing: Vec<Option<SmoothingInfo>>,
     pub notices: Vec<String>,
+    /// Where the recorded positions passed a joint's URDF limit (followed to it): said once for the
+    /// whole recording ([`super::past_limits::notice`]).
+    pub past_limits: Vec<PastLimit>,
 }
 
 impl Motion {
@@ -56,60 +60,11 @@ impl Motion {
 /// The fewest samples a motion can be differentiated from (the derivative stencils' width).
 pub const MIN_SAMPLES: usize = 5;
 
-/// Past its URDF range by more than this a recorded position cannot be the arm's, rad (20°: a real
-/// arm's calibrated range passes its URDF's by a few degrees; more is a wrong unit, sign or offset).
-pub const REVOLUTE_EXCESS_MAX: f64 = 20.0 * std::f64::consts::PI / 180.0;
-/// The same for a prismatic joint, m.
-pub const PRISMATIC_EXCESS_MAX: f64 = 0.02;
-/// Excesses below this are round-off, followed to the limit without a word, rad (m).
-const ROUND_OFF: f64 = 1e-9;
-
-/// A joint's range, [−∞, ∞] where the URDF gives none.
-fn range_of(model: &Model, j: usize) -> (f64, f64) {
-    let (lower, upper) = model.joints[j].range();
-    if lower.is_finite() && upper.is_finite() { (lower, upper) } else { (f64::NEG_INFINITY, f64::INFINITY) }
-}
-
-/// The recorded positions followed to each joint's limit where they pass it (one notice: the
-/// largest excess per joint, and where); a position past it by more than [`REVOLUTE_EXCESS_MAX`]
-/// ([`PRISMATIC_EXCESS_MAX`]) refused, naming the joint, episode, frame and value.
-fn follow_to_limits(model: &Model, episode: &Episode, mut mapped: Vec<Option<Vec<f64>>>, notices: &mut Vec<String>) -> Result<Vec<Option<Vec<f64>>>, Error> {
-    let mut past = Vec::new();
-    for (j, series) in mapped.iter_mut().enumerate() {
-        let Some(values) = series else { continue };
-        let (lower, upper) = range_of(model, j);
-        let joint = &model.joints[j];
-        let prismatic = joint.kind == crate::model::JointKind::Prismatic;
-        let (limit, unit, scale) = if prismatic { (PRISMATIC_EXCESS_MAX, "mm", 1e3) } else { (REVOLUTE_EXCESS_MAX, "°", 180.0 / std::f64::consts::PI) };
-        let mut worst = (0.0, 0usize);
-        for (k, v) in values.iter_mut().enumerate() {
-            let excess = (*v - upper).max(lower - *v);
-            if excess > limit {
-                return Err(Error::flag(
-                    episode.label.clone(),
-                    format!("joint '{}': frame {k} ({:.2} s) at {:.4} is {:.1}{unit} past its URDF range [{lower}, {upper}], more than the {:.0}{unit} a real arm's calibration passes it by: not a pose of this arm (a wrong unit, sign or offset in the joint map?)", joint.name, episode.time[k], *v, excess * scale, limit * scale),
-                ));
-            }
-            if excess > worst.0 {
-                worst = (excess, k);
-            }
-            *v = v.clamp(lower, upper);
-        }
-        if worst.0 > ROUND_OFF {
-            past.push(format!("{} by up to {:.1}{unit} (frame {}, {:.2} s)", joint.name, worst.0 * scale, worst.1, episode.time[worst.1]));
-        }
-    }
-    if !past.is_empty() {
-        notices.push(format!("{}: past the URDF's limits, followed to the limit: {}", episode.label, past.join(", ")));
-    }
-    Ok(mapped)
-}
-
 /// An episode's positions per coordinate of the model (None where the map leaves the joint out),
-/// followed to each joint's limit where they pass it (said in `notices`) — as recorded, before
+/// followed to each joint's limit where they pass it (and by how far) — as recorded, before
 /// smoothing.
-pub fn mapped_positions(model: &Model, map: &JointMap, episode: &Episode, notices: &mut Vec<String>) -> Result<Vec<Option<Vec<f64>>>, Error> {
-    follow_to_limits(model, episode, map.apply(model, episode)?, notices)
+pub fn mapped_positions(model: &Model, map: &JointMap, episode: &Episode) -> Result<(Vec<Option<Vec<f64>>>, Vec<PastLimit>), Error> {
+    follow_to_limits(model, episode, map.apply(model, episode)?)
 }
 
 /// Smooth an episode mapped onto the model's coordinates and work out the torques it needed.
@@ -121,7 +76,7 @@ pub fn inverse_replay(model: &Model, map: &JointMap, episode: &Episode, hold: &[
         return Err(Error::flag(episode.label.clone(), format!("{samples} samples: a replay needs at least {MIN_SAMPLES}")));
     }
     let mut notices = episode.notices.clone();
-    let mapped = mapped_positions(model, map, episode, &mut notices)?;
+    let (mapped, past_limits) = mapped_positions(model, map, episode)?;
     let mut smoother = Smoother::new(&episode.time);
     let mut q = Vec::with_capacity(n);
     let mut qd = Vec::with_capacity(n);
@@ -157,7 +112,7 @@ pub fn inverse_replay(model: &Model, map: &JointMap, episode: &Episode, hold: &[
     }
     let needed = needed_torques(model, &q, &qd, &qdd);
     let measured = model.joints.iter().map(|j| episode.effort.iter().find(|c| c.name == j.name).map(|c| c.values.clone())).collect();
-    Ok(Motion { label: episode.label.clone(), time: episode.time.clone(), q, qd, qdd, needed, recorded: mapped, measured, smoothing, notices })
+    Ok(Motion { label: episode.label.clone(), time: episode.time.clone(), q, qd, qdd, needed, recorded: mapped, measured, smoothing, notices, past_limits })
 }
 
 /// Per coordinate, the torque needed at every sample: RNEA(q, q̇, q̈) + D·q̇ + F·sign(q̇) (friction

@@ -11,6 +11,7 @@ pub mod at_rest;
 pub mod following;
 pub mod forward;
 pub mod inverse;
+pub mod past_limits;
 pub mod recording;
 pub mod report;
 pub mod schedule;

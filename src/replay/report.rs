@@ -20,6 +20,9 @@ pub struct EpisodeSummary {
     /// Per joint with a measured effort: RMS and largest |measured − model|, N·m.
     pub measured_vs_model: Vec<Option<EffortGap>>,
     pub notices: Vec<String>,
+    /// Where its positions passed a joint's URDF limit (said once for the recording).
+    #[serde(skip)]
+    pub past_limits: Vec<super::past_limits::PastLimit>,
 }
 
 #[derive(Clone, Copy, Debug, Serialize)]
@@ -54,6 +57,7 @@ impl EpisodeSummary {
             smoothing: m.smoothing.clone(),
             measured_vs_model,
             notices: m.notices.clone(),
+            past_limits: m.past_limits.clone(),
         }
     }
 
@@ -185,7 +189,7 @@ mod tests {
     #[test]
     fn a_joint_that_needed_torque_past_its_motors_speed_is_said_in_words() {
         // needed/available with nothing available is infinite: never printed as a number
-        let summary = |label: &str, load: f64| EpisodeSummary { label: label.into(), index: None, duration: 1.0, samples: 30, peak_load: load, worst_joint: "elbow_flex".into(), joints: Vec::new(), smoothing: Vec::new(), measured_vs_model: Vec::new(), notices: Vec::new() };
+        let summary = |label: &str, load: f64| EpisodeSummary { label: label.into(), index: None, duration: 1.0, samples: 30, peak_load: load, worst_joint: "elbow_flex".into(), joints: Vec::new(), smoothing: Vec::new(), measured_vs_model: Vec::new(), notices: Vec::new(), past_limits: Vec::new() };
         let text = ranking_text(&[summary("episode 0", f64::INFINITY), summary("episode 1", 0.42)]);
         assert!(text.contains("too fast") && text.contains("42%"), "{text}");
         assert!(!text.contains("inf") && !text.contains("NaN"), "{text}");

@@ -33,8 +33,8 @@ pub fn survey(replayer: &Replayer, source: &Source, episodes: &[i64], feature: &
         let (commanded, observed) = source.read_forward(index, feature, commands)?;
         // the positions as the replay maps them (the smoothing and the torques a replay works out
         // are not needed here)
-        let commanded_at = mapped_positions(&replayer.model, &replayer.map.only_columns_of(&commanded), &commanded, &mut Vec::new())?;
-        let observed_at = mapped_positions(&replayer.model, &replayer.map, &observed, &mut Vec::new())?;
+        let (commanded_at, _) = mapped_positions(&replayer.model, &replayer.map.only_columns_of(&commanded), &commanded)?;
+        let (observed_at, _) = mapped_positions(&replayer.model, &replayer.map, &observed)?;
         let depth = floor.map(|f| depth_below(replayer, f, &observed_at, observed.time.len()));
         Ok((index, following::sweeps(&commanded_at, &observed_at), depth))
     })?;
