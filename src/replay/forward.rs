@@ -144,7 +144,8 @@ pub struct ForwardCase {
     held: Vec<usize>,
     latency: Latency,
     schedule: PathBuf,
-    /// Where the commands' and the follower's positions passed a joint's URDF limit.
+    /// Where the commands' or the follower's positions passed a joint's URDF limit, the largest
+    /// excess per joint.
     past_limits: Vec<super::past_limits::PastLimit>,
 }
 
@@ -182,7 +183,7 @@ impl ForwardCase {
         // command_delay)
         let latency = latency.unwrap_or_else(|| Latency::given(schedule::frame_period(&command), "one frame"));
         schedule::write_delayed(schedule, &command, latency.seconds)?;
-        let past_limits = command.past_limits.iter().chain(&reality.past_limits).cloned().collect();
+        let past_limits = super::past_limits::largest_per_joint(command.past_limits.iter().chain(&reality.past_limits));
         Ok(Self { label: commands.label.clone(), command, reality, mapped, uncommanded, held, latency, schedule: schedule.to_path_buf(), past_limits })
     }
 
@@ -552,7 +553,7 @@ impl ForwardSummary {
     pub fn of(index: i64, replay: &ForwardReplay, notices: Vec<String>) -> Self {
         let trips: Vec<serde_json::Value> = replay.protection_trips.iter().map(|(joint, trip)| serde_json::json!({ "joint": joint, "trip": trip })).collect();
         let servo_delays: serde_json::Map<String, serde_json::Value> = replay.servo_delays.iter().map(|(joint, d)| (joint.clone(), serde_json::json!(d))).collect();
-        let document = serde_json::json!({ "episode": index, "latency_s": replay.latency.seconds, "latency_from": replay.latency.from, "servo_command_delay_s": servo_delays, "joints": replay.joints, "protection_trips": trips, "uncommanded": replay.uncommanded });
+        let document = serde_json::json!({ "episode": index, "latency_s": replay.latency.seconds, "latency_from": replay.latency.from, "servo_command_delay_s": servo_delays, "joints": replay.joints, "protection_trips": trips, "uncommanded": replay.uncommanded, "past_limits": replay.past_limits });
         let widest_gap = replay.joints.iter().filter(|g| g.follows).map(|g| g.gap_mae).fold(0.0, f64::max);
         Self { index, widest_gap, text: text(replay), document, notices, past_limits: replay.past_limits.clone() }
     }

@@ -16,15 +16,20 @@ pub const PRISMATIC_EXCESS_MAX: f64 = 0.02;
 const ROUND_OFF: f64 = 1e-9;
 
 /// One joint's largest excess past its URDF range in a series of recorded positions.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct PastLimit {
     /// The model's coordinate.
+    #[serde(skip)]
     pub joint: usize,
-    /// How far past, rad (m).
+    #[serde(rename = "joint")]
+    pub name: String,
+    /// How far past, rad (m for a prismatic joint).
     pub excess: f64,
     /// Where: the episode's label, its frame and the frame's time, s.
+    #[serde(skip)]
     pub episode: String,
     pub frame: usize,
+    #[serde(rename = "time_s")]
     pub time: f64,
 }
 
@@ -63,10 +68,24 @@ pub fn follow_to_limits(model: &Model, episode: &Episode, mut mapped: Vec<Option
             *v = v.clamp(lower, upper);
         }
         if worst.0 > ROUND_OFF {
-            past.push(PastLimit { joint: j, excess: worst.0, episode: episode.label.clone(), frame: worst.1, time: episode.time[worst.1] });
+            past.push(PastLimit { joint: j, name: model.joints[j].name.clone(), excess: worst.0, episode: episode.label.clone(), frame: worst.1, time: episode.time[worst.1] });
         }
     }
     Ok((mapped, past))
+}
+
+/// Of `past`, the largest excess of each joint, by joint.
+pub fn largest_per_joint<'a>(past: impl IntoIterator<Item = &'a PastLimit>) -> Vec<PastLimit> {
+    let mut largest: Vec<PastLimit> = Vec::new();
+    for p in past {
+        match largest.iter_mut().find(|l| l.joint == p.joint) {
+            Some(l) if p.excess > l.excess => *l = p.clone(),
+            Some(_) => {}
+            None => largest.push(p.clone()),
+        }
+    }
+    largest.sort_by_key(|p| p.joint);
+    largest
 }
 
 /// The one notice of a recording's positions past the URDF's limits, each episode's [`PastLimit`]s
@@ -74,18 +93,10 @@ pub fn follow_to_limits(model: &Model, episode: &Episode, mut mapped: Vec<Option
 /// in how many of the episodes (None: no position passed a limit).
 pub fn notice(model: &Model, episodes: &[&[PastLimit]]) -> Option<String> {
     let passed = episodes.iter().filter(|p| !p.is_empty()).count();
-    let mut largest: Vec<&PastLimit> = Vec::new();
-    for p in episodes.iter().flat_map(|p| p.iter()) {
-        match largest.iter_mut().find(|l| l.joint == p.joint) {
-            Some(l) if p.excess > l.excess => *l = p,
-            Some(_) => {}
-            None => largest.push(p),
-        }
-    }
+    let largest = largest_per_joint(episodes.iter().flat_map(|p| p.iter()));
     if largest.is_empty() {
         return None;
     }
-    largest.sort_by_key(|p| p.joint);
     let lone = episodes.len() == 1;
     let each = largest
         .iter()
