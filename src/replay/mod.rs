@@ -2,7 +2,8 @@
 //! needed, held against what its motor gives.
 //!
 //! config (URDF, payload, tool, motors) → [`Replayer`] (the model built once) → per episode:
-//! [`smoothing`] → [`inverse`] → [`verdict`] → [`report`] (text, JSON) and [`trace`] (CSV);
+//! [`past_limits`] → [`smoothing`] → [`inverse`] → [`verdict`] → [`report`] (text, JSON) and
+//! [`trace`] (CSV);
 //! forward, the commands followed by the simulated arm and held against the real follower
 //! ([`forward`]; the part of its gap made at rest: [`at_rest`]; where its tool went:
 //! [`tool_height`]).
