@@ -170,9 +170,9 @@ fn poses_past_a_urdf_limit_are_followed_to_it_and_impossible_ones_refused() {
     let motors = common::repo().join("assets/motors/so101.toml");
     for forward in [false, true] {
         let summary = dir.path().join("two.json");
-        let mut args = vec!["replay", root.to_str().unwrap(), "--urdf", urdf.to_str().unwrap(), "--no-rrd", "--no-mcap"];
+        let mut args = vec!["replay", root.to_str().unwrap(), "--urdf", urdf.to_str().unwrap(), "--no-rrd", "--no-mcap", "--summary-json", summary.to_str().unwrap()];
         if forward {
-            args.extend(["--forward", "--motors", motors.to_str().unwrap(), "--summary-json", summary.to_str().unwrap()]);
+            args.extend(["--forward", "--motors", motors.to_str().unwrap()]);
         }
         let (code, _, stderr) = run(&args);
         assert_eq!(code, 0, "{stderr}");
@@ -180,15 +180,14 @@ fn poses_past_a_urdf_limit_are_followed_to_it_and_impossible_ones_refused() {
         assert_eq!(notices.len(), 1, "{stderr}");
         let by: f64 = notices[0].split("elbow_flex by up to ").nth(1).and_then(|r| r.split('°').next()).and_then(|x| x.parse().ok()).unwrap_or_else(|| panic!("{}", notices[0]));
         assert!(notices[0].contains("in 2 of 2 episodes") && (2.8..=3.1).contains(&by) && notices[0].contains("(episode 1, frame"), "forward {forward}: {}", notices[0]);
-        if forward {
-            // and each episode's in its JSON: 1° and 3° past, elbow_flex alone
-            let doc: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&summary).unwrap()).unwrap();
-            for episode in doc["episodes"].as_array().unwrap() {
-                let past = episode["past_limits"].as_array().unwrap();
-                let want = if episode["episode"] == 0 { 1.0 } else { 3.0 };
-                let excess = past[0]["excess"].as_f64().unwrap().to_degrees();
-                assert!(past.len() == 1 && past[0]["joint"] == "elbow_flex" && (excess - want).abs() < 0.2, "{episode}");
-            }
+        // and each episode's in its JSON: 1° and 3° past, elbow_flex alone
+        let doc: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&summary).unwrap()).unwrap();
+        for episode in doc["episodes"].as_array().unwrap() {
+            let past = episode["past_limits"].as_array().unwrap();
+            let index = if forward { &episode["episode"] } else { &episode["index"] };
+            let want = if *index == 0 { 1.0 } else { 3.0 };
+            let excess = past[0]["excess"].as_f64().unwrap().to_degrees();
+            assert!(past.len() == 1 && past[0]["joint"] == "elbow_flex" && (excess - want).abs() < 0.2, "forward {forward}: {episode}");
         }
     }
     past[2].terms[0].0 = 0.3 + 25f64.to_radians();

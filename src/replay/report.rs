@@ -21,7 +21,6 @@ pub struct EpisodeSummary {
     pub measured_vs_model: Vec<Option<EffortGap>>,
     pub notices: Vec<String>,
     /// Where its positions passed a joint's URDF limit (said once for the recording).
-    #[serde(skip)]
     pub past_limits: Vec<super::past_limits::PastLimit>,
 }
 
