@@ -160,3 +160,19 @@ def test_replay_gives_each_episodes_motion_and_the_torque_it_needed(model, tmp_p
     assert np.allclose(peak, np.abs(ep.tau).max(axis=0), atol=1e-12)
     with pytest.raises(armscope.ArmscopeError, match="units: 'furlongs'"):
         armscope.replay(csv, SO101, units="furlongs")
+
+
+def test_a_replay_past_a_urdf_limit_is_followed_to_it_and_said_in_one_warning(model, tmp_path):
+    # elbow_flex's URDF limit is 1.69 rad: a real arm's 3 degrees past it is followed to the limit
+    t = np.arange(0, 4, 1 / 30)
+    elbow = model.joint_names.index("elbow_flex")
+    q = np.stack([0.3 * np.sin(1.3 * t + j) for j in range(model.nq)], axis=1)
+    q[:, elbow] = 1.39 + (0.3 + np.radians(3)) * np.sin(1.3 * t)
+    csv = tmp_path / "past.csv"
+    np.savetxt(csv, np.column_stack([t, q]), delimiter=",", header="t," + ",".join(model.joint_names), comments="")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        (ep,) = armscope.replay(csv, SO101)
+    past = [str(w.message) for w in caught if "past the URDF's limits" in str(w.message)]
+    assert len(past) == 1 and "elbow_flex by up to" in past[0], past
+    assert ep.q[:, elbow].max() <= 1.69 + 1e-12
