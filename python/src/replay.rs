@@ -73,7 +73,7 @@ pub fn replay<'py>(
         d.set_item("verdicts_json", serde_json::to_string(&replayed.verdicts).map_err(crate::error)?)?;
         out.push(d);
     }
-    if let Some(notice) = armscope::replay::past_limits::notice(&replayer.model, &past.iter().map(Vec::as_slice).collect::<Vec<_>>()) {
+    if let Some(notice) = armscope::replay::past_limits::notice(&replayer.model, past.iter().map(Vec::as_slice)) {
         warnings.call_method1("warn", (format!("armscope: {notice}"),))?;
     }
     Ok(out)

@@ -206,8 +206,7 @@ pub fn identify_arm(args: &IdentifyArgs, dataset: &Path) -> Result<i32, Error> {
     };
     let train_cases = train.iter().map(|&e| prepare(e)).collect::<Result<Vec<_>, _>>()?;
     let validate_cases = arm.validate_episodes.iter().map(|&e| prepare(e)).collect::<Result<Vec<_>, _>>()?;
-    let past: Vec<&[_]> = train_cases.iter().chain(&validate_cases).map(|c| c.past_limits()).collect();
-    if let Some(notice) = crate::replay::past_limits::notice(&model, &past) {
+    if let Some(notice) = crate::replay::past_limits::notice(&model, train_cases.iter().chain(&validate_cases).map(|c| c.past_limits())) {
         eprintln!("armscope: notice: {notice}");
     }
 

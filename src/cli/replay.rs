@@ -129,8 +129,7 @@ pub fn replay(args: &ReplayArgs) -> Result<i32, Error> {
             eprintln!("armscope: notice: {notice}");
         }
     }
-    let past: Vec<&[_]> = summaries.iter().map(|s| s.past_limits.as_slice()).collect();
-    if let Some(notice) = crate::replay::past_limits::notice(&replayer.model, &past) {
+    if let Some(notice) = crate::replay::past_limits::notice(&replayer.model, summaries.iter().map(|s| s.past_limits.as_slice())) {
         eprintln!("armscope: notice: {notice}");
     }
     if several {
@@ -233,8 +232,7 @@ fn forward(args: &ReplayArgs, replayer: &Replayer, source: &crate::motion::Sourc
             eprintln!("armscope: notice: {notice}");
         }
     }
-    let past: Vec<&[_]> = summaries.iter().map(|s| s.past_limits.as_slice()).collect();
-    if let Some(notice) = crate::replay::past_limits::notice(&replayer.model, &past) {
+    if let Some(notice) = crate::replay::past_limits::notice(&replayer.model, summaries.iter().map(|s| s.past_limits.as_slice())) {
         eprintln!("armscope: notice: {notice}");
     }
     if !several {

@@ -264,7 +264,7 @@ fn recorded_motions(args: &SizeArgs, source: &std::path::Path, base: RunConfig) 
         let name = if several { format!("episode {index}") } else { "recording".to_string() };
         out.push((name, RunConfig { trajectory: Some(path), duration: args.duration.unwrap_or(length), q0: Some(q0), ..base.clone() }));
     }
-    if let Some(notice) = crate::replay::past_limits::notice(&replayer.model, &past.iter().map(Vec::as_slice).collect::<Vec<_>>()) {
+    if let Some(notice) = crate::replay::past_limits::notice(&replayer.model, past.iter().map(Vec::as_slice)) {
         eprintln!("armscope: notice: {notice}");
     }
     Ok(out)

@@ -91,13 +91,18 @@ pub fn largest_per_joint<'a>(past: impl IntoIterator<Item = &'a PastLimit>) -> V
 /// The one notice of a recording's positions past the URDF's limits, each episode's [`PastLimit`]s
 /// given (its commands' and its follower's together): the largest excess per joint and where, and
 /// in how many of the episodes (None: no position passed a limit).
-pub fn notice(model: &Model, episodes: &[&[PastLimit]]) -> Option<String> {
-    let passed = episodes.iter().filter(|p| !p.is_empty()).count();
-    let largest = largest_per_joint(episodes.iter().flat_map(|p| p.iter()));
+pub fn notice<'a>(model: &Model, episodes: impl IntoIterator<Item = &'a [PastLimit]>) -> Option<String> {
+    let (mut count, mut passed, mut all) = (0, 0, Vec::new());
+    for past in episodes {
+        count += 1;
+        passed += usize::from(!past.is_empty());
+        all.extend(past);
+    }
+    let largest = largest_per_joint(all);
     if largest.is_empty() {
         return None;
     }
-    let lone = episodes.len() == 1;
+    let lone = count == 1;
     let each = largest
         .iter()
         .map(|p| {
@@ -109,5 +114,5 @@ pub fn notice(model: &Model, episodes: &[&[PastLimit]]) -> Option<String> {
         })
         .collect::<Vec<_>>()
         .join(", ");
-    Some(if lone { format!("{}: past the URDF's limits, followed to the limit: {each}", largest[0].episode) } else { format!("past the URDF's limits in {passed} of {} episodes, followed to the limit: {each}", episodes.len()) })
+    Some(if lone { format!("{}: past the URDF's limits, followed to the limit: {each}", largest[0].episode) } else { format!("past the URDF's limits in {passed} of {count} episodes, followed to the limit: {each}") })
 }
