@@ -59,6 +59,14 @@ pub trait Motor: Debug + Send + Sync {
     fn as_bus_servo(&self) -> Option<&BusServo> {
         None
     }
+    /// A copy of it, boxed (a drive train is copied per candidate in identification).
+    fn boxed_clone(&self) -> Box<dyn Motor>;
+}
+
+impl Clone for Box<dyn Motor> {
+    fn clone(&self) -> Self {
+        self.boxed_clone()
+    }
 }
 
 /// A drive train's part as a body the arm carries: the motor (a solid cylinder where the catalogue
@@ -91,7 +99,7 @@ impl Part {
 
 /// A motor behind a gearbox: the joint turns `gear_ratio` times slower than the motor, and the
 /// gearbox's losses act as friction at the joint by the direction power flows ([`LossyGear`]).
-#[derive(Debug)]
+#[derive(Clone, Debug)]
 pub struct DriveTrain {
     pub motor: Box<dyn Motor>,
     pub gear_ratio: f64,
@@ -290,7 +298,7 @@ impl DriveTrain {
 }
 
 /// The drive trains of a model's joints (by coordinate; `None`: the URDF's constant effort limit).
-#[derive(Debug, Default)]
+#[derive(Clone, Debug, Default)]
 pub struct MotorSet {
     pub joints: Vec<Option<DriveTrain>>,
     /// Per coordinate, the driver's microsteps per full step (steppers).

@@ -17,6 +17,9 @@ pub struct DcServo {
 }
 
 impl Motor for DcServo {
+    fn boxed_clone(&self) -> Box<dyn Motor> {
+        Box::new(self.clone())
+    }
     fn torque_at(&self, speed: f64) -> f64 {
         self.torque_speed().at(speed, self).0
     }

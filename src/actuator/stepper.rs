@@ -55,6 +55,9 @@ impl Stepper {
 }
 
 impl Motor for Stepper {
+    fn boxed_clone(&self) -> Box<dyn Motor> {
+        Box::new(self.clone())
+    }
     fn torque_at(&self, speed: f64) -> f64 {
         match &self.pull_out {
             // the closed form (it never asks the motor back)

@@ -8,7 +8,7 @@
 use super::cmaes::Cmaes;
 use super::space::Space;
 use crate::actuator::bus_servo::ServoParams;
-use crate::actuator::{MotorSet, load_motor_file};
+use crate::actuator::MotorSet;
 use crate::error::Error;
 use crate::model::Model;
 use crate::replay::forward::{Drives, FollowSetup, ForwardCase, gap_within};
@@ -211,6 +211,9 @@ impl ArmSpace {
 pub struct ArmObjective<'a> {
     pub model: &'a Model,
     pub motor_file: &'a Path,
+    /// The motor file's drives as read once (each candidate's are a copy with its parameters:
+    /// reading the file and its catalogue again would cost a tenth of a candidate's run).
+    pub drives: &'a MotorSet,
     pub tool: Option<&'a str>,
     pub space: &'a ArmSpace,
     pub cases: &'a [ForwardCase],
@@ -222,8 +225,8 @@ pub struct ArmObjective<'a> {
 
 impl ArmObjective<'_> {
     /// The motor file's drives with the servo parameters `params` (by kind).
-    pub fn motors(&self, params: &[ServoParams]) -> Result<MotorSet, Error> {
-        let mut set = load_motor_file(self.motor_file, self.model)?;
+    pub fn motors(&self, params: &[ServoParams]) -> MotorSet {
+        let mut set = self.drives.clone();
         if self.floor.is_some() {
             set.floor = self.floor;
         }
@@ -234,7 +237,7 @@ impl ArmObjective<'_> {
                 }
             }
         }
-        Ok(set)
+        set
     }
 
     /// The frames × fitted joints the loss averages over.
@@ -247,7 +250,7 @@ impl ArmObjective<'_> {
     /// (past the cutoff: a lower bound, enough to rank it last).
     pub fn loss(&self, u: &[f64], cutoff: f64) -> f64 {
         let (params, payload, offsets) = self.space.decode(u);
-        let make = || self.motors(&params);
+        let make = || Ok(self.motors(&params));
         let setup = FollowSetup { payload, tool: self.tool, offsets: (!self.space.offsets.is_empty()).then_some(offsets.as_slice()), without_floor: false };
         let samples = self.samples().max(1) as f64;
         let budget = if cutoff.is_finite() { cutoff * samples } else { f64::INFINITY };

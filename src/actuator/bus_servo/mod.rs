@@ -198,6 +198,9 @@ impl BusServo {
 }
 
 impl Motor for BusServo {
+    fn boxed_clone(&self) -> Box<dyn Motor> {
+        Box::new(self.clone())
+    }
     fn torque_at(&self, speed: f64) -> f64 {
         self.drive(self.firmware.family.max_duty, speed.abs(), self.supply, true).torque.max(0.0)
     }
