@@ -306,7 +306,7 @@ pub fn identify_arm(args: &IdentifyArgs, dataset: &Path) -> Result<i32, Error> {
         );
     }
     let search_cases: Vec<ForwardCase> = chosen.iter().map(|&i| train_cases[i].clone()).collect();
-    let objective = ArmObjective { model: &model, motor_file: motors, drives: &start_set, tool: arm.tool.as_deref(), space: &space, cases: &search_cases, fitted: is_fitted.clone(), floor };
+    let objective = ArmObjective { model: &model, drives: &start_set, tool: arm.tool.as_deref(), space: &space, cases: &search_cases, fitted: is_fitted.clone(), floor };
     let searches = match args.searches {
         0 if fit_payload => SEARCHES_WITH_PAYLOAD,
         0 => 1,

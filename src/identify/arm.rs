@@ -12,7 +12,6 @@ use crate::actuator::MotorSet;
 use crate::error::Error;
 use crate::model::Model;
 use crate::replay::forward::{Drives, FollowSetup, ForwardCase, gap_within};
-use std::path::Path;
 
 /// The servo parameters an arm's motion tells: the loop's gain and the motor's torque (k_t, the
 /// error gain), the rotor's inertia, the friction's base and viscous parts, and the command delay.
@@ -210,9 +209,9 @@ impl ArmSpace {
 /// The mean gap over the training episodes of a candidate: what the search minimises.
 pub struct ArmObjective<'a> {
     pub model: &'a Model,
-    pub motor_file: &'a Path,
-    /// The motor file's drives as read once (each candidate's are a copy with its parameters:
-    /// reading the file and its catalogue again would cost a tenth of a candidate's run).
+    /// The motor file's drives as read once (its path their `source`); each candidate's are a copy
+    /// with its parameters: reading the file and its catalogue again for each of a candidate's
+    /// runs took 5 % of its instructions.
     pub drives: &'a MotorSet,
     pub tool: Option<&'a str>,
     pub space: &'a ArmSpace,
@@ -256,7 +255,7 @@ impl ArmObjective<'_> {
         let budget = if cutoff.is_finite() { cutoff * samples } else { f64::INFINITY };
         let mut sum = 0.0;
         for case in self.cases {
-            match gap_within(self.model, case, &Drives::Made { file: self.motor_file, make: &make }, &setup, &self.fitted, budget - sum) {
+            match gap_within(self.model, case, &Drives::Made { file: &self.drives.source, make: &make }, &setup, &self.fitted, budget - sum) {
                 Ok((part, stopped)) => {
                     sum += part;
                     if stopped {
