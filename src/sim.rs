@@ -51,9 +51,11 @@ pub fn simulate_beside(experiment: &Experiment, recorders: &mut [&mut dyn Record
 }
 
 /// A run for its joint positions alone (identification's candidates, run hundreds of times): the
-/// same motion as [`simulate`]'s, with the energy audit's divergence check, but no statistics and no
-/// tool poses (the samples' `tool_position` and `tool_target` are zero). Its status: completed,
-/// interrupted or diverged.
+/// same motion as [`simulate`]'s, with the energy audit's divergence check, but no statistics, no
+/// tool poses and no figures of the drives and joints beside their torques (the samples'
+/// `tool_position` and `tool_target` are zero; their saturation, torque limits, chatter, duty,
+/// current, supply, limit and friction flags and winding temperatures stay at their start). Its
+/// status: completed, interrupted or diverged.
 pub fn simulate_positions(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], stop: Option<&AtomicBool>) -> Result<RunStatus, Error> {
     Ok(simulate_loop(experiment, recorders, stop, None, None, Keep::Positions)?.status)
 }
@@ -154,13 +156,15 @@ fn simulate_loop(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], s
         if let Some(s) = servos.as_mut() {
             // no PD on a servo joint: its firmware's position loop sets the duty toward the command
             s.command(&cmd, &q, &v, plant_step, &mut u);
-            s.outputs(&mut duty, &mut current, &mut supply);
-            for j in (0..n).filter(|&j| s.driven[j]) {
-                saturated[j] = s.saturated(j);
-                torque_limit[j] = s.limit(j, u[j], v[j]);
+            if everything {
+                s.outputs(&mut duty, &mut current, &mut supply);
+                for j in (0..n).filter(|&j| s.driven[j]) {
+                    saturated[j] = s.saturated(j);
+                    torque_limit[j] = s.limit(j, u[j], v[j]);
+                }
             }
         }
-        for i in 0..n {
+        for i in (0..n).filter(|_| everything) {
             // (a slipping stepper's torque swings sign with its lag: that is the motor, not the loop)
             let stepped = steppers.as_ref().is_some_and(|s| s.stepped[i]);
             chatter[i] = !stepped && k > 0 && u[i] * previous_u[i] < 0.0 && (saturated[i] || previous_saturated[i]);
@@ -228,7 +232,7 @@ fn simulate_loop(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], s
             }
             break;
         }
-        if heat.any() {
+        if everything && heat.any() {
             // the motors carry this step's torque (a stepper's as it stood at the control step)
             heat.step(&u);
         }
@@ -267,10 +271,13 @@ fn simulate_loop(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], s
                 stats.lost_steps(e);
             }
         }
-        at_limit.copy_from_slice(plant.limit_active());
-        if has_friction {
-            friction.copy_from_slice(plant.friction_torque());
-            stuck.copy_from_slice(plant.stuck());
+        // (the limits' and the friction's flags, for the samples: they do not move the arm)
+        if everything {
+            at_limit.copy_from_slice(plant.limit_active());
+            if has_friction {
+                friction.copy_from_slice(plant.friction_torque());
+                stuck.copy_from_slice(plant.stuck());
+            }
         }
         if let Some(diverged) = divergence(experiment, &q, &v, t + dt) {
             status = diverged;

@@ -84,7 +84,8 @@ impl PdGravityController {
 
     #[allow(clippy::too_many_arguments)]
     pub fn compute(&self, q: &[f64], v: &[f64], cmd: &[f64], cmd_dot: &[f64], tau_g: &[f64], mut out: ControlOutput) {
-        for i in 0..q.len() {
+        // (a joint driven elsewhere skipped before its PD: on an arm of servos, every joint)
+        for i in (0..q.len()).filter(|&i| !self.elsewhere[i]) {
             let mut u = self.kp[i] * (cmd[i] - q[i]) + self.kd[i] * (cmd_dot[i] - v[i]);
             if self.feed_forward {
                 u -= tau_g[i];
