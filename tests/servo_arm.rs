@@ -263,11 +263,13 @@ fn protection_registers_are_checked_and_set_in_their_units() {
     assert!((overload.protective - 0.2).abs() < 1e-12 && (overcurrent.time - 2.0).abs() < 1e-12, "the others keep the factory's");
 }
 
-/// Every sample's joint positions and speeds, and its tool position.
+/// Every sample's joint positions and speeds, its tool position, and its servos' duty and torque
+/// limits.
 #[derive(Default)]
 struct Motion {
     states: Vec<(Vec<f64>, Vec<f64>)>,
     tool: Vec<[f64; 3]>,
+    drive: Vec<(Vec<f64>, Vec<f64>)>,
 }
 
 impl armscope::recorder::Recorder for Motion {
@@ -277,6 +279,7 @@ impl armscope::recorder::Recorder for Motion {
     fn record(&mut self, s: &armscope::sample::Sample) -> Result<(), armscope::error::Error> {
         self.states.push((s.q.to_vec(), s.v.to_vec()));
         self.tool.push([s.tool_position.x, s.tool_position.y, s.tool_position.z]);
+        self.drive.push((s.duty.to_vec(), s.torque_limit.to_vec()));
         Ok(())
     }
     fn finish(&mut self, _: &armscope::recorder::RunInfo, _: &armscope::summary::Summary) -> Result<(), armscope::error::Error> {
@@ -287,7 +290,7 @@ impl armscope::recorder::Recorder for Motion {
 #[test]
 fn a_positions_only_run_moves_exactly_as_the_full_run() {
     // identification runs each candidate for its joint positions alone (no statistics, no tool
-    // poses): the motion must be the full run's to the bit, the SO-101 on its servos carrying 0.2 kg
+    // poses, no drive figures): the motion must be the full run's to the bit, the SO-101 on its servos carrying 0.2 kg
     // along its default trajectory
     let config = RunConfig { urdf: so101(), motors: Some(so101_motors()), payload: 0.2, duration: 1.5, ..RunConfig::default() };
     let experiment = Experiment::prepare(config).unwrap();
@@ -304,6 +307,9 @@ fn a_positions_only_run_moves_exactly_as_the_full_run() {
     // the full run's tool moves; the positions-only run's samples carry none
     assert!(full.tool.iter().any(|p| p != &full.tool[0]));
     assert!(lean.tool.iter().all(|p| p == &[0.0; 3]));
+    // nor the servos' duty and torque limits, which the full run's show
+    assert!(full.drive.iter().any(|(duty, limit)| duty.iter().any(|&d| d != 0.0) && limit.iter().all(|&l| l > 0.0)));
+    assert!(lean.drive.iter().all(|(duty, limit)| duty.iter().chain(limit).all(|&x| x == 0.0)));
 }
 
 #[test]
