@@ -164,12 +164,14 @@ fn simulate_loop(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], s
                 }
             }
         }
-        for i in (0..n).filter(|_| everything) {
-            // (a slipping stepper's torque swings sign with its lag: that is the motor, not the loop)
-            let stepped = steppers.as_ref().is_some_and(|s| s.stepped[i]);
-            chatter[i] = !stepped && k > 0 && u[i] * previous_u[i] < 0.0 && (saturated[i] || previous_saturated[i]);
-            previous_u[i] = u[i];
-            previous_saturated[i] = saturated[i];
+        if everything {
+            for i in 0..n {
+                // (a slipping stepper's torque swings sign with its lag: that is the motor, not the loop)
+                let stepped = steppers.as_ref().is_some_and(|s| s.stepped[i]);
+                chatter[i] = !stepped && k > 0 && u[i] * previous_u[i] < 0.0 && (saturated[i] || previous_saturated[i]);
+                previous_u[i] = u[i];
+                previous_saturated[i] = saturated[i];
+            }
         }
         if everything {
             body_poses(model, &cmd, &mut command_poses);
