@@ -72,7 +72,20 @@ impl Experiment {
 
     /// As [`Self::with_model`], with the motors given directly instead of by `config.motors` (which
     /// only names their file here): how `armscope size` tries candidate motor sets.
-    pub fn with_motors(config: RunConfig, mut model: Model, motors: Option<MotorSet>) -> Result<Self, Error> {
+    pub fn with_motors(config: RunConfig, model: Model, motors: Option<MotorSet>) -> Result<Self, Error> {
+        Self::build(config, model, motors, None)
+    }
+
+    /// As [`Self::with_motors`], following `schedule`: the one `config.trajectory` names, already
+    /// read (a forward replay follows one episode's schedule once per candidate motor set).
+    pub fn following(config: RunConfig, model: Model, motors: Option<MotorSet>, schedule: JointSchedule) -> Result<Self, Error> {
+        if config.trajectory.is_none() {
+            return Err(Error::flag("--trajectory", "a schedule to follow is given, but the configuration names none"));
+        }
+        Self::build(config, model, motors, Some(schedule))
+    }
+
+    fn build(config: RunConfig, mut model: Model, motors: Option<MotorSet>, schedule: Option<JointSchedule>) -> Result<Self, Error> {
         // the URDF's own numbers first: its errors name the file
         crate::dynamics::check_solvable(&model)?;
         let positive = |flag: &str, value: f64| {
@@ -102,7 +115,10 @@ impl Experiment {
         // the experiment is fitted to the robot as its URDF describes it (ranges, effort limits);
         // a payload and motors are then tried on it
         let mut start = start_pose(&config, &model)?;
-        let trajectory = trajectory(&config, &mut model, &mut start)?;
+        let trajectory: Box<dyn Trajectory> = match schedule {
+            Some(schedule) => Box::new(schedule),
+            None => trajectory(&config, &mut model, &mut start)?,
+        };
         let mut model = model.with_payload(config.payload);
         if let Some(set) = &motors {
             install_drive_trains(&mut model, set)?;

@@ -1,6 +1,6 @@
 //! The simulation loop: controller and plant at the control rate, every sample to every recorder.
 
-use crate::dynamics::{Data, body_poses, forward_kinematics, frame_pose, frame_pose_in, gravity_and_bias_from_kinematics, kinetic_energy_from_velocities, potential_energy_from_kinematics};
+use crate::dynamics::{Data, body_poses, forward_kinematics, frame_pose, frame_pose_in, gravity_and_bias_from_kinematics, kinetic_energy_from_momenta, potential_energy_from_kinematics};
 use crate::model::Model;
 use crate::error::Error;
 use crate::experiment::Experiment;
@@ -239,7 +239,7 @@ fn simulate_loop(experiment: &Experiment, recorders: &mut [&mut dyn Recorder], s
             heat.step(&u);
         }
         if let Some(a) = audit.as_mut() {
-            // the loop's passes left the kinematics and body velocities at (q_k, q̇_k) in data
+            // the loop's passes left the kinematics and body velocities and momenta at (q_k, q̇_k) in data
             if let Some(diverged) = a.period_start(model, &data, &v, t) {
                 status = diverged;
                 break;
@@ -361,7 +361,7 @@ impl EnergyAudit {
 
     /// At control step k: books E_k against E_{k−1} and the work in between.
     fn period_start(&mut self, model: &Model, data: &Data, v: &[f64], time: f64) -> Option<RunStatus> {
-        let energy = kinetic_energy_from_velocities(model, data, v) + potential_energy_from_kinematics(model, data);
+        let energy = kinetic_energy_from_momenta(model, data, v) + potential_energy_from_kinematics(model, data);
         if let Some(previous) = self.previous_energy {
             self.created += energy - previous - self.period_work;
         }

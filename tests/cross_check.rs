@@ -6,7 +6,7 @@
 
 mod common;
 
-use armscope::dynamics::{Data, aba, bias_forces, body_poses, crba, forward_kinematics, frame_jacobian, frame_pose, frame_pose_in, gravity_forces, kinetic_energy, kinetic_energy_from_velocities, rnea};
+use armscope::dynamics::{Data, aba, bias_forces, body_poses, crba, forward_kinematics, frame_jacobian, frame_pose, frame_pose_in, frame_vertical_jacobian, gravity_and_bias_from_kinematics, gravity_forces, kinetic_energy, kinetic_energy_from_momenta, kinetic_energy_from_velocities, rnea};
 use armscope::model::load_urdf_str;
 use common::random_tree::{tree, urdf};
 use nalgebra::{DMatrix, DVector};
@@ -75,6 +75,12 @@ proptest! {
         rnea(&model, &mut data, &q, &v, &vec![0.0; v.len()]);
         let after_rnea = kinetic_energy_from_velocities(&model, &data, &v);
         prop_assert!((from_m - after_rnea).abs() <= 1e-10 * from_m.abs().max(1.0));
+        // and from the momenta the simulation loop's gravity-and-bias pass leaves: the same
+        // products summed in the same order, so the same bits (the energy audit relies on it)
+        forward_kinematics(&model, &mut data, &q);
+        gravity_and_bias_from_kinematics(&model, &mut data, &v);
+        let (from_momenta, from_velocities) = (kinetic_energy_from_momenta(&model, &data, &v), kinetic_energy_from_velocities(&model, &data, &v));
+        prop_assert_eq!(from_momenta.to_bits(), from_velocities.to_bits());
     }
 
     #[test]
@@ -99,6 +105,12 @@ proptest! {
         forward_kinematics(&model, &mut data, &q);
         let mut jac = DMatrix::zeros(6, n);
         frame_jacobian(&model, &data, tool, &mut jac);
+        // the floor contact's vertical row alone is that row of the Jacobian, bit for bit
+        let mut vertical = vec![f64::NAN; n];
+        frame_vertical_jacobian(&model, &data, tool, &frame_pose(&model, &data, tool).translation, &mut vertical);
+        for (c, z) in vertical.iter().enumerate() {
+            prop_assert_eq!(z.to_bits(), jac[(5, c)].to_bits(), "coordinate {}", c);
+        }
         let twist = &jac * DVector::from_vec(v.clone());
         let eps = 1e-6;
         let at = |s: f64, data: &mut Data| {

@@ -16,6 +16,8 @@ pub struct Data {
     /// Body spatial velocities and accelerations (RNEA, ABA).
     pub velocity: Vec<Vector6<f64>>,
     pub acceleration: Vec<Vector6<f64>>,
+    /// Body spatial momenta I·v (the gravity-and-bias pass: what the energy audit's ½ vᵀ I v reuses).
+    pub momentum: Vec<Vector6<f64>>,
     /// Body forces (RNEA) and gravity wrenches (gravity pass).
     pub force: Vec<Vector6<f64>>,
     pub gravity_force: Vec<Vector6<f64>>,
@@ -50,6 +52,7 @@ impl Data {
             body_inertia: vec![SpatialInertia::zero(); b],
             velocity: vec![Vector6::zeros(); b],
             acceleration: vec![Vector6::zeros(); b],
+            momentum: vec![Vector6::zeros(); b],
             force: vec![Vector6::zeros(); b],
             gravity_force: vec![Vector6::zeros(); b],
             composite_inertia: vec![SpatialInertia::zero(); b],

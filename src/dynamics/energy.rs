@@ -23,6 +23,15 @@ pub fn kinetic_energy_from_velocities(model: &Model, data: &Data, v: &[f64]) -> 
     0.5 * (bodies + rotors)
 }
 
+/// [`kinetic_energy_from_velocities`] from the body velocities and momenta the gravity-and-bias pass
+/// ([`super::gravity_and_bias_from_kinematics`]) left in `data` at (q, q̇): the same sum of the same
+/// products, without applying each body's inertia a second time.
+pub fn kinetic_energy_from_momenta(model: &Model, data: &Data, v: &[f64]) -> f64 {
+    let bodies: f64 = (0..model.bodies.len()).map(|i| data.velocity[i].dot(&data.momentum[i])).sum();
+    let rotors: f64 = model.armature.iter().zip(v).map(|(a, v)| a * v * v).sum();
+    0.5 * (bodies + rotors)
+}
+
 /// The potential energy of gravity, −Σ m·g·c (c each body's centre of mass in the world), zero with
 /// every centre of mass at the world origin; from the body poses already in `data`.
 pub fn potential_energy_from_kinematics(model: &Model, data: &Data) -> f64 {

@@ -1,7 +1,7 @@
 use super::{Data, frame_pose};
 use crate::model::Model;
 use crate::spatial::{angular, linear};
-use nalgebra::DMatrix;
+use nalgebra::{DMatrix, Vector3};
 
 /// Geometric Jacobian of a frame's origin in world axes (6 × dof): rows 0–2 angular velocity,
 /// rows 3–5 the velocity of the frame origin. Uses the last `forward_kinematics`.
@@ -20,6 +20,21 @@ pub fn frame_jacobian(model: &Model, data: &Data, frame: usize, out: &mut DMatri
             out[(r, c)] += w[r];
             out[(r + 3, c)] += v[r];
         }
+        body = model.bodies[j].parent;
+    }
+}
+
+/// Row 5 of [`frame_jacobian`] (the world-vertical velocity of the point `origin`, the frame's
+/// origin, per coordinate) into `out`, with the same arithmetic: bit for bit that row, without the
+/// other five (a floor contact needs only the vertical).
+pub fn frame_vertical_jacobian(model: &Model, data: &Data, frame: usize, origin: &Vector3<f64>, out: &mut [f64]) {
+    out.fill(0.0);
+    let mut body = model.frames[frame].body;
+    while let Some(j) = body {
+        let s = &data.motion_subspace[j];
+        let w = angular(s);
+        // the z of linear(S) + w × origin
+        out[model.couplings[j].coordinate] += linear(s)[2] + (w[0] * origin[1] - w[1] * origin[0]);
         body = model.bodies[j].parent;
     }
 }

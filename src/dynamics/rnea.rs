@@ -63,8 +63,10 @@ pub fn gravity_and_bias_from_kinematics(model: &Model, data: &mut Data, v: &[f64
         let vel = v_parent + joint_velocity;
         let acc = a_parent + cross_motion(&vel, &joint_velocity);
         let inertia = &data.body_inertia[i];
-        data.force[i] = inertia.mul_motion(&acc) + cross_force(&vel, &inertia.mul_motion(&vel));
+        let momentum = inertia.mul_motion(&vel);
+        data.force[i] = inertia.mul_motion(&acc) + cross_force(&vel, &momentum);
         data.gravity_force[i] = inertia.mul_linear(&g);
+        data.momentum[i] = momentum;
         data.velocity[i] = vel;
         data.acceleration[i] = acc;
     }

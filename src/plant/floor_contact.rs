@@ -9,9 +9,8 @@
 //! solved without it. Its work is booked with the friction's for the energy audit.
 
 use super::stick_slip::{JointLaw, NotPositiveDefinite, StickSlipSolver};
-use crate::dynamics::{Data, frame_jacobian, frame_pose};
+use crate::dynamics::{Data, frame_pose, frame_vertical_jacobian};
 use crate::model::Model;
-use nalgebra::DMatrix;
 
 /// Where the floor is: a frame whose origin rests on it at `height` (world z, m).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -34,7 +33,7 @@ const FASTEST_POINT: f64 = 50.0;
 /// The contact and its buffers (sized once: no allocation within a step).
 pub struct FloorSolve {
     pub contact: FloorContact,
-    jacobian: DMatrix<f64>,
+    /// The point's world-vertical velocity per coordinate (its Jacobian's z row).
     normal: Vec<f64>,
     /// M with the contact's h·(C + h·K)·JᵀJ, by columns as M is.
     pressed: Vec<f64>,
@@ -49,7 +48,6 @@ impl FloorSolve {
     pub fn new(contact: FloorContact, dof: usize) -> Self {
         Self {
             contact,
-            jacobian: DMatrix::zeros(6, dof),
             normal: vec![0.0; dof],
             pressed: vec![0.0; dof * dof],
             rhs: vec![0.0; dof],
@@ -66,14 +64,12 @@ impl FloorSolve {
     #[allow(clippy::too_many_arguments)]
     pub fn impose(&mut self, model: &Model, data: &Data, h: f64, v: &[f64], solver: &mut StickSlipSolver, mass: &[f64], damping: &[f64], rhs: &[f64], laws: &[JointLaw], v_next: &mut [f64], residual: &mut [f64]) -> Result<(), NotPositiveDefinite> {
         self.work = 0.0;
-        let height = frame_pose(model, data, self.contact.frame).translation.z;
+        let point = frame_pose(model, data, self.contact.frame).translation;
+        let height = point.z;
         if height - self.contact.height > FASTEST_POINT * h {
             return Ok(());
         }
-        frame_jacobian(model, data, self.contact.frame, &mut self.jacobian);
-        for (j, n) in self.normal.iter_mut().enumerate() {
-            *n = self.jacobian[(5, j)];
-        }
+        frame_vertical_jacobian(model, data, self.contact.frame, &point, &mut self.normal);
         let speed = |x: &[f64], normal: &[f64]| normal.iter().zip(x).map(|(n, x)| n * x).sum::<f64>();
         let depth = self.contact.height - height;
         if depth - h * speed(v_next, &self.normal) <= 0.0 {
