@@ -19,8 +19,7 @@ pub fn kinetic_energy(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) -> f
 /// RNEA, or the loop's gravity-and-bias pass).
 pub fn kinetic_energy_from_velocities(model: &Model, data: &Data, v: &[f64]) -> f64 {
     let bodies: f64 = (0..model.bodies.len()).map(|i| data.velocity[i].dot(&data.body_inertia[i].mul_motion(&data.velocity[i]))).sum();
-    let rotors: f64 = model.armature.iter().zip(v).map(|(a, v)| a * v * v).sum();
-    0.5 * (bodies + rotors)
+    0.5 * (bodies + rotors_twice(model, v))
 }
 
 /// [`kinetic_energy_from_velocities`] from the body velocities and momenta the gravity-and-bias pass
@@ -28,8 +27,12 @@ pub fn kinetic_energy_from_velocities(model: &Model, data: &Data, v: &[f64]) -> 
 /// products, without applying each body's inertia a second time.
 pub fn kinetic_energy_from_momenta(model: &Model, data: &Data, v: &[f64]) -> f64 {
     let bodies: f64 = (0..model.bodies.len()).map(|i| data.velocity[i].dot(&data.momentum[i])).sum();
-    let rotors: f64 = model.armature.iter().zip(v).map(|(a, v)| a * v * v).sum();
-    0.5 * (bodies + rotors)
+    0.5 * (bodies + rotors_twice(model, v))
+}
+
+/// Σ J_r·N²·q̇² over the coordinates: twice the motors' rotors' kinetic energy.
+fn rotors_twice(model: &Model, v: &[f64]) -> f64 {
+    model.armature.iter().zip(v).map(|(a, v)| a * v * v).sum()
 }
 
 /// The potential energy of gravity, −Σ m·g·c (c each body's centre of mass in the world), zero with

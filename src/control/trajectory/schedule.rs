@@ -58,6 +58,11 @@ impl JointSchedule {
         &self.positions[k * self.dof..(k + 1) * self.dof]
     }
 
+    /// The interpolation's tangents at the schedule's k-th time.
+    fn tangent_row(&self, k: usize) -> &[f64] {
+        &self.tangents[k * self.dof..(k + 1) * self.dof]
+    }
+
     /// k with times[k] ≤ t < times[k + 1], for t within the schedule.
     fn interval(&self, t: f64) -> usize {
         let times = &self.times;
@@ -122,11 +127,9 @@ impl Trajectory for JointSchedule {
         let (s2, s3) = (s * s, s * s * s);
         let (h00, h10, h01, h11) = (2.0 * s3 - 3.0 * s2 + 1.0, s3 - 2.0 * s2 + s, -2.0 * s3 + 3.0 * s2, s3 - s2);
         let (d00, d10, d01, d11) = (6.0 * s2 - 6.0 * s, 3.0 * s2 - 4.0 * s + 1.0, -6.0 * s2 + 6.0 * s, 3.0 * s2 - 2.0 * s);
-        let n = self.dof;
-        let (p0, p1) = (&self.positions[k * n..(k + 1) * n], &self.positions[(k + 1) * n..(k + 2) * n]);
-        let (m0, m1) = (&self.tangents[k * n..(k + 1) * n], &self.tangents[(k + 1) * n..(k + 2) * n]);
-        let cmd_dot = &mut cmd_dot[..n];
-        for (j, c) in cmd[..n].iter_mut().enumerate() {
+        let (p0, p1, m0, m1) = (self.row(k), self.row(k + 1), self.tangent_row(k), self.tangent_row(k + 1));
+        let cmd_dot = &mut cmd_dot[..self.dof];
+        for (j, c) in cmd[..self.dof].iter_mut().enumerate() {
             let (p0, p1, m0, m1) = (p0[j], p1[j], m0[j], m1[j]);
             *c = h00 * p0 + h10 * h * m0 + h01 * p1 + h11 * h * m1;
             cmd_dot[j] = (d00 * p0 + d01 * p1) / h + d10 * m0 + d11 * m1;
