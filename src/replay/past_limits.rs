@@ -1,7 +1,9 @@
 //! Recorded positions past a joint's URDF range. A real arm's calibrated range commonly passes its
 //! URDF's limits by a few degrees: such positions are followed to the limit, and a recording's
 //! largest excess per joint said in one notice (over all its episodes, commands and follower alike);
-//! a position that cannot be the arm's is refused, naming the joint, episode, frame and value.
+//! a position that cannot be the arm's is refused, naming the joint, episode, frame and value. A
+//! revolute joint's position is an angle: a full-turn encoder (a wrist roll's) wraps at ±180°, so a
+//! position closer to the range a turn round is read there, and the notice says so.
 
 use crate::error::Error;
 use crate::model::{JointKind, Model};
@@ -31,6 +33,9 @@ pub struct PastLimit {
     pub frame: usize,
     #[serde(rename = "time_s")]
     pub time: f64,
+    /// Whether any of the joint's positions was read a turn round from where it was recorded.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub turned: bool,
 }
 
 /// A joint's range, [−∞, ∞] where the URDF gives none.
@@ -44,18 +49,42 @@ fn unit_of(model: &Model, j: usize) -> (f64, &'static str, f64) {
     if model.joints[j].kind == JointKind::Prismatic { (PRISMATIC_EXCESS_MAX, "mm", 1e3) } else { (REVOLUTE_EXCESS_MAX, "°", 180.0 / std::f64::consts::PI) }
 }
 
+/// How far `value` lies past [lower, upper] (≤ 0 within it).
+fn excess_of(value: f64, lower: f64, upper: f64) -> f64 {
+    (value - upper).max(lower - value)
+}
+
+/// A revolute joint's `value` past its range, or the same angle a turn round where that is closer to
+/// the range (a full-turn encoder wraps at ±180°, and a range spanning most of a turn reaches past it).
+fn nearest_turn(value: f64, lower: f64, upper: f64) -> f64 {
+    let turn = std::f64::consts::TAU;
+    let round = if value > upper { value - turn } else { value + turn };
+    if excess_of(round, lower, upper) < excess_of(value, lower, upper) { round } else { value }
+}
+
 /// `episode`'s positions `mapped` onto the model's coordinates, followed to each joint's limit where
-/// they pass it, and per joint that passed it the largest excess; a position past it by more than
-/// [`REVOLUTE_EXCESS_MAX`] ([`PRISMATIC_EXCESS_MAX`]) refused in one line.
+/// they pass it (a revolute joint's read a turn round where that is nearer its range), and per joint
+/// that passed it the largest excess; a position past it by more than [`REVOLUTE_EXCESS_MAX`]
+/// ([`PRISMATIC_EXCESS_MAX`]) refused in one line.
 pub fn follow_to_limits(model: &Model, episode: &Episode, mut mapped: Vec<Option<Vec<f64>>>) -> Result<(Vec<Option<Vec<f64>>>, Vec<PastLimit>), Error> {
     let mut past = Vec::new();
     for (j, series) in mapped.iter_mut().enumerate() {
         let Some(values) = series else { continue };
         let (lower, upper) = range_of(model, j);
         let (refused_past, unit, scale) = unit_of(model, j);
-        let mut worst = (0.0, 0usize);
+        // a range of a turn or more holds every angle: a position past it is the joint's own
+        let angle = model.joints[j].kind == JointKind::Revolute && upper - lower < std::f64::consts::TAU;
+        let (mut worst, mut first_turned) = ((0.0, 0usize), None);
         for (k, v) in values.iter_mut().enumerate() {
-            let excess = (*v - upper).max(lower - *v);
+            let mut excess = excess_of(*v, lower, upper);
+            if angle && excess > ROUND_OFF {
+                let round = nearest_turn(*v, lower, upper);
+                if round != *v {
+                    *v = round;
+                    excess = excess_of(round, lower, upper);
+                    first_turned.get_or_insert(k);
+                }
+            }
             if excess > refused_past {
                 return Err(Error::flag(
                     episode.label.clone(),
@@ -67,20 +96,23 @@ pub fn follow_to_limits(model: &Model, episode: &Episode, mut mapped: Vec<Option
             }
             *v = v.clamp(lower, upper);
         }
-        if worst.0 > ROUND_OFF {
-            past.push(PastLimit { joint: j, name: model.joints[j].name.clone(), excess: worst.0, episode: episode.label.clone(), frame: worst.1, time: episode.time[worst.1] });
+        // positions read a turn round into the range are said too, where the first was
+        let frame = if worst.0 > ROUND_OFF { Some(worst.1) } else { first_turned };
+        if let Some(frame) = frame {
+            let excess = worst.0.max(0.0);
+            past.push(PastLimit { joint: j, name: model.joints[j].name.clone(), excess, episode: episode.label.clone(), frame, time: episode.time[frame], turned: first_turned.is_some() });
         }
     }
     Ok((mapped, past))
 }
 
-/// Of `past`, the largest excess of each joint, by joint.
+/// Of `past`, the largest excess of each joint (read a turn round if any was), by joint.
 pub fn largest_per_joint<'a>(past: impl IntoIterator<Item = &'a PastLimit>) -> Vec<PastLimit> {
     let mut largest: Vec<PastLimit> = Vec::new();
     for p in past {
         match largest.iter_mut().find(|l| l.joint == p.joint) {
-            Some(l) if p.excess > l.excess => *l = p.clone(),
-            Some(_) => {}
+            Some(l) if p.excess > l.excess => *l = PastLimit { turned: l.turned || p.turned, ..p.clone() },
+            Some(l) => l.turned |= p.turned,
             None => largest.push(p.clone()),
         }
     }
@@ -108,11 +140,80 @@ pub fn notice<'a>(model: &Model, episodes: impl IntoIterator<Item = &'a [PastLim
         .map(|p| {
             let (_, unit, scale) = unit_of(model, p.joint);
             let at = if lone { String::new() } else { format!("{}, ", p.episode) };
+            let name = &model.joints[p.joint].name;
+            if p.excess <= ROUND_OFF {
+                return format!("{name} read a turn round into its range (360° from where it was recorded; {at}frame {}, {:.2} s)", p.frame, p.time);
+            }
             // an excess that rounds to nothing is still said
             let by = if p.excess * scale < 0.05 { format!("less than 0.1{unit}") } else { format!("up to {:.1}{unit}", p.excess * scale) };
-            format!("{} by {by} ({at}frame {}, {:.2} s)", model.joints[p.joint].name, p.frame, p.time)
+            let turned = if p.turned { ", some of it read a turn round (360° from where it was recorded, nearer the range)" } else { "" };
+            format!("{name} by {by} ({at}frame {}, {:.2} s{turned})", p.frame, p.time)
         })
         .collect::<Vec<_>>()
         .join(", ");
     Some(if lone { format!("{}: past the URDF's limits, followed to the limit: {each}", largest[0].episode) } else { format!("past the URDF's limits in {passed} of {count} episodes, followed to the limit: {each}") })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn so101() -> Model {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/robots/so101.urdf");
+        crate::model::load_urdf(&path).expect("the fixture loads")
+    }
+
+    /// An episode of `frames` frames at 30 fps; only its label and times are read here.
+    fn episode(frames: usize) -> Episode {
+        Episode { label: "episode 0".into(), index: Some(0), time: (0..frames).map(|k| k as f64 / 30.0).collect(), columns: vec![], effort: vec![], notices: vec![] }
+    }
+
+    /// The model's positions with joint `j`'s series `values` (in degrees) and the others absent.
+    fn one_joint(model: &Model, j: usize, degrees: &[f64]) -> Vec<Option<Vec<f64>>> {
+        (0..model.dof()).map(|i| (i == j).then(|| degrees.iter().map(|d| d.to_radians()).collect())).collect()
+    }
+
+    #[test]
+    fn a_wrist_roll_past_its_wrap_is_read_a_turn_round_and_followed_to_the_nearer_limit() {
+        // the SO-101's wrist roll spans −157.2°…162.8°; its full-turn encoder reads ±180°: −179° is
+        // +181°, 18.2° past the upper limit (21.8° past the lower read as recorded, which would be
+        // refused); −175° is nearer the lower limit as recorded (17.8° against 22.2°)
+        let model = so101();
+        let roll = model.joint_index("wrist_roll").unwrap();
+        let (lower, upper) = range_of(&model, roll);
+        let (mapped, past) = follow_to_limits(&model, &episode(4), one_joint(&model, roll, &[0.0, 179.0, -179.0, -175.0])).unwrap();
+        let followed = mapped[roll].as_ref().unwrap();
+        assert_eq!(followed[0], 0.0);
+        assert_eq!(&followed[1..], &[upper, upper, lower]);
+        assert_eq!(past.len(), 1);
+        let want = (181f64 - upper.to_degrees()).to_radians();
+        assert!((past[0].excess - want).abs() < 1e-12 && past[0].frame == 2 && past[0].turned, "{past:?}");
+        let said = notice(&model, [past.as_slice()]).unwrap();
+        assert!(said.contains("wrist_roll by up to 18.2° (frame 2, 0.07 s, some of it read a turn round"), "{said}");
+    }
+
+    #[test]
+    fn a_joint_whose_range_spans_less_than_the_excess_allowed_is_read_as_recorded() {
+        // the elbow spans ±96.8°: a turn round is never nearer its range, and 25° past it is refused
+        let model = so101();
+        let elbow = model.joint_index("elbow_flex").unwrap();
+        let upper = range_of(&model, elbow).1.to_degrees();
+        let (mapped, past) = follow_to_limits(&model, &episode(2), one_joint(&model, elbow, &[0.0, upper + 3.0])).unwrap();
+        assert_eq!(mapped[elbow].as_ref().unwrap()[1], range_of(&model, elbow).1);
+        assert!(!past[0].turned && (past[0].excess.to_degrees() - 3.0).abs() < 1e-9, "{past:?}");
+        let refused = follow_to_limits(&model, &episode(2), one_joint(&model, elbow, &[0.0, upper + 25.0])).unwrap_err().to_string();
+        assert!(refused.contains("episode 0") && refused.contains("joint 'elbow_flex': frame 1") && refused.contains("past its URDF range"), "{refused}");
+    }
+
+    #[test]
+    fn a_position_read_a_turn_round_into_the_range_is_said() {
+        // 210° is −150°, inside the wrist roll's range: followed there, and the notice says why
+        let model = so101();
+        let roll = model.joint_index("wrist_roll").unwrap();
+        let (mapped, past) = follow_to_limits(&model, &episode(3), one_joint(&model, roll, &[0.0, 0.0, 210.0])).unwrap();
+        assert!((mapped[roll].as_ref().unwrap()[2] - (-150f64).to_radians()).abs() < 1e-12);
+        assert!(past.len() == 1 && past[0].excess == 0.0 && past[0].frame == 2 && past[0].turned, "{past:?}");
+        let said = notice(&model, [past.as_slice()]).unwrap();
+        assert!(said.contains("wrist_roll read a turn round into its range (360° from where it was recorded; frame 2, 0.07 s)"), "{said}");
+    }
 }
