@@ -197,3 +197,36 @@ fn poses_past_a_urdf_limit_are_followed_to_it_and_impossible_ones_refused() {
     let error: Vec<&str> = stderr.lines().filter(|l| l.starts_with("armscope: error:")).collect();
     assert!(error.len() == 1 && error[0].contains("episode 0: joint 'elbow_flex': frame") && error[0].contains("past its URDF range"), "{stderr}");
 }
+
+#[test]
+fn a_wrist_roll_recorded_past_its_encoders_wrap_is_read_a_turn_round_and_both_replays_start() {
+    // the wrist roll's full-turn encoder reads ±180° in degrees; the URDF spans −157.2°…162.8°: a
+    // roll resting at −179° (tick 11) is +181°, 18.2° past the upper limit (as recorded, 21.8° past
+    // the lower: more than the 20° refused)
+    let dir = tempfile::tempdir().unwrap();
+    let urdf = so101();
+    let model = load_urdf(&urdf).unwrap();
+    let mut resting = motions();
+    resting[4] = Sines { center: (-179f64).to_radians(), terms: vec![] };
+    let root = write(dir.path(), "roll", |_| Storage::Degrees { sign: 1.0, offset: 0.0 }, resting);
+    let motors = common::repo().join("assets/motors/so101.toml");
+    let trace = dir.path().join("q.csv");
+    for forward in [false, true] {
+        let mut args = vec!["replay", root.to_str().unwrap(), "--urdf", urdf.to_str().unwrap(), "--no-rrd", "--no-mcap"];
+        if forward {
+            args.extend(["--forward", "--motors", motors.to_str().unwrap()]);
+        } else {
+            args.extend(["--trace", trace.to_str().unwrap()]);
+        }
+        let (code, _, stderr) = run(&args);
+        assert_eq!(code, 0, "forward {forward}: {stderr}");
+        let notice = stderr.lines().find(|l| l.contains("past the URDF's limits")).unwrap_or_else(|| panic!("{stderr}"));
+        // the stored degrees' quantum is 0.09°
+        let by: f64 = notice.split("wrist_roll by up to ").nth(1).and_then(|r| r.split('°').next()).and_then(|x| x.parse().ok()).unwrap_or_else(|| panic!("{notice}"));
+        assert!((by - 18.2).abs() <= 0.1 && notice.contains("some of it read a turn round"), "forward {forward}: {notice}");
+    }
+    let upper = model.joints[model.joint_index("wrist_roll").unwrap()].upper;
+    let rolls: Vec<f64> = trace_q(&trace).iter().map(|row| row[4]).collect();
+    // at the upper limit, within the smoothing's round-off of a constant series
+    assert!(rolls.iter().all(|&q| (q - upper).abs() < 1e-12), "the roll is followed to its upper limit {upper}: {rolls:?}");
+}
