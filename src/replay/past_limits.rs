@@ -54,12 +54,13 @@ fn excess_of(value: f64, lower: f64, upper: f64) -> f64 {
     (value - upper).max(lower - value)
 }
 
-/// A revolute joint's `value` past its range, or the same angle a turn round where that is closer to
-/// the range (a full-turn encoder wraps at ±180°, and a range spanning most of a turn reaches past it).
-fn nearest_turn(value: f64, lower: f64, upper: f64) -> f64 {
+/// The same angle as a revolute joint's `value`, past its range, a turn round, where that is closer
+/// to the range (a full-turn encoder wraps at ±180°, and a range spanning most of a turn reaches past
+/// it); None where `value` is the closer.
+fn nearer_a_turn_round(value: f64, lower: f64, upper: f64) -> Option<f64> {
     let turn = std::f64::consts::TAU;
     let round = if value > upper { value - turn } else { value + turn };
-    if excess_of(round, lower, upper) < excess_of(value, lower, upper) { round } else { value }
+    (excess_of(round, lower, upper) < excess_of(value, lower, upper)).then_some(round)
 }
 
 /// `episode`'s positions `mapped` onto the model's coordinates, followed to each joint's limit where
@@ -73,13 +74,12 @@ pub fn follow_to_limits(model: &Model, episode: &Episode, mut mapped: Vec<Option
         let (lower, upper) = range_of(model, j);
         let (refused_past, unit, scale) = unit_of(model, j);
         // a range of a turn or more holds every angle: a position past it is the joint's own
-        let angle = model.joints[j].kind == JointKind::Revolute && upper - lower < std::f64::consts::TAU;
+        let wraps = model.joints[j].kind == JointKind::Revolute && upper - lower < std::f64::consts::TAU;
         let (mut worst, mut first_turned) = ((0.0, 0usize), None);
         for (k, v) in values.iter_mut().enumerate() {
             let mut excess = excess_of(*v, lower, upper);
-            if angle && excess > ROUND_OFF {
-                let round = nearest_turn(*v, lower, upper);
-                if round != *v {
+            if wraps && excess > ROUND_OFF {
+                if let Some(round) = nearer_a_turn_round(*v, lower, upper) {
                     *v = round;
                     excess = excess_of(round, lower, upper);
                     first_turned.get_or_insert(k);
@@ -99,8 +99,7 @@ pub fn follow_to_limits(model: &Model, episode: &Episode, mut mapped: Vec<Option
         // positions read a turn round into the range are said too, where the first was
         let frame = if worst.0 > ROUND_OFF { Some(worst.1) } else { first_turned };
         if let Some(frame) = frame {
-            let excess = worst.0.max(0.0);
-            past.push(PastLimit { joint: j, name: model.joints[j].name.clone(), excess, episode: episode.label.clone(), frame, time: episode.time[frame], turned: first_turned.is_some() });
+            past.push(PastLimit { joint: j, name: model.joints[j].name.clone(), excess: worst.0, episode: episode.label.clone(), frame, time: episode.time[frame], turned: first_turned.is_some() });
         }
     }
     Ok((mapped, past))
@@ -168,7 +167,7 @@ mod tests {
         Episode { label: "episode 0".into(), index: Some(0), time: (0..frames).map(|k| k as f64 / 30.0).collect(), columns: vec![], effort: vec![], notices: vec![] }
     }
 
-    /// The model's positions with joint `j`'s series `values` (in degrees) and the others absent.
+    /// The model's positions with joint `j`'s series (given in degrees) and the others absent.
     fn one_joint(model: &Model, j: usize, degrees: &[f64]) -> Vec<Option<Vec<f64>>> {
         (0..model.dof()).map(|i| (i == j).then(|| degrees.iter().map(|d| d.to_radians()).collect())).collect()
     }
@@ -193,7 +192,7 @@ mod tests {
     }
 
     #[test]
-    fn a_joint_whose_range_spans_less_than_the_excess_allowed_is_read_as_recorded() {
+    fn a_joint_whose_range_is_far_from_a_turn_is_read_as_recorded_and_refused_past_the_excess_allowed() {
         // the elbow spans ±96.8°: a turn round is never nearer its range, and 25° past it is refused
         let model = so101();
         let elbow = model.joint_index("elbow_flex").unwrap();
