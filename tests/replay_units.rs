@@ -105,6 +105,26 @@ fn a_range_dataset_is_read_as_a_range_and_its_calibration_gives_the_motors_angle
             assert!((a[j] - b[j]).abs() < 1e-12, "{a:?} vs {b:?}");
         }
     }
+    // a map holding only the calibration (a path from the map's folder) is the built-in map with it,
+    // as --calibration: the unit still decided from the values and said, the same angles to the bit
+    let maps = dir.path().join("maps");
+    std::fs::create_dir(&maps).unwrap();
+    let only = maps.join("calibration_only.toml");
+    std::fs::write(&only, format!("calibration = \"../{}\"\n", cal.file_name().unwrap().to_str().unwrap())).unwrap();
+    let from_map = dir.path().join("from_map.csv");
+    let (code, _, stderr) = run(&["replay", root_s, "--urdf", urdf.to_str().unwrap(), "--joint-map", only.to_str().unwrap(), "--trace", from_map.to_str().unwrap(), "--no-rrd", "--no-mcap"]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(stderr.contains("the body joints read as LeRobot's RANGE_M100_100") && stderr.contains("angles from the middle of each motor's calibrated range in"), "{stderr}");
+    assert_eq!(trace_q(&from_map), q);
+    // it and --calibration both, or a map with neither joints nor a calibration: one line naming it
+    let (code, _, stderr) = run(&["replay", root_s, "--urdf", urdf.to_str().unwrap(), "--joint-map", only.to_str().unwrap(), "--calibration", cal.to_str().unwrap(), "--no-rrd", "--no-mcap"]);
+    assert_eq!(code, 2);
+    assert!(stderr.trim_end().ends_with("names its calibration file itself (its 'calibration' field)") && stderr.contains("calibration_only.toml"), "{stderr}");
+    let empty = maps.join("empty.toml");
+    std::fs::write(&empty, "# to fill in\n").unwrap();
+    let (code, _, stderr) = run(&["replay", root_s, "--urdf", urdf.to_str().unwrap(), "--joint-map", empty.to_str().unwrap(), "--no-rrd", "--no-mcap"]);
+    assert_eq!(code, 2);
+    assert!(stderr.contains("empty.toml: neither [joints.NAME] entries nor a calibration file"), "{stderr}");
     // a joint that barely moves leaves too few values to tell its range: its limits, said approximate
     let mut still = motions();
     still[4] = Sines { center: 0.0, terms: vec![(0.004, 0.9, 0.0)] };

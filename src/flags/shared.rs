@@ -119,8 +119,9 @@ pub struct RecordedMotionArgs {
     #[arg(long, default_value = "observation.state")]
     pub feature: String,
     /// How the recording's columns become the URDF's joints (TOML: `[joints.NAME] column, unit,
-    /// sign, offset`; optionally a LeRobot `calibration` file). Built in: bags and tables named by
-    /// joint in SI units, the SO-101's LeRobot datasets.
+    /// sign, offset`; optionally a LeRobot `calibration` file; a file with only `calibration` gives
+    /// it to the built-in map). Built in: bags and tables named by joint in SI units, the SO-101's
+    /// LeRobot datasets.
     #[arg(long, value_name = "FILE")]
     pub joint_map: Option<PathBuf>,
     /// A bag's joint-state topic (default: /joint_states, or the only one).

@@ -19,7 +19,8 @@
 //!
 //! The SO-101's LeRobot datasets have a built-in map; their body joints' unit (degrees, or LeRobot's
 //! RANGE_M100_100, the SO followers' default before 2026-02-13) is not in the dataset:
-//! [`decide_body_unit`] tells it from the values where they tell it.
+//! [`decide_body_unit`] tells it from the values where they tell it. A map file with only a
+//! `calibration` line gives the built-in map that calibration file, as `--calibration` does.
 
 use super::{Episode, SourceKind};
 use crate::error::Error;
@@ -98,9 +99,16 @@ pub struct JointMap {
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
-struct MapFile {
+struct MapToml {
     calibration: Option<PathBuf>,
-    joints: BTreeMap<String, JointEntry>,
+    joints: Option<BTreeMap<String, JointEntry>>,
+}
+
+/// What a map file gives: joints of its own, or — a file with no `[joints]` — only the LeRobot
+/// calibration file for the built-in map (the SO-101's), as `--calibration` gives it.
+pub enum MapFile {
+    Joints(JointMap),
+    Calibration(PathBuf),
 }
 
 #[derive(Deserialize)]
@@ -130,18 +138,28 @@ const SO101_JOINTS: [(&str, Unit); 6] = [("shoulder_pan", Unit::Deg), ("shoulder
 impl JointMap {
     /// Read a map file and check its joints against the model.
     pub fn load(path: &Path, model: &Model) -> Result<Self, Error> {
+        match Self::read(path, model)? {
+            MapFile::Joints(map) => Ok(map),
+            MapFile::Calibration(_) => Err(Error::flag(path.display().to_string(), "no [joints.NAME] entries: a map of its own needs them")),
+        }
+    }
+
+    /// Read a map file: its joints checked against the model, or, where it has no `[joints]`, the
+    /// calibration file it names (a relative path from the map's folder) for the built-in map.
+    pub fn read(path: &Path, model: &Model) -> Result<MapFile, Error> {
         let fail = |m: String| Error::flag(path.display().to_string(), m);
         let text = std::fs::read_to_string(path).map_err(|e| fail(e.to_string()))?;
-        let file: MapFile = toml::from_str(&text).map_err(|e| fail(e.message().to_string()))?;
-        let calibration: Option<BTreeMap<String, MotorCalibration>> = match &file.calibration {
-            Some(c) => {
-                let c = if c.is_relative() { path.parent().unwrap_or(Path::new(".")).join(c) } else { c.clone() };
-                Some(read_calibration(&c)?)
-            }
-            None => None,
+        let file: MapToml = toml::from_str(&text).map_err(|e| fail(e.message().to_string()))?;
+        let calibration_path = file.calibration.map(|c| if c.is_relative() { path.parent().unwrap_or(Path::new(".")).join(c) } else { c });
+        let Some(joints) = file.joints else {
+            return match calibration_path {
+                Some(c) => Ok(MapFile::Calibration(c)),
+                None => Err(fail("neither [joints.NAME] entries nor a calibration file: nothing to map with".into())),
+            };
         };
+        let calibration: Option<BTreeMap<String, MotorCalibration>> = calibration_path.as_deref().map(read_calibration).transpose()?;
         let mut entries = Vec::new();
-        for (name, e) in file.joints {
+        for (name, e) in joints {
             let joint = model.joint_index(&name).ok_or_else(|| fail(format!("[joints.{name}]: no moving joint '{name}' in {} (joints: {})", model.source.display(), joint_names(model))))?;
             if !(e.sign == 1.0 || e.sign == -1.0) {
                 return Err(fail(format!("[joints.{name}]: sign must be 1 or -1 (got {})", e.sign)));
@@ -163,7 +181,7 @@ impl JointMap {
             entries.push(Entry { joint, column: e.column, unit: e.unit, sign: e.sign, offset: e.offset, calibration });
         }
         entries.sort_by_key(|e| e.joint);
-        Ok(Self { entries, source: path.display().to_string() })
+        Ok(MapFile::Joints(Self { entries, source: path.display().to_string() }))
     }
 
     /// The map armscope knows for this model and recording, if there is one: a bag's or a table's

@@ -201,31 +201,48 @@ pub fn open_mapped(path: &Path, topic: Option<&str>, episodes: Option<&[i64]>, f
         return Err(Error::flag(path.display().to_string(), "no episodes"));
     }
     let mut notices = Vec::new();
-    let map = match joint_map {
-        Some(file) => {
-            if reading.units.is_some() {
-                return Err(Error::flag("--units", format!("{} gives each joint's unit (its 'unit' fields)", file.display())));
+    // the user's map of its own joints; or the calibration file a map without joints names, for
+    // the built-in map (as --calibration gives it)
+    let (own, map_calibration) = match joint_map {
+        Some(file) => match JointMap::read(file, model)? {
+            joint_map::MapFile::Joints(map) => {
+                if reading.units.is_some() {
+                    return Err(Error::flag("--units", format!("{} gives each joint's unit (its 'unit' fields)", file.display())));
+                }
+                if reading.calibration.is_some() {
+                    return Err(Error::flag("--calibration", format!("{} names its calibration file itself (its 'calibration' field)", file.display())));
+                }
+                (Some(map), None)
             }
-            if reading.calibration.is_some() {
-                return Err(Error::flag("--calibration", format!("{} names its calibration file itself (its 'calibration' field)", file.display())));
+            joint_map::MapFile::Calibration(calibration) => {
+                if reading.calibration.is_some() {
+                    return Err(Error::flag("--calibration", format!("{} names its calibration file itself (its 'calibration' field)", file.display())));
+                }
+                (None, Some((file, calibration)))
             }
-            JointMap::load(file, model)?
-        }
+        },
+        None => (None, None),
+    };
+    let map = match own {
+        Some(map) => map,
         None => {
+            let calibration_file = reading.calibration.or(map_calibration.as_ref().map(|(_, c)| c.as_path()));
+            // where a calibration came from, for an error: the flag, or the map file naming it
+            let calibration_source = || map_calibration.as_ref().map_or_else(|| "--calibration".to_string(), |(file, _)| file.display().to_string());
             let first = source.read(episodes[0], feature)?;
             match JointMap::builtin(source.kind(), model, &first) {
                 Some(map) if source.kind() == SourceKind::LeRobot => {
                     // the first episodes' values, read once: they tell the unit and a range's width
                     let body: Vec<String> = map.entries.iter().filter(|e| e.unit != joint_map::Unit::Range0To100).map(|e| e.column.clone()).collect();
-                    let told = reading.units.is_none() || (reading.units == Some(BodyUnits::Range) && reading.calibration.is_none());
+                    let told = reading.units.is_none() || (reading.units == Some(BodyUnits::Range) && calibration_file.is_none());
                     let values = if told { column_values(&source, &episodes, &[feature, "action"], &body) } else { Vec::new() };
                     let (unit, why) = body_unit(&values, reading.units, path)?;
-                    let calibration = match reading.calibration {
+                    let calibration = match calibration_file {
                         Some(c) => Some((c, joint_map::read_calibration(c)?)),
                         None => None,
                     };
                     let mut map = map.with_body_unit(unit, calibration.as_ref().map(|(p, r)| (*p, r)))?;
-                    let how = match (unit, reading.calibration) {
+                    let how = match (unit, calibration_file) {
                         (joint_map::Unit::RangeM100To100, None) => lattice_ranges(&values, feature, &mut map, model),
                         (_, Some(c)) => format!("; angles from the middle of each motor's calibrated range in {}", c.display()),
                         _ => String::new(),
@@ -238,10 +255,13 @@ pub fn open_mapped(path: &Path, topic: Option<&str>, episodes: Option<&[i64]>, f
                     map
                 }
                 Some(map) => {
-                    if reading.units.is_some() || reading.calibration.is_some() {
-                        return Err(Error::flag(if reading.units.is_some() { "--units" } else { "--calibration" }, format!("{}: for a LeRobot dataset's built-in map; this recording's columns are named by joint in SI units", path.display())));
+                    if reading.units.is_some() || calibration_file.is_some() {
+                        return Err(Error::flag(if reading.units.is_some() { "--units".to_string() } else { calibration_source() }, format!("{}: a calibration file or a unit is for a LeRobot dataset's built-in map; this recording's columns are named by joint in SI units", path.display())));
                     }
                     map
+                }
+                None if map_calibration.is_some() => {
+                    return Err(Error::flag(calibration_source(), format!("no [joints.NAME] entries, and armscope knows no built-in map from {}'s columns to {}'s joints: give each joint's column and unit", path.display(), model.source.display())));
                 }
                 None => return Ok(Mapped::NeedsMap { template: JointMap::template(model, &first.column_names()) }),
             }
