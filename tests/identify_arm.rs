@@ -135,19 +135,28 @@ fn a_known_payload_is_carried_in_the_search() {
     // not the delay's to make up
     let dir = tempfile::tempdir().unwrap();
     let root = dataset(dir.path(), "loaded", &common::follower::so101_motors(), 0.15, &motions()[..2]);
-    let fit = |payload: &str, searches: &str| {
+    let fit = |payload: &str, searches: &str, settled_after: &str| {
         let (out, summary) = (dir.path().join(format!("fit{payload}.toml")), dir.path().join(format!("fit{payload}.json")));
-        let (code, _, stderr) = identify(&[
-            "--from", root.to_str().unwrap(), "--urdf", so101().to_str().unwrap(), "--motors", common::follower::so101_motors().to_str().unwrap(), "--units", "degrees",
+        let (urdf, motors) = (so101(), common::follower::so101_motors());
+        let mut args = vec![
+            "--from", root.to_str().unwrap(), "--urdf", urdf.to_str().unwrap(), "--motors", motors.to_str().unwrap(), "--units", "degrees",
             "--fit-params", "command_delay", "--payload", payload, "--searches", searches, "--generations", "20", "--out", out.to_str().unwrap(), "--summary-json", summary.to_str().unwrap(), "--quiet",
-        ]);
+        ];
+        if !settled_after.is_empty() {
+            args.extend(["--settled-after", settled_after]);
+        }
+        let (code, _, stderr) = identify(&args);
         assert_eq!(code, 0, "{stderr}");
         assert!(!stderr.contains("the payload at the tool is fitted"), "{stderr}");
         read_json(&summary)
     };
-    // one search where the payload is known (0: the default), as many as asked
-    let (told, untold) = (fit("0.15", "0"), fit("0", "2"));
+    // one search where the payload is known (0: the default), as many as asked; a search of the one
+    // delay settles (its best standing still for a third of its generations), unless told not to
+    let (told, untold) = (fit("0.15", "0", ""), fit("0", "2", "0"));
     assert_eq!(untold["searches"].as_array().unwrap().len(), 2);
+    let generations = |doc: &Value| doc["searches"].as_array().unwrap().iter().map(|s| s["generations"].as_u64().unwrap()).collect::<Vec<_>>();
+    assert_eq!(generations(&untold), [20, 20]);
+    assert!(generations(&told)[0] < 20, "{:?}", generations(&told));
     let gap = |doc: &Value| doc["gap_rad"].as_f64().unwrap();
     assert_eq!(told["payload_kg"], 0.15);
     assert_eq!(told["payload_fitted"], false);

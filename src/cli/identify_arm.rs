@@ -70,6 +70,11 @@ pub struct ArmArgs {
     /// With --from: the teleop loop's latency, s (as `replay --forward --latency`; default one frame).
     #[arg(long, value_name = "SECONDS", requires = "from")]
     pub latency: Option<f64>,
+    /// With --from: a search ends once its best gap has improved over this many generations by no
+    /// more than a tenth of the recording's reading error and 1 % of the gap (default: a third of
+    /// --generations; 0: every search runs all of them).
+    #[arg(long, value_name = "GENERATIONS", requires = "from")]
+    pub settled_after: Option<usize>,
     /// With --from: candidates run at once (default: every core).
     #[arg(long, requires = "from")]
     pub jobs: Option<usize>,
@@ -86,12 +91,21 @@ const SHORTEST_EPISODE: f64 = 2.0;
 /// Default of `--generations` with --from.
 const GENERATIONS: usize = 60;
 
+/// `--settled-after` by default: this fraction of the generations (as the bench fit's searches end
+/// once their best has not moved for a third of theirs). A search's best can stand still for a
+/// dozen generations while CMA-ES adapts its distribution, then fall on: on a simulated SO-101
+/// (`tests/identify_arm.rs`) searches stood 10–20 generations at 0.66, 2.17 and 2.75 mrad before
+/// reaching the 0.42 of the truth, and on the real SO-101's shared episodes one stood 33 at 9.09
+/// mrad, then found 0.36 (its readings' error: 0.38) in its last 15 of 60 — where the fit keeps
+/// another search's end.
+const SETTLED_AFTER_FRACTION: usize = 3;
+
 /// Searches run by default when the payload is fitted, each from the motor file's parameters with its own
 /// seed. A load at the tool trades against the servos' holding stiffness along a ridge an arm's
 /// episodes leave nearly flat: on the real SO-101's two shared episodes, seven seeds ended between
-/// no payload at ×0.37 the catalogue's stiffness and 75 g at ×0.52, their gaps within 0.22 mrad of
+/// no payload at ×0.36 the catalogue's stiffness and 81 g at ×0.55, five of them within 0.17 mrad of
 /// each other (the readings' own error there: 0.38 mrad), and one search lands on either end. Of
-/// three, the one nearest the catalogue's servo is kept (`fit_arm`); three searches take three
+/// three, the one nearest the catalogue's servo is kept (`fit_arm`); three searches take up to three
 /// times one's time (12 s each on those 25 s of episodes, on two cores).
 const SEARCHES_WITH_PAYLOAD: usize = 3;
 
@@ -313,7 +327,7 @@ pub fn identify_arm(args: &IdentifyArgs, dataset: &Path) -> Result<i32, Error> {
         n => n,
     };
     let reading_error = crate::identify::arm::reading_error(&search_cases, &is_fitted);
-    let options = ArmFitOptions { population: args.population, generations, seed: args.seed, searches, indistinct: reading_error, jobs, ..ArmFitOptions::default() };
+    let options = ArmFitOptions { population: args.population, generations, seed: args.seed, searches, indistinct: reading_error, settled_after: arm.settled_after.unwrap_or(generations / SETTLED_AFTER_FRACTION), jobs, ..ArmFitOptions::default() };
     if fit_payload {
         eprintln!(
             "armscope: notice: the payload at the tool is fitted too (0 to {} kg; --payload KG for a known one){}",
@@ -382,7 +396,15 @@ pub fn identify_arm(args: &IdentifyArgs, dataset: &Path) -> Result<i32, Error> {
             println!(
                 "  {} searches ended at {}; gaps within the recording's reading error ({:.2} mrad) are not told apart: kept the one whose servos hold nearest the motor file's (search {})",
                 found.searches.len(),
-                found.searches.iter().map(|s| format!("{:.2} mrad ({:.0} g, ×{})", 1e3 * s.loss, 1e3 * s.payload, s.holding_stiffness.iter().map(|h| format!("{h:.2}")).collect::<Vec<_>>().join("/"))).collect::<Vec<_>>().join(", "),
+                found
+                    .searches
+                    .iter()
+                    .map(|s| {
+                        let settled = if s.generations < generations { format!("; settled after {} generations", s.generations) } else { String::new() };
+                        format!("{:.2} mrad ({:.0} g, ×{}{settled})", 1e3 * s.loss, 1e3 * s.payload, s.holding_stiffness.iter().map(|h| format!("{h:.2}")).collect::<Vec<_>>().join("/"))
+                    })
+                    .collect::<Vec<_>>()
+                    .join(", "),
                 1e3 * reading_error,
                 found.kept + 1
             );

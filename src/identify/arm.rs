@@ -285,12 +285,15 @@ pub struct ArmFitOptions {
     /// Losses closer than this to the best are not told apart (rad): of the searches that end
     /// within it, the one whose servos hold nearest their start is kept.
     pub indistinct: f64,
+    /// A search ends once its best loss has improved over this many generations by no more than
+    /// [`settled_tolerance`] (0: every search runs all its generations).
+    pub settled_after: usize,
     pub jobs: usize,
 }
 
 impl Default for ArmFitOptions {
     fn default() -> Self {
-        Self { population: 0, generations: 60, sigma: 0.1, seed: 1, searches: 1, indistinct: 0.0, jobs: 1 }
+        Self { population: 0, generations: 60, sigma: 0.1, seed: 1, searches: 1, indistinct: 0.0, settled_after: 0, jobs: 1 }
     }
 }
 
@@ -304,6 +307,8 @@ pub struct SearchEnd {
     pub payload: f64,
     /// Per servo kind, its holding stiffness against its start.
     pub holding_stiffness: Vec<f64>,
+    /// The generations it ran (fewer than asked where it settled).
+    pub generations: usize,
     #[serde(skip)]
     point: Vec<f64>,
 }
@@ -348,8 +353,8 @@ pub fn reading_error(cases: &[ForwardCase], fitted: &[bool]) -> f64 {
 /// and keep, of the searches ending within `options.indistinct` of the best, the one whose servos
 /// hold nearest their start: an arm's episodes can leave a ridge (the servos' stiffness against a
 /// load at the tool) flat to well below their readings' resolution, and along it the motor file's
-/// servo (the catalogue's bench identification) is what is known. `progress` sees (generation
-/// counted over the searches, best loss so far).
+/// servo (the catalogue's bench identification) is what is known. `progress` sees (generations
+/// counted over the searches, a settled search's remaining ones with its last; best loss so far).
 pub fn fit_arm(objective: &ArmObjective, options: &ArmFitOptions, progress: &(dyn Fn(usize, f64) + Sync)) -> Result<ArmFit, Error> {
     use rayon::prelude::*;
     let pool = rayon::ThreadPoolBuilder::new().num_threads(options.jobs.max(1)).build().map_err(|e| Error::flag("--jobs", e.to_string()))?;
@@ -358,23 +363,22 @@ pub fn fit_arm(objective: &ArmObjective, options: &ArmFitOptions, progress: &(dy
     let population = if options.population >= 2 { options.population } else { super::cmaes::default_population(start.len()) };
     // the generations done over all the searches, and the best loss so far
     let so_far = std::sync::Mutex::new((0usize, start_loss));
-    let report = |loss: f64| {
+    let report = |generations: usize, loss: f64| {
         let mut so_far = so_far.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
-        *so_far = (so_far.0 + 1, so_far.1.min(loss));
+        *so_far = (so_far.0 + generations, so_far.1.min(loss));
         progress(so_far.0, so_far.1);
     };
     // the searches are independent (each its own seed: the same ends in any order), so they run
     // at once: the cores then share every search's candidates, where one search's generation at a
     // time left a core idle while its last candidates finished (186 % of two cores busy)
-    let ends: Vec<(Vec<f64>, f64, usize)> =
-        pool.install(|| (0..options.searches.max(1)).into_par_iter().map(|k| search(objective, &start, start_loss, options, population, options.seed + k as u64, &report)).collect());
+    let ends: Vec<Searched> = pool.install(|| (0..options.searches.max(1)).into_par_iter().map(|k| search(objective, &start, start_loss, options, population, options.seed + k as u64, &report)).collect());
     let mut evaluations = 1;
     let mut searches = Vec::new();
-    for (k, (point, loss, runs)) in ends.into_iter().enumerate() {
-        evaluations += runs;
-        let (params, payload, _) = objective.space.decode(&point);
+    for (k, end) in ends.into_iter().enumerate() {
+        evaluations += end.evaluations;
+        let (params, payload, _) = objective.space.decode(&end.point);
         let holding_stiffness = objective.space.kinds.iter().zip(&params).map(|(kind, p)| Strength::of(p, &kind.start).holding_stiffness).collect();
-        searches.push(SearchEnd { seed: options.seed + k as u64, loss, payload, holding_stiffness, point });
+        searches.push(SearchEnd { seed: options.seed + k as u64, loss: end.loss, payload, holding_stiffness, generations: end.generations, point: end.point });
     }
     let kept = nearest_start_of_the_best(&searches, options.indistinct);
     let point = searches[kept].point.clone();
@@ -389,15 +393,44 @@ fn nearest_start_of_the_best(searches: &[SearchEnd], indistinct: f64) -> usize {
     (0..searches.len()).filter(|&i| searches[i].loss <= best + indistinct).min_by(|&a, &b| searches[a].from_start().total_cmp(&searches[b].from_start())).unwrap_or(0)
 }
 
+/// How much a search's best loss may improve over [`ArmFitOptions::settled_after`] generations and
+/// the search count as settled, rad: a tenth of what the recording resolves (`indistinct`: further
+/// progress that small could not tell its end from another search's) and a hundredth of the loss
+/// itself (a recording the model follows to its readings' error has its parameters pinned by
+/// smaller steps).
+pub fn settled_tolerance(indistinct: f64, best: f64) -> f64 {
+    (0.1 * indistinct).min(0.01 * best)
+}
+
+/// Whether a search whose best loss after each generation so far was `history` has settled: over
+/// its last `after` generations (0: never) the best fell by no more than [`settled_tolerance`].
+fn settled(history: &[f64], after: usize, indistinct: f64) -> bool {
+    match (history.last(), history.len().checked_sub(after + 1)) {
+        (Some(&best), Some(earlier)) if after > 0 => history[earlier] - best <= settled_tolerance(indistinct, best),
+        _ => false,
+    }
+}
+
+/// Where one search ended: its best point, that point's loss, the candidates it ran and the
+/// generations.
+struct Searched {
+    point: Vec<f64>,
+    loss: f64,
+    evaluations: usize,
+    generations: usize,
+}
+
 /// One CMA-ES search from `start` (whose loss is `start_loss`), its candidates run on the current
-/// rayon pool: the best point it ran, its loss, and the candidates run. `progress` sees each
-/// generation's best loss.
-fn search(objective: &ArmObjective, start: &[f64], start_loss: f64, options: &ArmFitOptions, population: usize, seed: u64, progress: &(dyn Fn(f64) + Sync)) -> (Vec<f64>, f64, usize) {
+/// rayon pool, for `options.generations` or until it settles. `progress` sees each generation's
+/// best loss (with the generations it stands for: a settled search's last, those it leaves).
+fn search(objective: &ArmObjective, start: &[f64], start_loss: f64, options: &ArmFitOptions, population: usize, seed: u64, progress: &(dyn Fn(usize, f64) + Sync)) -> Searched {
     use rayon::prelude::*;
     let (mut best, mut best_loss) = (start.to_vec(), start_loss);
     let mut es = Cmaes::new(start, options.sigma, population, seed);
     let mut evaluations = 0;
-    for _ in 0..options.generations {
+    // the best loss after each generation
+    let mut history = Vec::with_capacity(options.generations);
+    for generation in 1..=options.generations {
         let candidates = es.ask();
         let cutoff = es.cutoff();
         let losses: Vec<f64> = candidates.points.par_iter().map(|u| objective.loss(u, cutoff)).collect();
@@ -409,21 +442,47 @@ fn search(objective: &ArmObjective, start: &[f64], start_loss: f64, options: &Ar
             }
         }
         es.tell(candidates, &losses);
-        progress(best_loss);
+        history.push(best_loss);
+        if generation < options.generations && settled(&history, options.settled_after, options.indistinct) {
+            progress(options.generations - generation + 1, best_loss);
+            break;
+        }
+        progress(1, best_loss);
     }
-    (best, best_loss, evaluations)
+    Searched { point: best, loss: best_loss, evaluations, generations: history.len() }
 }
 
 #[cfg(test)]
 mod tests {
-    use super::{SearchEnd, Strength, nearest_start_of_the_best};
+    use super::{SearchEnd, Strength, nearest_start_of_the_best, settled};
+
+    #[test]
+    fn a_search_settles_once_its_best_has_stood_still_for_as_many_generations_as_asked() {
+        // the real SO-101's search of seed 2 (mrad): 9.09 from its 12th generation on; its readings'
+        // error 0.38 mrad, so progress of up to 0.038 counts as standing still
+        let mut history: Vec<f64> = (0..11).map(|g| 1e-3 * (11.0 - 0.16 * g as f64)).collect();
+        history.extend(std::iter::repeat_n(9.09e-3, 21));
+        assert!(!settled(&history[..31], 20, 0.38e-3), "19 generations still: not yet");
+        assert!(settled(&history, 20, 0.38e-3), "20 generations still (its 32nd): settled");
+        assert!(!settled(&history, 0, 0.38e-3), "0: never");
+        // its last 15 generations of 60 found 0.36 mrad: moving, whatever the window
+        let moving: Vec<f64> = (0..21).map(|g| 1e-3 * (9.09 - 0.018 * g as f64)).collect();
+        assert!(!settled(&moving, 20, 0.38e-3));
+        // a simulated follower fitted to 0.42 mrad: steps of 0.01 mrad still count there (1 % of the
+        // gap is finer than a tenth of the readings' error)
+        let fine: Vec<f64> = (0..21).map(|g| 1e-3 * (0.62 - 0.01 * g as f64)).collect();
+        assert!(!settled(&fine, 20, 0.38e-3));
+        let still: Vec<f64> = (0..21).map(|g| 1e-3 * (0.4210 - 0.0002 * g as f64)).collect();
+        assert!(settled(&still, 20, 0.38e-3));
+    }
 
     #[test]
     fn of_the_searches_the_recording_cannot_tell_apart_the_one_nearest_the_start_is_kept() {
-        let end = |loss: f64, stiffness: f64| SearchEnd { seed: 0, loss, payload: 0.0, holding_stiffness: vec![stiffness], point: Vec::new() };
-        // the real SO-101's three searches (seeds 1–3): 8.51, 8.73 and 8.68 mrad at ×0.37, ×0.45, ×0.48
-        let ridge = [end(8.51e-3, 0.37), end(8.73e-3, 0.45), end(8.68e-3, 0.48)];
-        // its readings' error, 0.38 mrad: the three are one, the stiffest (nearest ×1) kept
+        let end = |loss: f64, stiffness: f64| SearchEnd { seed: 0, loss, payload: 0.0, holding_stiffness: vec![stiffness], generations: 60, point: Vec::new() };
+        // the real SO-101's three searches (seeds 1–3): 8.51, 9.09 and 8.68 mrad at ×0.37, ×0.54, ×0.48
+        let ridge = [end(8.51e-3, 0.37), end(9.09e-3, 0.54), end(8.68e-3, 0.48)];
+        // its readings' error, 0.38 mrad: the first and the third are one, the stiffer (nearer ×1)
+        // kept; the second, past the error, is not, though stiffer still
         assert_eq!(nearest_start_of_the_best(&ridge, 0.38e-3), 2);
         // a finer recording tells them apart: the best kept
         assert_eq!(nearest_start_of_the_best(&ridge, 0.1e-3), 0);
