@@ -397,6 +397,40 @@ fn a_joint_that_does_not_follow_is_named_and_left_out_of_the_fit() {
 }
 
 #[test]
+fn an_episode_longer_than_the_search_is_searched_on_its_first_part_and_reported_whole() {
+    // one 28 s episode (a bag is one recording): the search replays its first 25 s, as from its
+    // start; the fit is then reported on all of it
+    let dir = tempfile::tempdir().unwrap();
+    let frames = 28 * 30 + 1;
+    let root = dataset_with(dir.path(), "long", &common::follower::so101_motors(), 0.0, &motions()[..1], frames, &|_| {});
+    let summary = dir.path().join("fit.json");
+    let (code, _, stderr) = identify(&[
+        "--from", root.to_str().unwrap(), "--urdf", so101().to_str().unwrap(), "--motors", common::follower::so101_motors().to_str().unwrap(), "--units", "degrees",
+        "--fit-params", "command_delay", "--payload", "0", "--generations", "2", "--out", dir.path().join("fit.toml").to_str().unwrap(), "--summary-json", summary.to_str().unwrap(), "--quiet",
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(stderr.contains("the search runs on the first 25 s of episode 0 (25 s of the training episodes' 28 s"), "{stderr}");
+    let doc = read_json(&summary);
+    // the frames up to 25 s at 30 fps: 751 of them, 25 s from the first
+    assert_eq!(doc["searched_seconds"].as_f64().unwrap(), 25.0);
+    assert_eq!(doc["searched_episodes"], serde_json::json!([0]));
+    // the catalogue's follower against itself, a frame's delay known: followed within the encoder's
+    // quantum over the whole 28 s, the part not searched included
+    let gap = doc["train_gap_rad"].as_f64().unwrap();
+    assert!(gap < 1.53e-3, "{:.2} mrad", 1e3 * gap);
+    // what it reports is the whole episode's forward replay with the file it wrote
+    let replayed = dir.path().join("replayed.json");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_armscope"))
+        .args(["replay", root.to_str().unwrap(), "--urdf", so101().to_str().unwrap(), "--motors", dir.path().join("fit.toml").to_str().unwrap(), "--units", "degrees", "--forward", "--no-rrd", "--no-mcap", "--summary-json", replayed.to_str().unwrap()])
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let whole = read_json(&replayed);
+    assert_eq!(whole["episodes"][0]["joints"], doc["train"][0]["joints"]);
+}
+
+#[test]
 fn bad_input_is_refused_in_one_line_naming_the_episode_or_flag() {
     let dir = tempfile::tempdir().unwrap();
     let motors = common::follower::so101_motors();

@@ -47,6 +47,13 @@ impl Episode {
     pub fn column_names(&self) -> Vec<&str> {
         self.columns.iter().map(|c| c.name.as_str()).collect()
     }
+
+    /// The episode's samples up to `seconds` from its start.
+    pub fn first_seconds(&self, seconds: f64) -> Episode {
+        let kept = self.time.partition_point(|&t| t <= seconds);
+        let cut = |columns: &[Column]| columns.iter().map(|c| Column { name: c.name.clone(), values: c.values[..kept.min(c.values.len())].to_vec() }).collect();
+        Episode { time: self.time[..kept].to_vec(), columns: cut(&self.columns), effort: cut(&self.effort), ..self.clone() }
+    }
 }
 
 /// What kind of thing a recording is: its units and naming follow from it.
