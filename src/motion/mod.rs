@@ -211,23 +211,19 @@ pub fn open_mapped(path: &Path, topic: Option<&str>, episodes: Option<&[i64]>, f
     // the user's map of its own joints; or the calibration file a map without joints names, for
     // the built-in map (as --calibration gives it)
     let (own, map_calibration) = match joint_map {
-        Some(file) => match JointMap::read(file, model)? {
-            joint_map::MapFile::Joints(map) => {
-                if reading.units.is_some() {
-                    return Err(Error::flag("--units", format!("{} gives each joint's unit (its 'unit' fields)", file.display())));
-                }
-                if reading.calibration.is_some() {
-                    return Err(Error::flag("--calibration", format!("{} names its calibration file itself (its 'calibration' field)", file.display())));
-                }
-                (Some(map), None)
+        Some(file) => {
+            let read = JointMap::read(file, model)?;
+            if matches!(read, joint_map::MapFile::Joints(_)) && reading.units.is_some() {
+                return Err(Error::flag("--units", format!("{} gives each joint's unit (its 'unit' fields)", file.display())));
             }
-            joint_map::MapFile::Calibration(calibration) => {
-                if reading.calibration.is_some() {
-                    return Err(Error::flag("--calibration", format!("{} names its calibration file itself (its 'calibration' field)", file.display())));
-                }
-                (None, Some((file, calibration)))
+            if reading.calibration.is_some() {
+                return Err(Error::flag("--calibration", format!("{} names its calibration file itself (its 'calibration' field)", file.display())));
             }
-        },
+            match read {
+                joint_map::MapFile::Joints(map) => (Some(map), None),
+                joint_map::MapFile::Calibration(calibration) => (None, Some((file, calibration))),
+            }
+        }
         None => (None, None),
     };
     let map = match own {
